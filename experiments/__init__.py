@@ -1,0 +1,1 @@
+"""Experiment scripts, one per paper table or figure; each registers itself for `workbench reproduce`."""

@@ -1,0 +1,246 @@
+"""The finite-element surface model shared by every reader, generator, algorithm and render path.
+
+Conventions (see the design notes): nodes are float64, elements are (M, 4) int32 with a
+triangle repeating its third node (``e[3] == e[2]``), one part id per element, optional
+(T, N, 3) coordinates of every time step sharing one topology, and fields per node
+((N,) or (T, N)) or per element ((M,) or (T, M)).
+
+Derived data (triangulation, unique edges, normals, crease-split "Gouraud edges") is computed
+on first request and cached on the instance; see :mod:`workbench.scene.derived`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+
+class MeshError(ValueError):
+    """An FE mesh that cannot be drawn or measured: empty, or with dangling node references."""
+
+
+@dataclass(eq=False)
+class FEMesh:
+    """A shell FE model: float64 nodes, (M, 4) int32 elements, part ids, time steps and fields.
+
+    Construction validates and normalises the arrays; an empty mesh, an element that names a
+    node outside ``nodes``, or a step array whose shape does not match is refused with
+    :class:`MeshError` (the first few offending elements are listed).
+    """
+
+    nodes: np.ndarray
+    elements: np.ndarray
+    parts: np.ndarray | None = None
+    steps: np.ndarray | None = None
+    node_fields: dict[str, np.ndarray] = field(default_factory=dict)
+    element_fields: dict[str, np.ndarray] = field(default_factory=dict)
+    part_names: dict[int, str] = field(default_factory=dict)
+    times: np.ndarray | None = None
+    name: str = "mesh"
+    units: str = "mm"
+
+    def __post_init__(self) -> None:
+        self.nodes = np.ascontiguousarray(self.nodes, dtype=np.float64)
+        if self.nodes.ndim != 2 or self.nodes.shape[1] != 3:
+            raise MeshError(f"{self.name}: nodes must be (N, 3), got {self.nodes.shape}")
+        elements = np.asarray(self.elements)
+        if elements.ndim == 2 and elements.shape[1] == 3:
+            elements = np.concatenate([elements, elements[:, 2:3]], axis=1)
+        if elements.ndim != 2 or elements.shape[1] != 4:
+            raise MeshError(f"{self.name}: elements must be (M, 4) or (M, 3), got {elements.shape}")
+        self.elements = np.ascontiguousarray(elements, dtype=np.int32)
+        if len(self.nodes) == 0 or len(self.elements) == 0:
+            raise MeshError(
+                f"{self.name}: empty mesh ({len(self.nodes)} nodes, {len(self.elements)} elements)"
+            )
+        if not np.isfinite(self.nodes).all():
+            bad = np.flatnonzero(~np.isfinite(self.nodes).all(axis=1))
+            raise MeshError(f"{self.name}: non-finite coordinates at nodes {bad[:5].tolist()}")
+        bad = np.flatnonzero(((self.elements < 0) | (self.elements >= len(self.nodes))).any(axis=1))
+        if len(bad):
+            raise MeshError(
+                f"{self.name}: {len(bad)} elements reference missing nodes, first "
+                f"{[(int(i), self.elements[i].tolist()) for i in bad[:5]]}"
+            )
+        if self.parts is None:
+            self.parts = np.zeros(len(self.elements), np.int32)
+        self.parts = np.ascontiguousarray(self.parts, dtype=np.int32)
+        if self.parts.shape != (len(self.elements),):
+            raise MeshError(f"{self.name}: parts must be ({len(self.elements)},), got {self.parts.shape}")
+        if self.steps is not None:
+            self.steps = np.ascontiguousarray(self.steps, dtype=np.float64)
+            if self.steps.ndim != 3 or self.steps.shape[1:] != self.nodes.shape:
+                raise MeshError(
+                    f"{self.name}: steps must be (T, {len(self.nodes)}, 3), got {self.steps.shape}"
+                )
+        for kind, fields, n in (("node", self.node_fields, len(self.nodes)),
+                                ("element", self.element_fields, len(self.elements))):
+            for key, values in list(fields.items()):
+                values = np.asarray(values, dtype=np.float64)
+                ok = values.shape == (n,) or (values.ndim == 2 and values.shape[1] == n
+                                              and values.shape[0] == self.n_steps)
+                if not ok:
+                    raise MeshError(
+                        f"{self.name}: {kind} field {key!r} must be ({n},) or "
+                        f"({self.n_steps}, {n}), got {values.shape}"
+                    )
+                fields[key] = values
+
+    # ----------------------------------------------------------------- sizes
+    @property
+    def n_nodes(self) -> int:
+        return len(self.nodes)
+
+    @property
+    def n_elements(self) -> int:
+        return len(self.elements)
+
+    @property
+    def n_steps(self) -> int:
+        """Number of time steps (1 for a static mesh)."""
+        return 1 if self.steps is None else len(self.steps)
+
+    @cached_property
+    def is_triangle(self) -> np.ndarray:
+        """(M,) bool: elements stored as triangles (third node repeated)."""
+        return self.elements[:, 3] == self.elements[:, 2]
+
+    @property
+    def n_quads(self) -> int:
+        return int((~self.is_triangle).sum())
+
+    # ----------------------------------------------------------------- geometry
+    def coordinates(self, step: int | None = None) -> np.ndarray:
+        """(N, 3) float64 node coordinates of ``step`` (the reference nodes when None or static)."""
+        if step is None or self.steps is None:
+            return self.nodes
+        return self.steps[step]
+
+    def node_field(self, name: str, step: int | None = None) -> np.ndarray:
+        """(N,) values of a per-node field at ``step`` (static fields ignore the step)."""
+        values = self.node_fields[name]
+        return values if values.ndim == 1 else values[0 if step is None else step]
+
+    def element_field(self, name: str, step: int | None = None) -> np.ndarray:
+        """(M,) values of a per-element field at ``step`` (static fields ignore the step)."""
+        values = self.element_fields[name]
+        return values if values.ndim == 1 else values[0 if step is None else step]
+
+    def field_range(self, name: str) -> tuple[float, float]:
+        """(min, max) of a field over all steps, finite values only."""
+        values = self.node_fields.get(name)
+        if values is None:
+            values = self.element_fields[name]
+        finite = values[np.isfinite(values)]
+        return (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+
+    def used_nodes(self) -> np.ndarray:
+        """Sorted indices of the nodes referenced by at least one element."""
+        return np.unique(self.elements)
+
+    def bounds(self, step: int | None = None, all_steps: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi) float64 corners of the axis-aligned box of the referenced nodes."""
+        used = self.used_nodes()
+        if all_steps and self.steps is not None:
+            pts = self.steps[:, used].reshape(-1, 3)
+        else:
+            pts = self.coordinates(step)[used]
+        return pts.min(axis=0), pts.max(axis=0)
+
+    def bounding_sphere(self, step: int | None = None, all_steps: bool = False) -> tuple[np.ndarray, float]:
+        """(centre, radius) of the sphere around the bounding box of the referenced nodes."""
+        lo, hi = self.bounds(step, all_steps)
+        return (lo + hi) / 2.0, float(np.linalg.norm(hi - lo) / 2.0)
+
+    def translated(self, offset) -> "FEMesh":
+        """A copy moved by ``offset`` (model units); topology and fields are shared."""
+        offset = np.asarray(offset, dtype=np.float64)
+        return FEMesh(
+            nodes=self.nodes + offset,
+            elements=self.elements,
+            parts=self.parts,
+            steps=None if self.steps is None else self.steps + offset,
+            node_fields=dict(self.node_fields),
+            element_fields=dict(self.element_fields),
+            part_names=dict(self.part_names),
+            times=self.times,
+            name=self.name,
+            units=self.units,
+        )
+
+    def part(self, part_id: int) -> "FEMesh":
+        """The sub-mesh of one part, with its nodes compacted (fields follow)."""
+        keep = self.parts == part_id
+        if not keep.any():
+            raise MeshError(f"{self.name}: no part {part_id}")
+        return self.subset(keep, name=f"{self.name}:{self.part_names.get(part_id, part_id)}")
+
+    def subset(self, element_mask: np.ndarray, name: str | None = None) -> "FEMesh":
+        """The sub-mesh of the selected elements, with unreferenced nodes removed."""
+        elements = self.elements[element_mask]
+        used, inverse = np.unique(elements, return_inverse=True)
+        return FEMesh(
+            nodes=self.nodes[used],
+            elements=inverse.reshape(elements.shape).astype(np.int32),
+            parts=self.parts[element_mask],
+            steps=None if self.steps is None else self.steps[:, used],
+            node_fields={k: v[..., used] for k, v in self.node_fields.items()},
+            element_fields={k: v[..., element_mask] for k, v in self.element_fields.items()},
+            part_names=dict(self.part_names),
+            times=self.times,
+            name=name or self.name,
+            units=self.units,
+        )
+
+    # ----------------------------------------------------------------- derived (cached)
+    @cached_property
+    def triangulation(self):
+        """:class:`~workbench.scene.derived.Triangulation`: quads split along the shorter diagonal."""
+        from .derived import triangulate
+
+        return triangulate(self.elements, self.nodes)
+
+    @property
+    def triangles(self) -> np.ndarray:
+        """(K, 3) int32 triangles into ``nodes`` (quads split along the shorter diagonal)."""
+        return self.triangulation.triangles
+
+    @cached_property
+    def edges(self) -> np.ndarray:
+        """(E, 2) int32 unique element edges (quad edges only, no diagonals), sorted per row."""
+        from .derived import unique_edges
+
+        return unique_edges(self.elements)
+
+    def face_normals(self, step: int | None = None) -> np.ndarray:
+        """(M, 3) float64 unit normals per element (zero for degenerate elements)."""
+        from .derived import element_normals
+
+        return element_normals(self.elements, self.coordinates(step))
+
+    def vertex_normals(self, step: int | None = None) -> np.ndarray:
+        """(N, 3) float64 area-weighted unit normals per node, no crease split."""
+        from .derived import node_normals
+
+        return node_normals(self.elements, self.coordinates(step))
+
+    def gouraud(self, crease_deg: float = 30.0):
+        """:class:`~workbench.scene.derived.GouraudSplit` for this crease angle (cached per angle).
+
+        Creases are detected on the first and last time steps together (crash2000, Fig. 2).
+        """
+        cache = self.__dict__.setdefault("_gouraud_cache", {})
+        if crease_deg not in cache:
+            from .derived import gouraud_split
+
+            coords = [self.coordinates(0)]
+            if self.n_steps > 1:
+                coords.append(self.coordinates(self.n_steps - 1))
+            cache[crease_deg] = gouraud_split(self.elements, coords, crease_deg, self.triangulation)
+        return cache[crease_deg]
+
+    def __repr__(self) -> str:
+        return (f"FEMesh({self.name!r}: {self.n_nodes} nodes, {self.n_elements} elements "
+                f"({self.n_quads} quads), {len(np.unique(self.parts))} parts, {self.n_steps} steps)")
