@@ -38,6 +38,8 @@ class FEMesh:
     element_fields: dict[str, np.ndarray] = field(default_factory=dict)
     part_names: dict[int, str] = field(default_factory=dict)
     times: np.ndarray | None = None
+    node_ids: np.ndarray | None = None
+    element_ids: np.ndarray | None = None
     name: str = "mesh"
     units: str = "mm"
 
@@ -166,6 +168,8 @@ class FEMesh:
             element_fields=dict(self.element_fields),
             part_names=dict(self.part_names),
             times=self.times,
+            node_ids=self.node_ids,
+            element_ids=self.element_ids,
             name=self.name,
             units=self.units,
         )
@@ -190,6 +194,8 @@ class FEMesh:
             element_fields={k: v[..., element_mask] for k, v in self.element_fields.items()},
             part_names=dict(self.part_names),
             times=self.times,
+            node_ids=None if self.node_ids is None else self.node_ids[used],
+            element_ids=None if self.element_ids is None else self.element_ids[element_mask],
             name=name or self.name,
             units=self.units,
         )
