@@ -1,1 +1,10 @@
-"""gl."""
+"""GL layer: headless EGL context, offscreen framebuffers, queries, cameras and shader loading."""
+
+from .camera import Camera
+from .context import GLUnavailable, create_context, renderer
+from .framebuffer import Framebuffer
+from .queries import GpuTimer, PrimitivesGenerated, SamplesPassed
+from .shaders import load_program
+
+__all__ = ["Camera", "Framebuffer", "GLUnavailable", "GpuTimer", "PrimitivesGenerated",
+           "SamplesPassed", "create_context", "load_program", "renderer"]

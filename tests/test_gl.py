@@ -1,0 +1,109 @@
+"""GL layer: context, framebuffer read-back, queries and the float64-origin camera."""
+
+import numpy as np
+import pytest
+
+from workbench.gl import Camera, Framebuffer, GpuTimer, SamplesPassed, create_context, renderer
+
+VERT = """#version 330
+uniform mat4 mvp;
+in vec3 position;
+void main() { gl_Position = mvp * vec4(position, 1.0); }
+"""
+FRAG = """#version 330
+out vec4 color;
+void main() { color = vec4(1.0, 0.0, 0.0, 1.0); }
+"""
+
+
+@pytest.fixture(scope="module")
+def ctx():
+    return create_context()
+
+
+def draw_quad(ctx, camera, corners, size=(64, 48), samples=0):
+    """Draw the float64 quad ``corners`` (4, 3) in red on white; return the image and samples passed."""
+    fb = Framebuffer(ctx, size, samples=samples)
+    prog = ctx.program(vertex_shader=VERT, fragment_shader=FRAG)
+    prog["mvp"].write(camera.mvp_bytes())
+    vbo = ctx.buffer(camera.relative(corners)[[0, 1, 2, 0, 2, 3]].tobytes())
+    vao = ctx.vertex_array(prog, [(vbo, "3f", "position")])
+    fb.clear()
+    ctx.enable(ctx.DEPTH_TEST)
+    with SamplesPassed(ctx) as occlusion:
+        vao.render()
+    image = fb.read()
+    for obj in (vao, vbo, prog):
+        obj.release()
+    fb.release()
+    return image, occlusion.samples
+
+
+def red_mask(image):
+    return (image[..., 0] == 255) & (image[..., 1] == 0)
+
+
+def test_renderer_is_named(ctx):
+    assert renderer(ctx)
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e6])
+def test_quad_covers_known_pixel_rectangle(ctx, offset):
+    # orthographic camera on a 2 x 2 view (radius 1, aspect 4:3 widens x): 64 x 48 pixels span
+    # x in [-4/3, 4/3] and y in [-1, 1], so a pixel is 1/24 model units wide.
+    o = np.array([offset, -offset, offset])
+    cam = Camera.fit(o, 1.0, margin=1.0, aspect=64 / 48)
+    corners = o + np.array([[-0.5, -0.25, 0], [0.5, -0.25, 0], [0.5, 0.5, 0], [-0.5, 0.5, 0]])
+    image, samples = draw_quad(ctx, cam, corners)
+    mask = red_mask(image)
+    rows, cols = np.nonzero(mask)
+    # x: [-0.5, 0.5] → pixels 32 ± 12; y: [-0.25, 0.5] → rows from 24 - 12 = 12 to 24 + 6 = 30
+    assert (cols.min(), cols.max() + 1) == (20, 44)
+    assert (rows.min(), rows.max() + 1) == (12, 30)
+    assert mask.sum() == 24 * 18 == samples
+
+
+def test_project_matches_rasterised_corners(ctx):
+    cam = Camera.fit([3.0, 2.0, 1.0], 2.0, azimuth=30, elevation=20, projection="perspective",
+                     aspect=1.0)
+    pts = cam.project([[3.0, 2.0, 1.0]], (100, 100))
+    assert np.allclose(pts[0, :2], [50, 50])
+    assert 0.0 < pts[0, 2] < 1.0
+
+
+def test_near_far_enclose_sphere_tightly():
+    for projection in ("orthographic", "perspective"):
+        cam = Camera.fit([0, 0, 0], 5.0, azimuth=45, elevation=30, projection=projection, margin=1.0)
+        dist = np.linalg.norm(cam.eye - cam.target)
+        assert np.isclose(cam.far - dist, 5.0)
+        assert cam.near > 0 and np.isclose(dist - cam.near, 5.0)
+
+
+def test_view_angles_are_oriented():
+    # azimuth 90 puts the eye on +X; elevation 90 puts it on +Y; roll 90 turns +Y up into -X up
+    assert np.allclose(Camera.fit([0, 0, 0], 1, azimuth=90, margin=1).eye / 2, [1, 0, 0])
+    assert np.allclose(Camera.fit([0, 0, 0], 1, elevation=90, margin=1).eye / 2, [0, 1, 0])
+    up = Camera.fit([0, 0, 0], 1, roll=90).up
+    assert np.allclose(up, [-1, 0, 0]) or np.allclose(up, [1, 0, 0])
+    cam = Camera.fit([0, 0, 0], 1, roll=90)
+    # a point on +X appears above the centre once the image is rolled counter-clockwise
+    assert cam.project([[0.5, 0, 0]], (100, 100))[0, 1] < 50
+
+
+def test_far_origin_keeps_subpixel_precision(ctx):
+    # with world-space float32 upload, 1e7 offsets lose ~1 unit; relative upload keeps the edge exact
+    o = np.array([1e7, 1e7, 0.0])
+    cam = Camera.fit(o, 1.0, margin=1.0)
+    corners = o + np.array([[-0.5, -0.5, 0], [0.5, -0.5, 0], [0.5, 0.5, 0], [-0.5, 0.5, 0]])
+    image, _ = draw_quad(ctx, cam, corners, size=(64, 64))
+    assert red_mask(image).sum() == 32 * 32
+
+
+def test_msaa_resolves_and_timer_reports(ctx):
+    cam = Camera.fit([0, 0, 0], 1.0, margin=1.0)
+    corners = np.array([[-0.5, -0.5, 0], [0.5, -0.5, 0], [0.5, 0.5, 0], [-0.5, 0.5, 0]])
+    image, _ = draw_quad(ctx, cam, corners, size=(32, 32), samples=4)
+    assert image.shape == (32, 32, 4) and red_mask(image).sum() == 16 * 16
+    with GpuTimer(ctx) as timer:
+        draw_quad(ctx, cam, corners)
+    assert timer.elapsed_ms >= 0.0

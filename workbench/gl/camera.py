@@ -1,0 +1,128 @@
+"""Cameras fitted to a bounding sphere, in float64, with a float64 upload origin.
+
+Vertices are uploaded as float32 *relative to* ``Camera.origin`` (the scene centre), and the
+matrices are composed in float64 with that origin folded in before the final cast to float32,
+so that a model 10⁶ mm from the world origin keeps the precision of one at the origin.
+
+View angles: azimuth 0 and elevation 0 look down −Z with +Y up (the eye is on the +Z side);
+azimuth turns the eye about +Y towards +X, elevation lifts it towards +Y, roll turns the image
+counter-clockwise about the viewing direction. Angles in degrees.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+PROJECTIONS = ("orthographic", "perspective")
+
+
+def _look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray) -> np.ndarray:
+    forward = target - eye
+    forward /= np.linalg.norm(forward)
+    side = np.cross(forward, up)
+    side /= np.linalg.norm(side)
+    true_up = np.cross(side, forward)
+    view = np.eye(4)
+    view[0, :3], view[1, :3], view[2, :3] = side, true_up, -forward
+    view[:3, 3] = -view[:3, :3] @ eye
+    return view
+
+
+@dataclass
+class Camera:
+    """A float64 camera: eye/target/up relative to ``origin``, projection and tight near/far."""
+
+    origin: np.ndarray
+    eye: np.ndarray
+    target: np.ndarray
+    up: np.ndarray
+    projection: str = "orthographic"
+    half_height: float = 1.0  # orthographic half extent of the view, model units
+    fov_deg: float = 30.0  # perspective vertical field of view
+    aspect: float = 1.0  # width / height
+    near: float = 0.1
+    far: float = 10.0
+
+    @classmethod
+    def fit(cls, center, radius: float, *, azimuth: float = 0.0, elevation: float = 0.0,
+            roll: float = 0.0, projection: str = "orthographic", fov_deg: float = 30.0,
+            aspect: float = 1.0, margin: float = 1.05, origin=None) -> "Camera":
+        """A camera that sees the whole sphere (``center``, ``radius``) from the given angles.
+
+        Near and far planes enclose the sphere tightly (``margin`` times its radius); the
+        upload origin defaults to the sphere centre. Refuses a non-positive or non-finite radius.
+        """
+        if projection not in PROJECTIONS:
+            raise ValueError(f"projection must be one of {PROJECTIONS}, got {projection!r}")
+        if not (np.isfinite(radius) and radius > 0):
+            raise ValueError(f"bounding radius must be positive and finite, got {radius}")
+        center = np.asarray(center, np.float64)
+        origin = center.copy() if origin is None else np.asarray(origin, np.float64)
+        az, el, ro = np.radians([azimuth, elevation, roll])
+        direction = np.array([np.sin(az) * np.cos(el), np.sin(el), np.cos(az) * np.cos(el)])
+        # up: +Y tilted with the elevation, then rolled about the viewing direction
+        up = np.array([-np.sin(az) * np.sin(el), np.cos(el), -np.cos(az) * np.sin(el)])
+        side = np.cross(up, direction)
+        up = np.cos(ro) * up - np.sin(ro) * side
+        r = radius * margin
+        half_height = r if aspect >= 1.0 else r / aspect
+        if projection == "orthographic":
+            distance = 2.0 * r
+        else:
+            half_fov = np.radians(fov_deg) / 2.0
+            narrow = half_fov if aspect >= 1.0 else np.arctan(np.tan(half_fov) * aspect)
+            distance = r / np.sin(narrow)
+        near = max(distance - r, 1e-4 * (distance + r)) if projection == "perspective" else distance - r
+        return cls(origin=origin, eye=center - origin + distance * direction, target=center - origin,
+                   up=up, projection=projection, half_height=half_height, fov_deg=fov_deg,
+                   aspect=aspect, near=near, far=distance + r)
+
+    def view_matrix(self) -> np.ndarray:
+        """(4, 4) float64: coordinates relative to ``origin`` → eye space."""
+        return _look_at(np.asarray(self.eye, np.float64), np.asarray(self.target, np.float64),
+                        np.asarray(self.up, np.float64))
+
+    def projection_matrix(self) -> np.ndarray:
+        """(4, 4) float64 OpenGL clip-space projection."""
+        n, f = self.near, self.far
+        proj = np.zeros((4, 4))
+        if self.projection == "orthographic":
+            h, w = self.half_height, self.half_height * self.aspect
+            proj[0, 0], proj[1, 1], proj[2, 2] = 1.0 / w, 1.0 / h, -2.0 / (f - n)
+            proj[2, 3], proj[3, 3] = -(f + n) / (f - n), 1.0
+        else:
+            t = 1.0 / np.tan(np.radians(self.fov_deg) / 2.0)
+            proj[0, 0], proj[1, 1] = t / self.aspect, t
+            proj[2, 2], proj[2, 3] = -(f + n) / (f - n), -2.0 * f * n / (f - n)
+            proj[3, 2] = -1.0
+        return proj
+
+    def mvp(self) -> np.ndarray:
+        """(4, 4) float64 view-projection for coordinates relative to ``origin``."""
+        return self.projection_matrix() @ self.view_matrix()
+
+    def mvp_bytes(self) -> bytes:
+        """The view-projection as float32 column-major bytes for a ``mat4`` uniform."""
+        return self.mvp().T.astype(np.float32).tobytes()
+
+    def view_bytes(self) -> bytes:
+        """The view matrix as float32 column-major bytes for a ``mat4`` uniform."""
+        return self.view_matrix().T.astype(np.float32).tobytes()
+
+    def relative(self, points) -> np.ndarray:
+        """float32 coordinates relative to ``origin``: what is uploaded for float64 ``points``."""
+        return (np.asarray(points, np.float64) - self.origin).astype(np.float32)
+
+    def project(self, points, size: tuple[int, int]) -> np.ndarray:
+        """(N, 3) float64 window coordinates (x right, y down from the top, depth in [0, 1]).
+
+        Pixel (i, j) of a read-back image covers x in [j, j+1), y in [i, i+1); its centre is
+        (j + 0.5, i + 0.5).
+        """
+        rel = np.asarray(points, np.float64) - self.origin
+        clip = np.c_[rel, np.ones(len(rel))] @ self.mvp().T
+        ndc = clip[:, :3] / clip[:, 3:4]
+        width, height = size
+        return np.c_[(ndc[:, 0] + 1) * width / 2, (1 - ndc[:, 1]) * height / 2, (ndc[:, 2] + 1) / 2]

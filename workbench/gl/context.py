@@ -1,0 +1,36 @@
+"""The headless OpenGL context every render path and measurement shares."""
+
+from __future__ import annotations
+
+import moderngl
+
+EGL_PACKAGES = "libegl1 libegl-mesa0 libgl1-mesa-dri"
+
+
+class GLUnavailable(RuntimeError):
+    """No headless OpenGL 3.3+ context could be created through EGL."""
+
+
+def create_context(require: int = 330) -> moderngl.Context:
+    """A standalone moderngl context on EGL (no display needed), OpenGL ``require`` or newer.
+
+    Refuses with :class:`GLUnavailable` naming the Debian packages to install when EGL or a
+    Mesa/GPU driver is missing.
+    """
+    try:
+        ctx = moderngl.create_standalone_context(require=require, backend="egl")
+    except Exception as exc:  # moderngl raises plain Exception for a missing libEGL or driver
+        raise GLUnavailable(
+            f"no headless OpenGL {require // 100}.{require % 100 // 10} context through EGL ({exc}); "
+            f"on Debian/Ubuntu install: apt-get install {EGL_PACKAGES}"
+        ) from exc
+    return ctx
+
+
+def renderer(ctx: moderngl.Context) -> str:
+    """The renderer string recorded in every measurement row (e.g. 'llvmpipe (LLVM 15.0.6, 256 bits)')."""
+    return str(ctx.info["GL_RENDERER"])
+
+
+def gl_version(ctx: moderngl.Context) -> str:
+    return str(ctx.info["GL_VERSION"])
