@@ -65,7 +65,7 @@ class Camera:
         # up: +Y tilted with the elevation, then rolled about the viewing direction
         up = np.array([-np.sin(az) * np.sin(el), np.cos(el), -np.cos(az) * np.sin(el)])
         side = np.cross(up, direction)
-        up = np.cos(ro) * up - np.sin(ro) * side
+        up = np.cos(ro) * up + np.sin(ro) * side
         r = radius * margin
         half_height = r if aspect >= 1.0 else r / aspect
         if projection == "orthographic":
