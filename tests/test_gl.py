@@ -90,6 +90,15 @@ def test_view_angles_are_oriented():
     assert cam.project([[0.5, 0, 0]], (100, 100))[0, 1] < 50
 
 
+def test_z_up_frame():
+    cam = Camera.fit([0, 0, 0], 1, up="z", margin=1)
+    assert np.allclose(cam.eye / 2, [0, -1, 0]) and np.allclose(cam.up, [0, 0, 1])
+    # +Z appears above the centre, +X to the right
+    top, right = cam.project([[0, 0, 0.5], [0.5, 0, 0]], (100, 100))
+    assert top[1] < 50 and right[0] > 50
+    assert np.allclose(Camera.fit([0, 0, 0], 1, up="z", elevation=90, margin=1).eye / 2, [0, 0, 1])
+
+
 def test_far_origin_keeps_subpixel_precision(ctx):
     # with world-space float32 upload, 1e7 offsets lose ~1 unit; relative upload keeps the edge exact
     o = np.array([1e7, 1e7, 0.0])

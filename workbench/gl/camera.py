@@ -6,7 +6,9 @@ so that a model 10⁶ mm from the world origin keeps the precision of one at the
 
 View angles: azimuth 0 and elevation 0 look down −Z with +Y up (the eye is on the +Z side);
 azimuth turns the eye about +Y towards +X, elevation lifts it towards +Y, roll turns the image
-counter-clockwise about the viewing direction. Angles in degrees.
+counter-clockwise about the viewing direction. Angles in degrees. With ``up="z"`` (the usual
+convention of CAE models) the same angles apply to a frame turned so that +Z is up: azimuth 0
+and elevation 0 then look along +Y from the −Y side.
 """
 
 from __future__ import annotations
@@ -16,6 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 PROJECTIONS = ("orthographic", "perspective")
+# columns: the world directions of the Y-up frame's x, y, z axes
+_UP_FRAMES = {"y": np.eye(3), "z": np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])}
 
 
 def _look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray) -> np.ndarray:
@@ -48,12 +52,15 @@ class Camera:
     @classmethod
     def fit(cls, center, radius: float, *, azimuth: float = 0.0, elevation: float = 0.0,
             roll: float = 0.0, projection: str = "orthographic", fov_deg: float = 30.0,
-            aspect: float = 1.0, margin: float = 1.05, origin=None) -> "Camera":
+            aspect: float = 1.0, margin: float = 1.05, origin=None, up: str = "y") -> "Camera":
         """A camera that sees the whole sphere (``center``, ``radius``) from the given angles.
 
         Near and far planes enclose the sphere tightly (``margin`` times its radius); the
-        upload origin defaults to the sphere centre. Refuses a non-positive or non-finite radius.
+        upload origin defaults to the sphere centre; ``up`` is the world axis shown upwards at
+        elevation 0 ("y" or "z"). Refuses a non-positive or non-finite radius.
         """
+        if up not in _UP_FRAMES:
+            raise ValueError(f"up must be 'y' or 'z', got {up!r}")
         if projection not in PROJECTIONS:
             raise ValueError(f"projection must be one of {PROJECTIONS}, got {projection!r}")
         if not (np.isfinite(radius) and radius > 0):
@@ -63,9 +70,12 @@ class Camera:
         az, el, ro = np.radians([azimuth, elevation, roll])
         direction = np.array([np.sin(az) * np.cos(el), np.sin(el), np.cos(az) * np.cos(el)])
         # up: +Y tilted with the elevation, then rolled about the viewing direction
+        up_axis = up
         up = np.array([-np.sin(az) * np.sin(el), np.cos(el), -np.cos(az) * np.sin(el)])
         side = np.cross(up, direction)
         up = np.cos(ro) * up + np.sin(ro) * side
+        frame = _UP_FRAMES[up_axis]
+        direction, up = frame @ direction, frame @ up
         r = radius * margin
         half_height = r if aspect >= 1.0 else r / aspect
         if projection == "orthographic":
