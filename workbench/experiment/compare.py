@@ -1,0 +1,125 @@
+"""Image error against a reference image: max and mean difference, differing share, PSNR, SSIM.
+
+Images are uint8 (H, W, 3) or (H, W, 4) arrays; differences are in 1/255 units.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+SSIM_WINDOW = 7  # scikit-image's default window; smaller images are refused
+
+
+@dataclass(frozen=True)
+class ImageDiff:
+    """How far image ``b`` is from reference ``a``.
+
+    ``max_abs``: largest channel difference over RGB(A), in 1/255. ``mean_abs``: mean absolute
+    difference per RGB channel, in 1/255. ``share_differing``: share (0..1) of pixels with any
+    RGB(A) channel differing. ``psnr``: peak signal-to-noise ratio of RGB in dB, ``inf`` for
+    identical colours. ``ssim``: structural similarity of RGB (scikit-image, data range 255),
+    1 for identical colours.
+    """
+
+    max_abs: int
+    mean_abs: float
+    share_differing: float
+    psnr: float
+    ssim: float
+
+    def as_row(self, prefix: str = "") -> dict[str, float | int]:
+        """Flat table columns, names optionally prefixed."""
+        return {prefix + k: getattr(self, k)
+                for k in ("max_abs", "mean_abs", "share_differing", "psnr", "ssim")}
+
+
+def _check_image(image, name: str) -> np.ndarray:
+    image = np.asarray(image)
+    if image.dtype != np.uint8:
+        raise TypeError(f"{name} must be a uint8 image, got dtype {image.dtype}")
+    if image.ndim != 3 or image.shape[2] not in (3, 4):
+        raise ValueError(f"{name} must be (H, W, 3) or (H, W, 4), got shape {image.shape}")
+    return image
+
+
+def difference_map(a, b) -> np.ndarray:
+    """(H, W) uint8: the largest absolute channel difference of each pixel, in 1/255."""
+    a, b = _check_image(a, "a"), _check_image(b, "b")
+    if a.shape != b.shape:
+        raise ValueError(f"images differ in shape: {a.shape} vs {b.shape}")
+    return np.abs(a.astype(np.int16) - b.astype(np.int16)).max(axis=2).astype(np.uint8)
+
+
+def compare_images(a, b, mask=None) -> ImageDiff:
+    """Compare image ``b`` with reference ``a`` (same shape, uint8, 3 or 4 channels).
+
+    With a boolean (H, W) ``mask`` every statistic covers only the masked pixels (SSIM: the mean
+    of scikit-image's SSIM map over them). Refuses differing shapes, non-uint8 images, images
+    smaller than 7 × 7 (the SSIM window), a mask of the wrong shape and an empty mask.
+    """
+    from skimage.metrics import structural_similarity
+
+    a, b = _check_image(a, "a"), _check_image(b, "b")
+    if a.shape != b.shape:
+        raise ValueError(f"images differ in shape: {a.shape} vs {b.shape}")
+    if min(a.shape[:2]) < SSIM_WINDOW:
+        raise ValueError(f"images must be at least {SSIM_WINDOW} x {SSIM_WINDOW} pixels for SSIM, "
+                         f"got {a.shape[1]} x {a.shape[0]}")
+    if mask is None:
+        mask = np.ones(a.shape[:2], bool)
+    else:
+        mask = np.asarray(mask)
+        if mask.shape != a.shape[:2] or mask.dtype != bool:
+            raise ValueError(f"mask must be a boolean array of shape {a.shape[:2]}, "
+                             f"got {mask.dtype} {mask.shape}")
+        if not mask.any():
+            raise ValueError("mask selects no pixels")
+    diff = np.abs(a.astype(np.int16) - b.astype(np.int16))[mask]  # (P, C)
+    max_abs = int(diff.max())
+    rgb = diff[:, :3].astype(np.float64)
+    mean_abs = float(rgb.mean())
+    share = float((diff > 0).any(axis=1).mean())
+    mse = float((rgb ** 2).mean())
+    psnr = math.inf if mse == 0.0 else 10.0 * math.log10(255.0 ** 2 / mse)
+    if mse == 0.0:
+        ssim = 1.0
+    else:
+        _, ssim_map = structural_similarity(a[..., :3], b[..., :3], channel_axis=2,
+                                            data_range=255, full=True)
+        ssim = float(ssim_map[mask].mean())
+    return ImageDiff(max_abs=max_abs, mean_abs=mean_abs, share_differing=share, psnr=psnr,
+                     ssim=ssim)
+
+
+def _background_bytes(background) -> np.ndarray:
+    bg = np.asarray(background)
+    if bg.ndim != 1 or bg.shape[0] not in (3, 4):
+        raise ValueError(f"background must have 3 or 4 components, got {background!r}")
+    if np.issubdtype(bg.dtype, np.floating):
+        if not np.all((bg >= 0.0) & (bg <= 1.0)):
+            raise ValueError(f"float background components must lie in [0, 1], got {background!r}")
+        return np.rint(bg * 255.0).astype(np.int16)
+    if np.issubdtype(bg.dtype, np.integer):
+        if not np.all((bg >= 0) & (bg <= 255)):
+            raise ValueError("integer background components must lie in [0, 255], "
+                             f"got {background!r}")
+        return bg.astype(np.int16)
+    raise TypeError(f"background must be numeric, got {background!r}")
+
+
+def coverage(image, background=(1.0, 1.0, 1.0, 1.0), tolerance: int = 0) -> np.ndarray:
+    """(H, W) bool: pixels whose colour differs from ``background`` by more than ``tolerance``.
+
+    ``background`` has 3 (RGB compared) or 4 (RGBA compared) components: floats in [0, 1] as
+    passed to ``Framebuffer.clear``, or integers in [0, 255]. ``tolerance`` is in 1/255.
+    """
+    image = _check_image(image, "image")
+    bg = _background_bytes(background)
+    channels = len(bg)
+    if channels > image.shape[2]:
+        raise ValueError("an RGBA background needs an RGBA image")
+    diff = np.abs(image[..., :channels].astype(np.int16) - bg)
+    return (diff > tolerance).any(axis=2)

@@ -1,0 +1,210 @@
+"""Figures from rendered images: PNGs, field images with a labelled colour bar, comparison grids.
+
+matplotlib is used through ``Figure`` + ``FigureCanvasAgg`` only (never pyplot), so nothing
+opens a window and no global state changes. Rendered images are placed at their native
+resolution (one image pixel = one figure pixel, 100 dpi; images under 160 pixels high are
+enlarged by repeating each pixel k × k) so figures show exactly what was measured. Every
+file is written atomically.
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from .tables import atomic_write_bytes
+
+DPI = 100
+MARGIN = 10  # pixels around panels
+TITLE_HEIGHT = 28
+BAR_GAP, BAR_WIDTH, BAR_LABELS = 12, 18, 110  # colour bar: gap, bar, ticks + label (pixels)
+MIN_PANEL_HEIGHT = 160  # smaller images are enlarged by pixel repetition
+
+
+def _check_image(image, name: str = "image") -> np.ndarray:
+    image = np.asarray(image)
+    if image.dtype != np.uint8 or image.ndim != 3 or image.shape[2] not in (3, 4):
+        raise ValueError(f"{name} must be a uint8 (H, W, 3) or (H, W, 4) array, "
+                         f"got {image.dtype} {image.shape}")
+    return image
+
+
+def _rgba(image: np.ndarray) -> np.ndarray:
+    if image.shape[2] == 4:
+        return np.ascontiguousarray(image)
+    return np.concatenate([image, np.full(image.shape[:2] + (1,), 255, np.uint8)], axis=2)
+
+
+def save_png(path, image) -> Path:
+    """Write a uint8 (H, W, 3|4) image, row 0 at the top, as an RGBA PNG (atomically)."""
+    from PIL import Image
+
+    image = _rgba(_check_image(image))
+    buffer = io.BytesIO()
+    Image.fromarray(image, "RGBA").save(buffer, format="PNG")
+    return atomic_write_bytes(path, buffer.getvalue())
+
+
+def _colormap(colormap):
+    import matplotlib
+    from matplotlib.colors import Colormap, ListedColormap
+
+    if isinstance(colormap, Colormap):
+        return colormap
+    if isinstance(colormap, str):
+        try:
+            return matplotlib.colormaps[colormap]
+        except KeyError:
+            raise ValueError(f"unknown matplotlib colour map {colormap!r}") from None
+    colors = np.asarray(colormap)
+    if colors.ndim != 2 or colors.shape[1] not in (3, 4) or len(colors) < 2:
+        raise ValueError("colormap must be a name, a matplotlib Colormap or an (N, 3|4) colour "
+                         f"table with N >= 2, got shape {colors.shape}")
+    if np.issubdtype(colors.dtype, np.integer):
+        colors = colors / 255.0
+    return ListedColormap(np.asarray(colors, np.float64))
+
+
+def _mappable(value_range, colormap, bands: int, log: bool):
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import BoundaryNorm, LogNorm, Normalize
+
+    lo, hi = (float(v) for v in value_range)
+    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+        raise ValueError(f"value_range must be finite with low < high, got {value_range}")
+    if log and lo <= 0:
+        raise ValueError(f"a logarithmic colour bar needs a positive range, got {value_range}")
+    if int(bands) != bands or bands < 0:
+        raise ValueError(f"bands must be a non-negative integer, got {bands}")
+    cmap = _colormap(colormap)
+    if bands:
+        cmap = cmap.resampled(int(bands))
+        edges = np.geomspace(lo, hi, bands + 1) if log else np.linspace(lo, hi, bands + 1)
+        return ScalarMappable(BoundaryNorm(edges, int(bands)), cmap), edges
+    norm = LogNorm(lo, hi) if log else Normalize(lo, hi)
+    return ScalarMappable(norm, cmap), None
+
+
+def _new_figure(width_px: int, height_px: int):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width_px / DPI, height_px / DPI), dpi=DPI)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _axes_px(fig, left: int, bottom: int, width: int, height: int):
+    """Axes at a pixel rectangle (origin at the figure's bottom left)."""
+    fw, fh = fig.get_size_inches() * DPI
+    return fig.add_axes((left / fw, bottom / fh, width / fw, height / fh))
+
+
+def _show(ax, image, **kwargs) -> None:
+    ax.imshow(image, interpolation="none", aspect="auto", resample=False, **kwargs)
+    ax.set_axis_off()
+
+
+def _write_figure(fig, path) -> Path:
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=DPI)
+    return atomic_write_bytes(path, buffer.getvalue())
+
+
+def _display_scale(height: int) -> int:
+    """Integer enlargement so that a small image (and its colour bar) stays legible."""
+    return max(1, -(-MIN_PANEL_HEIGHT // height))
+
+
+def _enlarge(image: np.ndarray, scale: int) -> np.ndarray:
+    return image if scale == 1 else np.repeat(np.repeat(image, scale, axis=0), scale, axis=1)
+
+
+def save_field_figure(path, image, *, value_range, colormap, label: str, units: str,
+                      title: str | None = None, bands: int = 0, log: bool = False) -> Path:
+    """A rendered field image with a colour bar ``label [units]``; returns the path.
+
+    ``value_range`` = (low, high) is the field range the render mapped onto ``colormap`` (a
+    matplotlib name, a ``Colormap`` or the (N, 3|4) colour table the render path used);
+    ``bands`` > 0 shows a colour bar of that many equal bands (band contours), ticked at the
+    band edges; ``log`` a logarithmic scale. The image keeps its pixels (native resolution, or
+    each pixel repeated k × k when it is under 160 pixels high); axes are hidden. Refuses a
+    non-uint8 image, an empty or non-finite range, a non-positive range with ``log`` and a
+    negative band count.
+    """
+    from matplotlib.ticker import FuncFormatter
+
+    image = _check_image(image)
+    mappable, edges = _mappable(value_range, colormap, bands, log)
+    image = _enlarge(image, _display_scale(image.shape[0]))
+    h, w = image.shape[:2]
+    top = TITLE_HEIGHT if title else MARGIN
+    fig = _new_figure(MARGIN + w + BAR_GAP + BAR_WIDTH + BAR_LABELS, MARGIN + h + top)
+    _show(_axes_px(fig, MARGIN, MARGIN, w, h), image)
+    bar = fig.colorbar(mappable, cax=_axes_px(fig, MARGIN + w + BAR_GAP, MARGIN, BAR_WIDTH, h))
+    if edges is not None and bands <= 12:
+        bar.set_ticks(edges)
+        bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
+    bar.set_label(f"{label} [{units}]" if units else label)
+    if title:
+        fig.text(0.5, 1.0 - (TITLE_HEIGHT / 2) / (MARGIN + h + top), title, ha="center",
+                 va="center")
+    return _write_figure(fig, path)
+
+
+def save_image_grid(path, images: Sequence, titles: Sequence[str], *, columns: int | None = None,
+                    colormap: str = "magma", scalar_label: str = "|difference| [1/255]") -> Path:
+    """Images side by side, each under its title; returns the path.
+
+    ``images`` are uint8 (H, W, 3|4) renders or (H, W) scalar maps (e.g. a difference image from
+    :func:`workbench.experiment.compare.difference_map`), all of one size; scalar maps are shown
+    with ``colormap`` from 0 to their maximum and a colour bar ``scalar_label``. ``columns``
+    panels per row (default: all in one row). Pixels are kept as in
+    :func:`save_field_figure`. Refuses mismatched counts or sizes and non-finite maps.
+    """
+    images = [np.asarray(im) for im in images]
+    if not images:
+        raise ValueError("no images to show")
+    if len(titles) != len(images):
+        raise ValueError(f"{len(images)} images but {len(titles)} titles")
+    for i, im in enumerate(images):
+        if im.ndim == 3:
+            _check_image(im, f"image {i}")
+        elif im.ndim != 2 or not np.isfinite(im).all():
+            raise ValueError(f"image {i} must be (H, W, 3|4) uint8 or a finite (H, W) map, "
+                             f"got shape {im.shape}")
+    if any(im.shape[:2] != images[0].shape[:2] for im in images):
+        raise ValueError(f"images differ in size: {[im.shape[:2] for im in images]}")
+    columns = len(images) if columns is None else int(columns)
+    if columns < 1:
+        raise ValueError(f"columns must be positive, got {columns}")
+    scale = _display_scale(images[0].shape[0])
+    images = [_enlarge(im, scale) for im in images]
+    h, w = images[0].shape[:2]
+    bar_w = BAR_GAP + BAR_WIDTH + BAR_LABELS
+    grid = [images[i:i + columns] for i in range(0, len(images), columns)]
+    widths = [[w + MARGIN + (bar_w if im.ndim == 2 else 0) for im in row] for row in grid]
+    cell_h = h + TITLE_HEIGHT
+    fig_w = MARGIN + max(sum(row) for row in widths)
+    fig_h = MARGIN + len(grid) * cell_h
+    fig = _new_figure(fig_w, fig_h)
+    titles = iter(titles)
+    for r, (row, row_widths) in enumerate(zip(grid, widths)):
+        bottom = MARGIN + (len(grid) - 1 - r) * cell_h
+        left = MARGIN
+        for im, cell_w in zip(row, row_widths):
+            ax = _axes_px(fig, left, bottom, w, h)
+            if im.ndim == 2:
+                _show(ax, im, cmap=colormap, vmin=0.0, vmax=float(max(im.max(), 1)))
+                bar = fig.colorbar(ax.images[0],
+                                   cax=_axes_px(fig, left + w + BAR_GAP, bottom, BAR_WIDTH, h))
+                bar.set_label(scalar_label)
+            else:
+                _show(ax, im)
+            fig.text((left + w / 2) / fig_w, (bottom + h + TITLE_HEIGHT / 2) / fig_h,
+                     next(titles), ha="center", va="center")
+            left += cell_w
+    return _write_figure(fig, path)

@@ -1,0 +1,112 @@
+"""The experiment registry behind ``workbench reproduce``.
+
+An experiment script in the top-level ``experiments/`` folder (the package
+``workbench.experiments``) registers a function with :func:`experiment`; the function
+``run(out_dir, quick, progress)`` writes its figures into ``out_dir`` and returns its rows.
+:func:`run_experiment` then writes ``table.csv``/``table.md`` from those rows.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from .tables import write_table
+
+Progress = Callable[[str], None]
+RunFunction = Callable[[Path, bool, "Progress | None"], list]
+
+EXPERIMENTS_PACKAGE = "workbench.experiments"
+_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """A registered experiment: its name (also its figures folder), a one-line description and
+    the function ``run(out_dir: Path, quick: bool, progress) -> list[dict]``."""
+
+    name: str
+    description: str
+    function: RunFunction
+
+
+EXPERIMENTS: dict[str, Experiment] = {}
+_discovered = False
+
+
+def experiment(name: str, description: str) -> Callable[[RunFunction], RunFunction]:
+    """Decorator registering ``run`` under ``name`` (letters, digits, ``_ . -``; it names the
+    folder ``figures/<name>/``). Refuses a name already taken by a different function; a module
+    imported again replaces its own entry. Returns the function unchanged."""
+    if not isinstance(name, str) or not _NAME.match(name):
+        raise ValueError(f"experiment name must be letters, digits, '_', '.' or '-' (not leading), "
+                         f"got {name!r}")
+
+    def register(function: RunFunction) -> RunFunction:
+        if not callable(function):
+            raise TypeError(f"experiment {name!r} must decorate a function")
+        old = EXPERIMENTS.get(name)
+        if old is not None and (old.function.__module__, old.function.__qualname__) != (
+                function.__module__, function.__qualname__):
+            raise ValueError(f"experiment {name!r} is already registered by "
+                             f"{old.function.__module__}.{old.function.__qualname__}")
+        EXPERIMENTS[name] = Experiment(name, str(description), function)
+        return function
+
+    return register
+
+
+def discover(package: str = EXPERIMENTS_PACKAGE) -> dict[str, Experiment]:
+    """Import every module of ``package`` (they register on import) and return the registry.
+
+    Modules whose name starts with ``_`` are skipped. An import error propagates, naming the
+    module, so a broken script is not silently missing from the list.
+    """
+    global _discovered
+    pkg = importlib.import_module(package)
+    for module in sorted(pkgutil.iter_modules(pkg.__path__), key=lambda m: m.name):
+        if module.name.startswith("_"):
+            continue
+        full = f"{package}.{module.name}"
+        try:
+            importlib.import_module(full)
+        except Exception as exc:
+            raise ImportError(f"experiment module {full} failed to import: {exc}") from exc
+    _discovered = True
+    return EXPERIMENTS
+
+
+def get_experiment(name: str) -> Experiment:
+    """The registered experiment ``name``; KeyError listing the known names otherwise."""
+    try:
+        return EXPERIMENTS[name]
+    except KeyError:
+        known = ", ".join(sorted(EXPERIMENTS)) or "none"
+        hint = "" if _discovered else " (call discover() first to register the experiment scripts)"
+        raise KeyError(f"unknown experiment {name!r}; known: {known}{hint}") from None
+
+
+def run_experiment(name: str, figures_root: Path = Path("figures"), quick: bool = False,
+                   progress: Progress | None = None) -> tuple[list[dict], Path]:
+    """Run experiment ``name`` into ``figures_root/<name>/`` and write its table there.
+
+    Creates the folder, calls the experiment's function, writes ``table.csv`` and ``table.md``
+    (atomically, titled with the name and description) and returns ``(rows, out_dir)``.
+    Unknown names raise KeyError listing the known ones; rows that are not dicts raise TypeError.
+    """
+    exp = get_experiment(name)
+    out_dir = Path(figures_root) / exp.name
+    out_dir.mkdir(parents=True, exist_ok=True)
+    rows = exp.function(out_dir, bool(quick), progress)
+    if rows is None:
+        raise TypeError(f"experiment {name!r} returned None instead of a list of rows")
+    rows = list(rows)
+    bad = [type(r).__name__ for r in rows if not isinstance(r, dict)]
+    if bad:
+        raise TypeError(f"experiment {name!r} returned rows that are not dicts: {bad[:3]}")
+    write_table(rows, out_dir, "table", title=f"{exp.name}: {exp.description}")
+    return rows, out_dir

@@ -1,0 +1,130 @@
+"""Timing of draws and CPU work: warm-up, at least five repetitions, median and spread.
+
+GPU time comes from a GL_TIME_ELAPSED query around the draw; wall time spans the draw and
+``ctx.finish()``; read-back (``Framebuffer.read``) is timed on its own. Clearing the target is
+excluded from all three. Times are in milliseconds and hold only for the renderer they were
+measured on (``workbench.gl.renderer(ctx)``), so experiments report ratios from one run.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from statistics import median
+from typing import Any, Callable
+
+from workbench.gl import GpuTimer
+
+MIN_REPEATS = 5
+
+
+def check_counts(warmup: int, repeat: int) -> None:
+    """Refuse fewer than :data:`MIN_REPEATS` repetitions or a negative warm-up count."""
+    if int(repeat) != repeat or repeat < MIN_REPEATS:
+        raise ValueError(f"repeat must be an integer >= {MIN_REPEATS} (median and spread need "
+                         f"several samples), got {repeat}")
+    if int(warmup) != warmup or warmup < 0:
+        raise ValueError(f"warmup must be a non-negative integer, got {warmup}")
+
+
+def _spread(samples: list[float] | None) -> tuple[float | None, float | None, float | None]:
+    if not samples:
+        return None, None, None
+    return float(median(samples)), float(min(samples)), float(max(samples))
+
+
+@dataclass(frozen=True)
+class Timing:
+    """Median and range of repeated measurements, in milliseconds.
+
+    GPU and read-back times are ``None`` where they were not measured (CPU work, or a renderer
+    without timer queries). ``wall_samples_ms``/``gpu_samples_ms`` keep the raw repetitions;
+    ``result`` holds what the timed function returned last (:func:`time_call` only).
+    """
+
+    gpu_ms: float | None
+    gpu_ms_min: float | None
+    gpu_ms_max: float | None
+    wall_ms: float
+    wall_ms_min: float
+    wall_ms_max: float
+    readback_ms: float | None
+    repeats: int
+    wall_samples_ms: tuple[float, ...] = field(default=(), repr=False, compare=False)
+    gpu_samples_ms: tuple[float, ...] = field(default=(), repr=False, compare=False)
+    result: Any = field(default=None, repr=False, compare=False)
+
+    @classmethod
+    def from_samples(cls, wall: list[float], gpu: list[float] | None = None,
+                     readback: list[float] | None = None, result: Any = None) -> "Timing":
+        """Summarise raw samples (ms): medians and ranges; ``gpu``/``readback`` may be None."""
+        if len(wall) < MIN_REPEATS:
+            raise ValueError(f"need at least {MIN_REPEATS} wall-time samples, got {len(wall)}")
+        if gpu is not None and len(gpu) != len(wall):
+            raise ValueError(f"{len(gpu)} GPU samples for {len(wall)} wall samples")
+        g, g_min, g_max = _spread(gpu)
+        w, w_min, w_max = _spread(wall)
+        return cls(gpu_ms=g, gpu_ms_min=g_min, gpu_ms_max=g_max, wall_ms=w, wall_ms_min=w_min,
+                   wall_ms_max=w_max, readback_ms=_spread(readback)[0], repeats=len(wall),
+                   wall_samples_ms=tuple(wall), gpu_samples_ms=tuple(gpu or ()), result=result)
+
+    def as_row(self, prefix: str = "") -> dict[str, float | int | None]:
+        """Flat table columns (``gpu_ms`` … ``repeats``), names optionally prefixed."""
+        names = ("gpu_ms", "gpu_ms_min", "gpu_ms_max", "wall_ms", "wall_ms_min", "wall_ms_max",
+                 "readback_ms", "repeats")
+        return {prefix + name: getattr(self, name) for name in names}
+
+
+def time_draw(ctx, fb, draw: Callable[[], Any], warmup: int = 2, repeat: int = 7,
+              readback_repeat: int | None = None) -> Timing:
+    """Time ``draw()`` into framebuffer ``fb`` on ``ctx``: GPU, wall and read-back milliseconds.
+
+    Each repetition clears ``fb`` (and waits for the clear) outside the clock, then measures wall
+    time around ``draw()`` inside a GPU timer query plus ``ctx.finish()``. ``draw`` must draw into
+    the bound framebuffer and must not open a time query of its own (queries of one kind do not
+    nest). Read-back is then timed separately: ``fb.read()`` of the finished last draw, repeated
+    ``readback_repeat`` times (default ``repeat``) after one untimed read. Afterwards ``fb`` holds
+    the last drawn image. Refuses ``repeat`` < 5 and a negative ``warmup``.
+    """
+    check_counts(warmup, repeat)
+    readback_repeat = repeat if readback_repeat is None else readback_repeat
+    check_counts(0, readback_repeat)
+    timer = GpuTimer(ctx)  # moderngl 5.13 queries have no release(); the object is collected
+    wall: list[float] = []
+    gpu: list[float] = []
+    for i in range(warmup + repeat):
+        fb.clear()
+        ctx.finish()
+        start = time.perf_counter()
+        with timer:
+            draw()
+        ctx.finish()
+        elapsed = (time.perf_counter() - start) * 1e3
+        if i >= warmup:
+            wall.append(elapsed)
+            gpu.append(timer.elapsed_ms)
+    fb.read()
+    readback = []
+    for _ in range(readback_repeat):
+        start = time.perf_counter()
+        fb.read()
+        readback.append((time.perf_counter() - start) * 1e3)
+    return Timing.from_samples(wall, gpu, readback)
+
+
+def time_call(fn: Callable[[], Any], warmup: int = 1, repeat: int = 5) -> Timing:
+    """Wall time (ms) of the CPU work ``fn()``; GPU and read-back times are None.
+
+    The value returned by the last call is kept in ``Timing.result``. Refuses ``repeat`` < 5
+    and a negative ``warmup``.
+    """
+    check_counts(warmup, repeat)
+    wall: list[float] = []
+    result = None
+    for i in range(warmup + repeat):
+        start = time.perf_counter()
+        result = fn()
+        elapsed = (time.perf_counter() - start) * 1e3
+        if i >= warmup:
+            wall.append(elapsed)
+    return Timing.from_samples(wall, result=result)
