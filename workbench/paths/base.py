@@ -1,0 +1,448 @@
+"""The render-path interface, its shared implementation, and the registry of paths.
+
+A render path is built once for a scene (:meth:`RenderPath.prepare`) and drawn many times
+(:meth:`RenderPath.draw`), so that timing covers drawing only; :meth:`RenderPath.set_step`
+uploads one time step's coordinates (and normals, and time-dependent field values) into the
+buffers allocated at prepare time, never topology.
+
+Conventions every path follows (a reference renderer can match them exactly):
+
+* **Vertices** are uploaded as float32 relative to ``camera.origin`` (``camera.relative``);
+  geometry stays float64 on the CPU. A deformation plot shows
+  ``reference + magnification·(step − reference)``, computed in float64 per node.
+* **Lighting** (all lit paths): a two-sided headlight without specular,
+  ``colour·(0.25 + 0.75·|n·l|)``, ``l`` the unit direction towards the viewer in eye space —
+  ``(0, 0, 1)`` for an orthographic camera, ``−p_eye/|p_eye|`` for a perspective one. The
+  absolute value lights a back face as its front (shells are two-sided). Flat paths evaluate
+  it per fragment with the face normal; Gouraud paths evaluate it per vertex with the
+  crease-split vertex normal and interpolate the resulting factor (or lit colour) across the
+  triangle. A zero normal gets the ambient 0.25 only.
+* **Colour scales**: see :mod:`workbench.paths.colormap` (1-D texture, smooth or bands,
+  transfer-function α with an alpha test that discards fragments with α < ½).
+* **Clip planes**: up to four world-space float64 planes ``(a, b, c, d)``; points with
+  ``a·x + b·y + c·z + d ≥ 0`` are kept. The plane is moved to the upload origin in float64
+  (``d' = d + (a, b, c)·origin``) and applied with ``gl_ClipDistance``.
+* **Wire frame** (``Style.wireframe``): the element edges (quad edges, no diagonals) drawn as a
+  second pass of ``GL_LINES``; the fill pass uses polygon offset (factor 1, units 1) so the
+  lines win the depth test — the "standard wire frame" line overdraw of fe2003 Table 3.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import ClassVar
+
+import moderngl
+import numpy as np
+
+from ..gl import load_program
+from .colormap import ColorScale, scale_for
+
+NEEDS = frozenset({"triangles", "face_normals", "gouraud", "edges", "node_field", "element_field"})
+MAX_CLIP_PLANES = 4
+GL_CLIP_DISTANCE0 = 0x3000
+VALUES_TEXTURE_WIDTH = 4096  # row length of the per-triangle value texture (element fields)
+POLYGON_OFFSET = (1.0, 1.0)  # fill pass under a wire frame: (factor, units)
+
+
+@dataclass
+class Style:
+    """How a path draws; every field is optional.
+
+    field: name of a node field ((N,) or (T, N)) or element field ((M,) or (T, M)) of the mesh.
+    step: time step drawn. colormap: a matplotlib colormap name. value_range: (lo, hi) of the
+    colour scale, default the field's range over all steps. bands: 0 for smooth contours, n > 0
+    for n constant-colour bands. hide_range: field values in [lo, hi] get α = 0 in the 1-D
+    texture and are discarded by the alpha test (crash2000 §5). crease_deg: Gouraud crease angle
+    in degrees. clip_planes: up to 4 world-space planes (a, b, c, d) keeping a·x+b·y+c·z+d ≥ 0.
+    magnification / reference_step: deformation plot, shown = reference + magnification·(step −
+    reference). wireframe: line-overdraw element wire frame in ``wire_color``. base_color: RGB in
+    [0, 1] of the uncoloured paths. cull_back: cull back faces (default off: shells are two-sided).
+
+    Refused with ValueError: more than 4 clip planes, a plane that is not 4 finite numbers with a
+    non-zero normal, a negative step, a non-finite magnification, a crease angle outside
+    [0, 180], colours that are not 3 numbers in [0, 1], a negative band count.
+    """
+
+    field: str | None = None
+    step: int = 0
+    colormap: str = "viridis"
+    value_range: tuple[float, float] | None = None
+    bands: int = 0
+    hide_range: tuple[float, float] | None = None
+    crease_deg: float = 30.0
+    clip_planes: tuple = ()
+    magnification: float = 1.0
+    reference_step: int = 0
+    wireframe: bool = False
+    wire_color: tuple = (0.0, 0.0, 0.0)
+    base_color: tuple = (0.75, 0.75, 0.78)
+    cull_back: bool = False
+
+    def __post_init__(self) -> None:
+        planes = np.asarray(self.clip_planes, np.float64).reshape(-1, 4) if len(self.clip_planes) \
+            else np.zeros((0, 4))
+        if len(planes) > MAX_CLIP_PLANES:
+            raise ValueError(f"at most {MAX_CLIP_PLANES} clip planes, got {len(planes)}")
+        if not np.isfinite(planes).all() or (np.abs(planes[:, :3]).sum(axis=1) == 0).any():
+            raise ValueError(f"clip planes must be finite (a, b, c, d) with a non-zero normal, "
+                             f"got {self.clip_planes}")
+        self.clip_planes = tuple(tuple(float(v) for v in p) for p in planes)
+        for name in ("step", "reference_step", "bands"):
+            value = getattr(self, name)
+            if int(value) != value or value < 0:
+                raise ValueError(f"{name} must be a non-negative integer, got {value}")
+            setattr(self, name, int(value))
+        if not math.isfinite(self.magnification):
+            raise ValueError(f"magnification must be finite, got {self.magnification}")
+        if not 0.0 <= self.crease_deg <= 180.0:
+            raise ValueError(f"crease_deg must be in [0, 180], got {self.crease_deg}")
+        for name in ("wire_color", "base_color"):
+            color = tuple(float(c) for c in getattr(self, name))
+            if len(color) != 3 or not all(0.0 <= c <= 1.0 for c in color):
+                raise ValueError(f"{name} must be 3 numbers in [0, 1], got {getattr(self, name)}")
+            setattr(self, name, color)
+
+
+class RenderPath(ABC):
+    """One way of drawing an FE mesh, built once (``prepare``) and drawn many times (``draw``).
+
+    ``needs`` names the derived data the path asks the mesh for (a subset of
+    ``{"triangles", "face_normals", "gouraud", "edges", "node_field", "element_field"}``); an
+    instance drawing a wire frame adds ``"edges"`` to its own ``needs``. After ``prepare``:
+    ``triangles``, ``vertices`` and ``edges`` (wire-frame lines, 0 without) drawn,
+    ``bytes_uploaded`` (everything uploaded by prepare, textures included) and
+    ``bytes_per_step`` (what one ``set_step`` uploads).
+    """
+
+    name: ClassVar[str]
+    needs: ClassVar[frozenset[str]]
+
+    def __init__(self, style: Style | None = None) -> None:
+        self.style = style if style is not None else Style()
+        if self.style.wireframe:
+            self.needs = type(self).needs | {"edges"}
+        self.triangles = self.vertices = self.edges = 0
+        self.bytes_uploaded = self.bytes_per_step = 0
+
+    @abstractmethod
+    def prepare(self, ctx: moderngl.Context, mesh, camera) -> None:
+        """Derive what ``needs`` says (only that) and upload it once, with ``style.step`` drawn."""
+
+    @abstractmethod
+    def set_camera(self, camera) -> None:
+        """Set the camera uniforms; ``camera.origin`` must equal the one given to ``prepare``."""
+
+    @abstractmethod
+    def set_step(self, step: int) -> int:
+        """Upload the coordinates (and normals, time-dependent values) of ``step``; return bytes."""
+
+    @abstractmethod
+    def draw(self) -> None:
+        """Draw into the bound framebuffer: no uploads, no allocations; sets its own GL state."""
+
+    @abstractmethod
+    def release(self) -> None:
+        """Free every GL object the path holds."""
+
+    def __init_subclass__(cls, **kwargs) -> None:
+        super().__init_subclass__(**kwargs)
+        if "name" in cls.__dict__:
+            unknown = cls.needs - NEEDS
+            if unknown:
+                raise TypeError(f"{cls.__name__}.needs names unknown data {sorted(unknown)}")
+            PATHS[cls.name] = cls
+
+
+PATHS: dict[str, type[RenderPath]] = {}
+
+
+def make_path(name: str, style: Style | None = None) -> RenderPath:
+    """A new, unprepared path of registry ``name``; ValueError listing the registry otherwise."""
+    try:
+        cls = PATHS[name]
+    except KeyError:
+        raise ValueError(f"unknown render path {name!r}; known paths: {sorted(PATHS)}") from None
+    return cls(style)
+
+
+def field_kind(mesh, name: str) -> str:
+    """'node' or 'element' for a field of ``mesh``; KeyError listing the mesh's fields otherwise."""
+    if name in mesh.node_fields:
+        return "node"
+    if name in mesh.element_fields:
+        return "element"
+    raise KeyError(f"{mesh.name} has no field {name!r}; node fields: {sorted(mesh.node_fields)}, "
+                   f"element fields: {sorted(mesh.element_fields)}")
+
+
+class MeshPath(RenderPath):
+    """The shared implementation: one indexed triangle VAO, optionally a wire-frame VAO.
+
+    Subclasses choose shaders and three switches: ``split`` (vertices are the crease-split
+    Gouraud vertices with per-vertex normals; otherwise the mesh's referenced nodes without
+    normals), ``field_per`` (None, ``"node"`` — a per-vertex attribute — or ``"element"`` — one
+    value per triangle in a float texture read with ``gl_PrimitiveID``).
+    """
+
+    vertex_shader: ClassVar[str]
+    fragment_shader: ClassVar[str]
+    split: ClassVar[bool] = False
+    field_per: ClassVar[str | None] = None
+
+    def __init__(self, style: Style | None = None) -> None:
+        super().__init__(style)
+        self.ctx = None
+        self._objects: list = []
+
+    # ------------------------------------------------------------------ prepare
+    def prepare(self, ctx: moderngl.Context, mesh, camera) -> None:
+        if self.ctx is not None:
+            self.release()
+        style = self.style
+        for label in ("step", "reference_step"):
+            if getattr(style, label) >= mesh.n_steps:
+                raise ValueError(f"{label} {getattr(style, label)} out of range: "
+                                 f"{mesh.name} has {mesh.n_steps} steps")
+        self.scale: ColorScale | None = None
+        if self.field_per is not None:
+            self._check_field(mesh)
+            self.scale = scale_for(mesh, style.field, style.colormap, style.value_range,
+                                   style.bands, style.hide_range)
+        self.mesh, self.ctx, self.origin = mesh, ctx, np.array(camera.origin, np.float64)
+        try:
+            self._build(ctx, camera)
+        except BaseException:
+            self.release()
+            raise
+
+    def _build(self, ctx: moderngl.Context, camera) -> None:
+        mesh, style = self.mesh, self.style
+        if self.split:
+            g = mesh.gouraud(style.crease_deg)
+            self._gouraud = g
+            self._vertex_node = np.asarray(g.vertex_node, np.int64)
+            index = g.triangles
+        else:
+            used = mesh.used_nodes()
+            index = mesh.triangles
+            if len(used) == mesh.n_nodes:
+                self._vertex_node = None
+            else:  # compact away unreferenced nodes
+                remap = np.full(mesh.n_nodes, -1, np.int64)
+                remap[used] = np.arange(len(used))
+                self._vertex_node, index = used, remap[index]
+        index = np.ascontiguousarray(index, dtype=np.int32)
+        n_vertices = mesh.n_nodes if self._vertex_node is None else len(self._vertex_node)
+        self.triangles, self.vertices = len(index), n_vertices
+        uploaded = 0
+
+        defines = {"NUM_CLIP": len(style.clip_planes)}
+        if style.hide_range is not None and self.field_per is not None:
+            defines["HIDE"] = 1
+        if self.field_per == "element":
+            self._values_width = min(self.triangles, VALUES_TEXTURE_WIDTH)
+            defines["VALUES_WIDTH"] = self._values_width
+        self._program = self._keep(load_program(ctx, self.vertex_shader, self.fragment_shader,
+                                                defines=defines))
+        self._positions = self._keep(ctx.buffer(reserve=n_vertices * 12))
+        self._index = self._keep(ctx.buffer(index.tobytes()))
+        uploaded += index.nbytes
+        content = [(self._positions, "3f", "position")]
+        self._normals = self._values = self._values_texture = self._colormap = None
+        if self.split:
+            self._normals = self._keep(ctx.buffer(reserve=n_vertices * 12))
+            content.append((self._normals, "3f", "normal"))
+        if self.field_per == "node":
+            self._values = self._keep(ctx.buffer(reserve=n_vertices * 4))
+            content.append((self._values, "1f", "value"))
+        if self.field_per == "element":
+            rows = -(-self.triangles // self._values_width)
+            self._values_texture = self._keep(
+                ctx.texture((self._values_width, rows), 1, dtype="f4"))
+            self._values_texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self._element_of = mesh.triangulation.element_of
+            self._program["element_values"].value = 1
+        if self.scale is not None:
+            texels = self.scale.texture_data()
+            self._colormap = self._keep(ctx.texture((len(texels), 1), 4, texels.tobytes()))
+            filt = moderngl.LINEAR if self.scale.linear else moderngl.NEAREST
+            self._colormap.filter = (filt, filt)
+            self._colormap.repeat_x = self._colormap.repeat_y = False
+            self._program["colormap"].value = 0
+            self._program["colormap_st"].value = self.scale.coord_transform
+            uploaded += texels.nbytes
+        self._vao = self._keep(ctx.vertex_array(self._program, content, self._index,
+                                                index_element_size=4))
+        if "base_color" in self._uniforms(self._program):
+            self._program["base_color"].value = style.base_color
+
+        self._wire_program = self._wire_vao = None
+        if style.wireframe:
+            edges = self._vertex_of_node()[mesh.edges]
+            edges = np.ascontiguousarray(edges, dtype=np.int32)
+            self._wire_program = self._keep(load_program(
+                ctx, "position.vert.glsl", "position.frag.glsl",
+                defines={"NUM_CLIP": len(style.clip_planes)}))
+            self._wire_program["base_color"].value = style.wire_color
+            self._edges = self._keep(ctx.buffer(edges.tobytes()))
+            uploaded += edges.nbytes
+            self._wire_vao = self._keep(ctx.vertex_array(
+                self._wire_program, [(self._positions, "3f", "position")], self._edges,
+                index_element_size=4))
+            self.edges = len(edges)
+
+        self._static_values = False
+        if self.field_per is not None and self._field_values().ndim == 1:
+            uploaded += self._upload_values(style.step)
+            self._static_values = True
+        self._set_clip_planes()
+        self.set_camera(camera)
+        self.bytes_per_step = self.set_step(style.step)
+        self.bytes_uploaded = uploaded + self.bytes_per_step
+
+    def _keep(self, obj):
+        self._objects.append(obj)
+        return obj
+
+    @staticmethod
+    def _uniforms(program) -> set[str]:
+        return {name for name in program if isinstance(program[name], moderngl.Uniform)}
+
+    def _check_field(self, mesh) -> None:
+        name = self.style.field
+        if name is None:
+            raise ValueError(f"path {self.name!r} draws a field: set Style.field to one of "
+                             f"node fields {sorted(mesh.node_fields)} or element fields "
+                             f"{sorted(mesh.element_fields)}")
+        kind = field_kind(mesh, name)
+        if kind != self.field_per:
+            other = "element_color" if kind == "element" else "pixel_color or vertex_color"
+            raise ValueError(f"path {self.name!r} draws {self.field_per} fields, {name!r} is an "
+                             f"{kind} field: draw it with {other}")
+
+    def _field_values(self) -> np.ndarray:
+        fields = self.mesh.node_fields if self.field_per == "node" else self.mesh.element_fields
+        return fields[self.style.field]
+
+    def _vertex_of_node(self) -> np.ndarray:
+        """(N,) one vertex index per referenced node (the first split vertex of each)."""
+        if self._vertex_node is None:
+            return np.arange(self.mesh.n_nodes)
+        first = np.full(self.mesh.n_nodes, -1, np.int64)
+        first[self._vertex_node[::-1]] = np.arange(len(self._vertex_node))[::-1]
+        return first
+
+    def _set_clip_planes(self) -> None:
+        planes = np.array(self.style.clip_planes, np.float64).reshape(-1, 4)
+        if not len(planes):
+            return
+        shifted = planes.copy()
+        shifted[:, 3] += planes[:, :3] @ self.origin  # float64, before the float32 cast
+        data = shifted.astype(np.float32).tobytes()
+        for program in (self._program, self._wire_program):
+            if program is not None:
+                program["clip_planes"].write(data)
+
+    # ------------------------------------------------------------------ per frame / per step
+    def set_camera(self, camera) -> None:
+        if self.ctx is None:
+            raise RuntimeError(f"path {self.name!r} is not prepared")
+        if not np.array_equal(np.asarray(camera.origin, np.float64), self.origin):
+            raise ValueError(f"camera origin {camera.origin} differs from the prepared origin "
+                             f"{self.origin}: prepare the path again for a new origin")
+        mvp, view = camera.mvp_bytes(), camera.view_bytes()
+        perspective = 1.0 if camera.projection == "perspective" else 0.0
+        for program in (self._program, self._wire_program):
+            if program is None:
+                continue
+            names = self._uniforms(program)
+            program["mvp"].write(mvp)
+            if "view" in names:
+                program["view"].write(view)
+            if "perspective" in names:
+                program["perspective"].value = perspective
+
+    def shown_coordinates(self, step: int) -> np.ndarray:
+        """(N, 3) float64 node positions drawn for ``step`` (deformation plot applied)."""
+        mesh, style = self.mesh, self.style
+        current = mesh.coordinates(step)
+        if style.magnification == 1.0 or step == style.reference_step:
+            return current
+        reference = mesh.coordinates(style.reference_step)
+        return reference + style.magnification * (current - reference)
+
+    def set_step(self, step: int) -> int:
+        if self.ctx is None:
+            raise RuntimeError(f"path {self.name!r} is not prepared")
+        if int(step) != step or not 0 <= step < self.mesh.n_steps:
+            raise ValueError(f"step {step} out of range: {self.mesh.name} has "
+                             f"{self.mesh.n_steps} steps")
+        step = int(step)
+        shown = self.shown_coordinates(step)
+        points = shown if self._vertex_node is None else shown[self._vertex_node]
+        data = (points - self.origin).astype(np.float32)
+        self._positions.write(data)
+        sent = data.nbytes
+        if self.split:
+            normals = np.asarray(self._gouraud.normals(shown), np.float32)
+            self._normals.write(normals)
+            sent += normals.nbytes
+        if self.field_per is not None and not self._static_values:
+            sent += self._upload_values(step)
+        self.step = step
+        return sent
+
+    def _upload_values(self, step: int) -> int:
+        """Upload the normalised field values of ``step``; refuses non-finite values."""
+        values = self.mesh.node_field(self.style.field, step) if self.field_per == "node" \
+            else self.mesh.element_field(self.style.field, step)
+        bad = ~np.isfinite(values)
+        if bad.any():
+            raise ValueError(f"field {self.style.field!r} has {int(bad.sum())} non-finite values at "
+                             f"step {step} (first at index {int(np.flatnonzero(bad)[0])})")
+        t = self.scale.normalise(values)
+        if self.field_per == "node":
+            if self._vertex_node is not None:
+                t = t[self._vertex_node]
+            data = t.astype(np.float32)
+            self._values.write(data)
+            return data.nbytes
+        texture = self._values_texture
+        data = np.zeros(texture.width * texture.height, np.float32)
+        data[: self.triangles] = t[self._element_of]
+        texture.write(data)
+        return data.nbytes
+
+    def draw(self) -> None:
+        ctx, style = self.ctx, self.style
+        ctx.enable_only(moderngl.DEPTH_TEST | (moderngl.CULL_FACE if style.cull_back else 0))
+        if style.cull_back:
+            ctx.front_face, ctx.cull_face = "ccw", "back"
+        for i in range(len(style.clip_planes)):
+            ctx.enable_direct(GL_CLIP_DISTANCE0 + i)
+        if self._colormap is not None:
+            self._colormap.use(0)
+        if self._values_texture is not None:
+            self._values_texture.use(1)
+        if self._wire_vao is not None:
+            ctx.polygon_offset = POLYGON_OFFSET
+            self._vao.render(moderngl.TRIANGLES)
+            ctx.polygon_offset = (0.0, 0.0)
+            self._wire_vao.render(moderngl.LINES)
+        else:
+            self._vao.render(moderngl.TRIANGLES)
+        for i in range(len(style.clip_planes)):
+            ctx.disable_direct(GL_CLIP_DISTANCE0 + i)
+
+    def release(self) -> None:
+        for obj in reversed(self._objects):
+            obj.release()
+        self._objects.clear()
+        self.ctx = None
+
+
+# the path modules register themselves in PATHS on import
+from . import fields, surface  # noqa: E402,F401
