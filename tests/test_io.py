@@ -1,0 +1,589 @@
+"""Mesh readers: LS-DYNA keyword decks, d3plot results, meshio and trimesh files."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from workbench.data import CAR_DECK, D3PLOT, shared_file
+from workbench.scene.d3plot import mid_surface, von_mises
+from workbench.scene.io import MESHIO_SUFFIXES, ParseError, detect_format, load
+
+
+# --------------------------------------------------------------------------- writing small decks
+def node(nid, x, y, z, width=8, coord=16) -> str:
+    return f"{nid:{width}d}{x:{coord}.6f}{y:{coord}.6f}{z:{coord}.6f}{0:{width}d}{0:{width}d}"
+
+
+def shell(eid, pid, *nodes, width=8) -> str:
+    return "".join(f"{v:{width}d}" for v in (eid, pid, *nodes))
+
+
+def write(folder, name, lines) -> str:
+    path = folder / name
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+SQUARE = [(101, 0.0, 0.0, 0.0), (102, 10.0, 0.0, 0.0), (103, 10.0, 10.0, 0.0),
+          (104, 0.0, 10.0, 0.0), (105, 20.0, 0.0, 0.0)]
+
+
+def two_element_deck(width=8, coord=16, header="*KEYWORD", suffix=""):
+    return [
+        header,
+        "$ two shells: a quad and a triangle",
+        f"*NODE{suffix}",
+        *[node(*n, width=width, coord=coord) for n in SQUARE],
+        f"*ELEMENT_SHELL{suffix}",
+        shell(7, 3, 101, 102, 103, 104, width=width),
+        shell(9, 3, 102, 105, 103, 103, width=width),
+        "*END",
+    ]
+
+
+def ids_of(mesh):
+    """Element connectivity as node ids (independent of the index order)."""
+    return mesh.node_ids[mesh.elements]
+
+
+# --------------------------------------------------------------------------- shared data
+def test_car_deck():
+    path = shared_file(CAR_DECK)
+    if path is None:
+        pytest.skip(f"shared data {CAR_DECK} not available")
+    mesh = load(path)
+    assert (mesh.n_nodes, mesh.n_elements) == (4395, 4366)
+    assert sorted(np.unique(mesh.parts).tolist()) == list(range(1, 9))
+    assert set(mesh.part_names) == set(range(1, 9))
+    assert mesh.part_names[8] == "material type # 20 (Rigid)"
+    assert "Kinematic/Isotropic Elastic-Plastic" in mesh.part_names[1]
+    assert len(np.unique(mesh.node_ids)) == 4395 and len(np.unique(mesh.element_ids)) == 4366
+    # element 1 of the deck: "1 2 1 3877 3881 3880"
+    first = int(np.flatnonzero(mesh.element_ids == 1)[0])
+    assert ids_of(mesh)[first].tolist() == [1, 3877, 3881, 3880]
+    assert mesh.parts[first] == 2
+    lo, hi = mesh.bounds()
+    assert np.allclose(lo, [-355.384, 0.0, -254.0]) and np.allclose(hi, [4318.0, 1397.0, 1778.0])
+    thickness = mesh.element_fields["thickness"]
+    assert (thickness > 0).all()
+    # section thicknesses through *PARAMETER (&tbumper = 3, &thood = 1, &trailf = 5) and the
+    # 0.2 mm element thickness cards of the rigid part 8
+    expected = {1: 2.0, 2: 3.0, 3: 1.0, 4: 1.0, 5: 5.0, 6: 2.0, 7: 2.0, 8: 0.2}
+    for pid, t in expected.items():
+        assert np.allclose(thickness[mesh.parts == pid], t), pid
+    assert mesh.units == "mm"
+
+
+def test_d3plot_sample():
+    path = shared_file(D3PLOT)
+    if path is None:
+        pytest.skip(f"shared data {D3PLOT} not available")
+    mesh = load(path)
+    assert (mesh.n_nodes, mesh.n_elements) == (4915, 4696)
+    assert mesh.steps.shape == (1, 4915, 3) and mesh.times.shape == (1,)
+    # the state array holds coordinates (equal to the geometry at t = 0), not displacements
+    assert np.abs(mesh.nodes).max() > 1.0
+    assert np.array_equal(mesh.steps[0], mesh.nodes)
+    for name in ("von_mises", "plastic_strain", "thickness", "alive"):
+        values = mesh.element_fields[name]
+        assert values.shape == (1, 4696) and np.isfinite(values).all(), name
+    assert (mesh.element_fields["von_mises"] >= 0).all()
+    assert np.allclose(mesh.element_fields["thickness"], 2.93, atol=1e-5)
+    assert (mesh.element_fields["alive"] == 1).all()
+    assert mesh.part_names == {1: "Zugprobe"} and (mesh.parts == 1).all()
+    assert len(np.unique(mesh.element_ids)) == 4696
+
+
+# --------------------------------------------------------------------------- d3plot written here
+def write_d3plot(folder, rigid=False):
+    from lasso.dyna import ArrayType, D3plot
+
+    plot = D3plot()
+    coords = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0]], np.float32)
+    plot.arrays[ArrayType.node_coordinates] = coords
+    plot.arrays[ArrayType.node_ids] = np.array([10, 20, 30, 40, 50], np.int32)
+    plot.arrays[ArrayType.element_shell_node_indexes] = np.array([[0, 1, 2, 3], [1, 4, 2, 2]],
+                                                                 np.int32)
+    plot.arrays[ArrayType.element_shell_part_indexes] = np.array([0, 1], np.int32)
+    plot.arrays[ArrayType.element_shell_ids] = np.array([7, 8], np.int32)
+    plot.arrays[ArrayType.part_ids] = np.array([5, 9], np.int32)
+    plot.arrays[ArrayType.global_timesteps] = np.array([0.0, 1e-3, 2e-3], np.float32)
+    plot.arrays[ArrayType.node_displacement] = np.stack(
+        [coords + [0.0, 0.0, 0.5 * t] for t in range(3)]).astype(np.float32)
+    n = 1 if rigid else 2
+    stress = np.zeros((3, n, 3, 6), np.float32)
+    stress[:, :, 0, 0] = 100.0  # mid surface (first of 3 layers): uniaxial 100
+    stress[:, :, 1:, 3] = 50.0  # inner and outer: shear, which must not be picked
+    plot.arrays[ArrayType.element_shell_stress] = stress
+    plastic = np.zeros((3, n, 3), np.float32)
+    plastic[:, :, 0] = [[0.0], [0.01], [0.02]]
+    plot.arrays[ArrayType.element_shell_effective_plastic_strain] = plastic
+    plot.arrays[ArrayType.element_shell_thickness] = np.full((3, n), 1.5, np.float32)
+    if rigid:
+        plot.arrays[ArrayType.part_material_type] = np.array([3, 20], np.int32)
+    else:
+        plot.arrays[ArrayType.element_shell_is_alive] = np.array([[1, 1], [1, 1], [1, 0]],
+                                                                  np.float32)
+    path = folder / "d3plot"
+    plot.write_d3plot(str(path))
+    return path
+
+
+def test_d3plot_states_and_fields(tmp_path):
+    mesh = load(write_d3plot(tmp_path))
+    assert mesh.steps.shape == (3, 5, 3)
+    assert np.allclose(mesh.times, [0.0, 1e-3, 2e-3])
+    assert np.allclose(mesh.steps[2, :, 2], 1.0) and np.allclose(mesh.nodes[:, 2], 0.0)
+    assert mesh.node_ids.tolist() == [10, 20, 30, 40, 50]
+    assert mesh.element_ids.tolist() == [7, 8] and mesh.parts.tolist() == [5, 9]
+    assert mesh.is_triangle.tolist() == [False, True]
+    assert np.allclose(mesh.element_fields["von_mises"], 100.0)
+    assert np.allclose(mesh.element_fields["plastic_strain"][:, 0], [0.0, 0.01, 0.02])
+    assert np.allclose(mesh.element_fields["thickness"], 1.5)
+    assert mesh.element_fields["alive"].tolist() == [[1, 1], [1, 1], [1, 0]]
+    assert mesh.n_elements == 2  # a deleted element is kept, flagged
+
+
+def test_d3plot_rigid_shells_get_nan(tmp_path):
+    mesh = load(write_d3plot(tmp_path, rigid=True))
+    vm = mesh.element_fields["von_mises"]
+    assert np.allclose(vm[:, 0], 100.0) and np.isnan(vm[:, 1]).all()
+
+
+def test_d3plot_family_member_reads_the_family(tmp_path):
+    write_d3plot(tmp_path)
+    assert (tmp_path / "d3plot01").exists()
+    assert load(tmp_path / "d3plot01").steps.shape == (3, 5, 3)
+
+
+def test_d3plot_garbage_is_a_parse_error(tmp_path):
+    path = tmp_path / "d3plot"
+    path.write_bytes(b"\x00\x01garbage" * 10)
+    with pytest.raises(ParseError) as info:
+        load(path)
+    assert info.value.path == path
+
+
+stress_values = st.floats(-1e3, 1e3, allow_nan=False)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(stress_values, min_size=6, max_size=6))
+def test_von_mises_matches_principal_stresses(components):
+    xx, yy, zz, xy, yz, zx = components
+    principal = np.linalg.eigvalsh(np.array([[xx, xy, zx], [xy, yy, yz], [zx, yz, zz]]))
+    s1, s2, s3 = principal
+    reference = np.sqrt(((s1 - s2) ** 2 + (s2 - s3) ** 2 + (s3 - s1) ** 2) / 2)
+    assert von_mises(np.array(components)) == pytest.approx(reference, rel=1e-7, abs=1e-6)
+
+
+def test_mid_surface_layer_order():
+    layers = lambda n: np.arange(n, dtype=float).reshape(1, 1, n)  # noqa: E731
+    assert mid_surface(layers(3))[0, 0] == 0  # mid, inner, outer
+    assert mid_surface(layers(5))[0, 0] == 2  # bottom to top
+    assert mid_surface(layers(4))[0, 0] == 1.5
+    assert mid_surface(layers(1))[0, 0] == 0
+
+
+# --------------------------------------------------------------------------- keyword decks
+def test_fixed_width_blank_fields(tmp_path):
+    path = write(tmp_path, "blank.k", [
+        "*KEYWORD",
+        "*NODE",
+        "       1             1.5                            -2.0",  # blank y, no tc/rc
+        "       2",  # all coordinates blank
+        "       3            1.D2             0.0             0.0       0       0",
+        "*ELEMENT_SHELL",
+        "      11               1       2       3       3",  # blank part id -> 0
+        "*END",
+    ])
+    mesh = load(path)
+    assert mesh.nodes.tolist() == [[1.5, 0.0, -2.0], [0.0, 0.0, 0.0], [100.0, 0.0, 0.0]]
+    assert mesh.parts.tolist() == [0]
+    assert mesh.is_triangle.tolist() == [True]
+
+
+def test_free_format_and_mixed_cards(tmp_path):
+    path = write(tmp_path, "free.k", [
+        "*KEYWORD",
+        "*NODE",
+        "1, 0.0, 0.0, 0.0",
+        "2,10.0,0,0,0,0",
+        node(3, 10.0, 10.0, 0.0),
+        "4,0.0,10.0",  # z omitted
+        "*ELEMENT_SHELL",
+        "5,2,1,2,3,4",
+        shell(6, 2, 2, 3, 4, 4),
+        "*END",
+    ])
+    mesh = load(path)
+    assert mesh.node_ids.tolist() == [1, 2, 3, 4]
+    assert np.allclose(mesh.nodes, [[0, 0, 0], [10, 0, 0], [10, 10, 0], [0, 10, 0]])
+    assert ids_of(mesh).tolist() == [[1, 2, 3, 4], [2, 3, 4, 4]]
+    assert mesh.element_ids.tolist() == [5, 6] and mesh.parts.tolist() == [2, 2]
+
+
+def test_comments_case_unknown_keywords_and_end(tmp_path):
+    path = write(tmp_path, "mixed.k", [
+        "$ a comment before anything",
+        "*keyword",
+        "*Control_Termination",
+        "      0.15         0",
+        "*node",
+        "$#   nid               x               y               z      tc      rc",
+        *[node(*n) for n in SQUARE[:4]],
+        "$ comment inside a block",
+        node(*SQUARE[4]),
+        "*ELEMENT_SOLID",
+        "       1       1       1       2       3       4       5       5       5       5",
+        "*element_shell",
+        shell(1, 1, 101, 102, 103, 104),
+        "",
+        "*End",
+        "*ELEMENT_SHELL",
+        "this would not parse",
+    ])
+    mesh = load(path)
+    assert mesh.n_nodes == 5 and mesh.n_elements == 1
+
+
+def test_triangles(tmp_path):
+    path = write(tmp_path, "tri.k", [
+        "*NODE", *[node(*n) for n in SQUARE],
+        "*ELEMENT_SHELL",
+        shell(1, 1, 101, 102, 103, 103),
+        shell(2, 1, 102, 105, 103),  # n4 blank
+        shell(3, 1, 101, 102, 103, 104),
+    ])
+    mesh = load(path)
+    assert mesh.is_triangle.tolist() == [True, True, False]
+    assert (mesh.elements[:2, 3] == mesh.elements[:2, 2]).all()
+    assert ids_of(mesh)[1].tolist() == [102, 105, 103, 103]
+
+
+def test_element_shell_thickness_and_sections(tmp_path):
+    path = write(tmp_path, "thick.k", [
+        "*PARAMETER",
+        "Rtsec     2.5       ",
+        "*PART",
+        "left part",
+        "         1         4         1",
+        "*SECTION_SHELL",
+        "         4         2",
+        "&tsec",
+        "*NODE", *[node(*n) for n in SQUARE],
+        "*ELEMENT_SHELL_THICKNESS",
+        shell(1, 1, 101, 102, 103, 104),
+        "             1.0             2.0             3.0             2.0",
+        shell(3, 1, 101, 102, 103, 103),
+        "             1.0             1.0                             ",
+        shell(2, 1, 102, 105, 103, 103),
+        "$ blank thickness card, the last of the block: the section's 2.5",
+        "",
+        "*ELEMENT_SHELL",
+        shell(4, 1, 101, 102, 103, 104),
+        shell(5, 2, 101, 102, 103, 104),  # part 2 has no section
+    ])
+    mesh = load(path)
+    thickness = mesh.element_fields["thickness"]
+    assert mesh.element_ids.tolist() == [1, 3, 2, 4, 5]
+    assert np.allclose(thickness[:4], [2.0, (1 + 1 + 2.5) / 3, 2.5, 2.5])
+    assert np.isnan(thickness[4])
+
+
+def test_part_titles(tmp_path):
+    path = write(tmp_path, "parts.k", [
+        "*PART",
+        "front rail",
+        "        11         1         1",
+        "",  # an empty title
+        "        12         1         1",
+        "*PART_CONTACT",
+        "roof",
+        "        13         1         1",
+        "       0.0       0.0",
+        "hood",
+        "        14         1         1",
+        "       0.0       0.0",
+        "",
+        "*PART_MOVE",
+        "        13       1.0       0.0       0.0",
+        "*NODE", *[node(*n) for n in SQUARE],
+        "*ELEMENT_SHELL",
+        *[shell(i, pid, 101, 102, 103, 104) for i, pid in enumerate((11, 12, 13, 14, 15), 1)],
+    ])
+    mesh = load(path)
+    assert mesh.part_names == {11: "front rail", 13: "roof", 14: "hood"}
+    assert mesh.parts.tolist() == [11, 12, 13, 14, 15]
+
+
+def test_include_relative_to_the_including_file(tmp_path):
+    write(tmp_path, "sub/deeper/elements.k", [
+        "*ELEMENT_SHELL", shell(1, 1, 101, 102, 103, 104), shell(2, 1, 102, 105, 103, 103)])
+    write(tmp_path, "sub/nodes.k", [
+        "*KEYWORD", "*NODE", *[node(*n) for n in SQUARE], "*INCLUDE", "deeper/elements.k",
+        "*END"])
+    path = write(tmp_path, "main.k", ["*KEYWORD", "*INCLUDE", "$ the nodes", "sub/nodes.k",
+                                      "*PART", "the part", "         1", "*END"])
+    mesh = load(path)
+    assert mesh.n_nodes == 5 and mesh.n_elements == 2 and mesh.part_names == {1: "the part"}
+
+
+def test_i10_and_long_formats_read_alike(tmp_path):
+    small = load(write(tmp_path, "small.k", two_element_deck()))
+    variants = [
+        two_element_deck(width=10, suffix=" %"),
+        two_element_deck(width=10, header="*KEYWORD I10=Y"),
+        two_element_deck(width=20, coord=20, header="*KEYWORD LONG=Y"),
+        two_element_deck(width=20, coord=20, suffix="+"),
+    ]
+    for i, lines in enumerate(variants):
+        mesh = load(write(tmp_path, f"variant{i}.k", lines))
+        assert np.array_equal(mesh.nodes, small.nodes), i
+        assert np.array_equal(ids_of(mesh), ids_of(small)), i
+        assert mesh.parts.tolist() == [3, 3], i
+
+
+def test_long_include_of_a_small_deck(tmp_path):
+    write(tmp_path, "long.k", two_element_deck(width=20, coord=20)[1:])
+    path = write(tmp_path, "master.k", ["*KEYWORD", "*INCLUDE +", "long.k"])
+    assert load(path).n_elements == 2
+
+
+ids = st.integers(-(2**40), 2**40)
+coordinates = st.floats(-1e6, 1e6, allow_nan=False).map(lambda v: float(f"{v:.7g}"))
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+def test_random_decks_read_back(tmp_path, data):
+    n = data.draw(st.integers(3, 12))
+    node_ids = data.draw(st.lists(st.integers(-(10**7) + 1, 10**8 - 1), min_size=n, max_size=n,
+                                  unique=True))
+    xyz = data.draw(st.lists(st.tuples(coordinates, coordinates, coordinates), min_size=n,
+                             max_size=n))
+    free = data.draw(st.lists(st.booleans(), min_size=2 * n, max_size=2 * n))
+    lines = ["*NODE"]
+    for k, (nid, (x, y, z)) in enumerate(zip(node_ids, xyz)):
+        lines.append(f"{nid},{x!r},{y!r},{z!r}" if free[k] else f"{nid:8d}{x:16.7g}{y:16.7g}{z:16.7g}")
+    m = data.draw(st.integers(1, 8))
+    cells = data.draw(st.lists(st.lists(st.sampled_from(node_ids), min_size=4, max_size=4),
+                               min_size=m, max_size=m))
+    lines.append("*ELEMENT_SHELL")
+    for k, cell in enumerate(cells):
+        values = (k * 1000 - 5, k % 3, *cell)
+        lines.append(",".join(map(str, values)) if free[n + k % n] else shell(*values))
+    mesh = load(write(tmp_path, "random.k", lines))
+    assert mesh.node_ids.tolist() == node_ids
+    assert np.array_equal(mesh.nodes, np.array(xyz, dtype=float))
+    assert ids_of(mesh).tolist() == cells
+    assert mesh.element_ids.tolist() == [k * 1000 - 5 for k in range(m)]
+
+
+# --------------------------------------------------------------------------- refusals
+def test_malformed_node_names_line_and_card(tmp_path):
+    path = write(tmp_path, "bad.k", [
+        "*KEYWORD", "*NODE", node(1, 0, 0, 0), "$ comment",
+        "       2             abc             0.0             0.0",
+        "*ELEMENT_SHELL", shell(1, 1, 1, 2, 2, 2)])
+    with pytest.raises(ParseError) as info:
+        load(path)
+    err = info.value
+    assert isinstance(err, ValueError)
+    assert (err.path, err.line) == (path, 5)
+    assert err.card == "       2             abc             0.0             0.0"
+    assert "expected 3 coordinates" in err.message
+    assert str(err).startswith(f"{path}:5: *NODE: expected 3 coordinates, got 'abc' in '")
+
+
+def test_malformed_element_and_free_format_lines(tmp_path):
+    base = ["*NODE", *[node(*n) for n in SQUARE], "*ELEMENT_SHELL"]
+    with pytest.raises(ParseError) as info:
+        load(write(tmp_path, "a.k", base + [shell(1, 1, 101, 102, 103, 104), "2,1,101,x,103"]))
+    assert info.value.line == 9 and "'x'" in info.value.message
+    with pytest.raises(ParseError) as info:
+        load(write(tmp_path, "b.k", base + ["       1       1 101 102 103 104"]))
+    assert info.value.line == 8 and "node ids" in info.value.message
+
+
+def test_malformed_line_in_included_file(tmp_path):
+    inner = write(tmp_path, "parts/inner.k", [
+        "*NODE", node(1, 0, 0, 0), node(2, 1, 0, 0), "$ the next one is broken",
+        "       3        1.0.0           0.0             0.0"])
+    path = write(tmp_path, "main.k", ["*KEYWORD", "*INCLUDE", "parts/inner.k",
+                                      "*ELEMENT_SHELL", shell(1, 1, 1, 2, 3, 3)])
+    with pytest.raises(ParseError) as info:
+        load(path)
+    assert info.value.path.resolve() == inner.resolve() and info.value.line == 5
+    assert str(info.value).startswith(f"{info.value.path}:5: *NODE:")
+
+
+def test_missing_thickness_card(tmp_path):
+    path = write(tmp_path, "odd.k", [
+        "*NODE", *[node(*n) for n in SQUARE], "*ELEMENT_SHELL_THICKNESS",
+        shell(1, 1, 101, 102, 103, 104), "             1.0", shell(2, 1, 101, 102, 103, 104)])
+    with pytest.raises(ParseError) as info:
+        load(path)
+    assert info.value.line == 10
+
+
+def test_missing_node_reference(tmp_path):
+    path = write(tmp_path, "dangling.k", [
+        "*NODE", *[node(*n) for n in SQUARE], "*ELEMENT_SHELL",
+        shell(1, 1, 101, 102, 103, 104), shell(2, 1, 101, 999, 103, 104),
+        shell(3, 1, 998, 102, 103, 104)])
+    with pytest.raises(ParseError) as info:
+        load(path)
+    assert info.value.line == 9
+    assert "(2, 999)" in info.value.message and "(3, 998)" in info.value.message
+
+
+def test_duplicate_ids(tmp_path):
+    path = write(tmp_path, "dup.k", [
+        "*NODE", *[node(*n) for n in SQUARE], node(102, 5, 5, 5), "*ELEMENT_SHELL",
+        shell(1, 1, 101, 102, 103, 104)])
+    with pytest.raises(ParseError, match="node id 102 is defined twice") as info:
+        load(path)
+    assert info.value.line == 7
+    path = write(tmp_path, "dup2.k", [
+        "*NODE", *[node(*n) for n in SQUARE], "*ELEMENT_SHELL",
+        shell(1, 1, 101, 102, 103, 104), shell(1, 1, 101, 102, 103, 104)])
+    with pytest.raises(ParseError, match="element id 1 is defined twice"):
+        load(path)
+
+
+def test_empty_decks(tmp_path):
+    with pytest.raises(ParseError, match="no shell elements"):
+        load(write(tmp_path, "empty.k", ["*KEYWORD", "*END"]))
+    with pytest.raises(ParseError, match=r"\*ELEMENT_SOLID"):
+        load(write(tmp_path, "solid.k", [
+            "*NODE", *[node(*n) for n in SQUARE], "*ELEMENT_SOLID",
+            "       1       1     101     102     103     104     105     105     105     105"]))
+
+
+def test_include_errors(tmp_path):
+    with pytest.raises(ParseError, match="not found") as info:
+        load(write(tmp_path, "missing.k", ["*KEYWORD", "*INCLUDE", "nowhere.k"]))
+    assert info.value.line == 3
+    write(tmp_path, "b.k", ["*INCLUDE", "a.k"])
+    with pytest.raises(ParseError, match="include cycle"):
+        load(write(tmp_path, "a.k", ["*INCLUDE", "b.k"]))
+    with pytest.raises(ParseError, match="INCLUDE_TRANSFORM"):
+        load(write(tmp_path, "t.k", ["*INCLUDE_TRANSFORM", "b.k"]))
+
+
+def test_unsupported_variants_and_parameters(tmp_path):
+    with pytest.raises(ParseError, match="ELEMENT_SHELL_COMPOSITE"):
+        load(write(tmp_path, "c.k", ["*ELEMENT_SHELL_COMPOSITE", shell(1, 1, 1, 2, 3, 4)]))
+    with pytest.raises(ParseError, match="'tmissing' is not defined") as info:
+        load(write(tmp_path, "p.k", [
+            "*PART", "p", "         1         1", "*SECTION_SHELL", "         1",
+            "&tmissing", "*NODE", *[node(*n) for n in SQUARE], "*ELEMENT_SHELL",
+            shell(1, 1, 101, 102, 103, 104)]))
+    assert info.value.line == 6
+
+
+def test_unknown_suffix_and_missing_file(tmp_path):
+    path = tmp_path / "mesh.xyz123"
+    path.write_text("")
+    with pytest.raises(ParseError, match="supported") as info:
+        load(path)
+    assert "mesh.xyz123" in str(info.value) and ".k" in str(info.value)
+    with pytest.raises(FileNotFoundError, match="nothere.k"):
+        load(tmp_path / "nothere.k")
+    assert detect_format("run/d3plot") == "d3plot" and detect_format("x.KEY") == "keyword"
+
+
+# --------------------------------------------------------------------------- meshio and trimesh
+def test_meshio_round_trip(tmp_path):
+    import meshio
+
+    points = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0]], float)
+    cells = [("quad", np.array([[0, 1, 2, 3]])), ("triangle", np.array([[1, 4, 2]])),
+             ("line", np.array([[0, 1]]))]
+    path = tmp_path / "mesh.vtu"
+    meshio.write(path, meshio.Mesh(
+        points, cells, point_data={"temperature": np.arange(5.0), "velocity": np.ones((5, 3))},
+        cell_data={"pressure": [np.array([1.5]), np.array([2.5]), np.array([9.0])]}))
+    mesh = load(path)
+    assert np.array_equal(mesh.nodes, points)
+    assert mesh.elements.tolist() == [[0, 1, 2, 3], [1, 4, 2, 2]]
+    assert mesh.node_fields.keys() == {"temperature"}
+    assert np.array_equal(mesh.node_fields["temperature"], np.arange(5.0))
+    assert mesh.element_fields["pressure"].tolist() == [1.5, 2.5]
+
+
+def test_meshio_gmsh_physical_tags_become_parts(tmp_path):
+    import meshio
+
+    points = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [2, 0]], float)
+    cells = [("quad", np.array([[0, 1, 2, 3]])), ("triangle", np.array([[1, 4, 2]]))]
+    raw = meshio.Mesh(points, cells, cell_data={
+        "gmsh:physical": [np.array([4]), np.array([6])],
+        "gmsh:geometrical": [np.array([1]), np.array([2])]})
+    raw.field_data = {"roof": np.array([4, 2]), "door": np.array([6, 2])}
+    path = tmp_path / "mesh.msh"
+    meshio.write(path, raw, file_format="gmsh22", binary=False)
+    mesh = load(path)
+    assert mesh.parts.tolist() == [4, 6] and mesh.part_names == {4: "roof", 6: "door"}
+    assert np.allclose(mesh.nodes[:, 2], 0.0)
+
+
+def test_meshio_abaqus_element_sets_become_parts(tmp_path):
+    path = write(tmp_path, "model.inp", [
+        "*NODE", "1, 0.0, 0.0, 0.0", "2, 1.0, 0.0, 0.0", "3, 1.0, 1.0, 0.0", "4, 0.0, 1.0, 0.0",
+        "5, 2.0, 0.0, 0.0",
+        "*ELEMENT, TYPE=S4, ELSET=ROOF", "1, 1, 2, 3, 4",
+        "*ELEMENT, TYPE=S3, ELSET=DOOR", "2, 2, 5, 3"])
+    mesh = load(path)
+    assert mesh.elements.tolist() == [[0, 1, 2, 3], [1, 4, 2, 2]]
+    assert mesh.parts.tolist() == [1, 2] and mesh.part_names == {1: "ROOF", 2: "DOOR"}
+
+
+def test_meshio_errors_are_parse_errors(tmp_path):
+    path = tmp_path / "broken.vtu"
+    path.write_text("<VTKFile> not really")
+    with pytest.raises(ParseError, match="meshio") as info:
+        load(path)
+    assert info.value.path == path
+    import meshio
+
+    path = tmp_path / "lines.vtu"
+    meshio.write(path, meshio.Mesh(np.zeros((2, 3)), [("line", np.array([[0, 1]]))]))
+    with pytest.raises(ParseError, match="no quad or triangle cells"):
+        load(path)
+
+
+def test_meshio_suffixes_are_known_to_meshio():
+    import meshio
+
+    known = set(meshio.extension_to_filetypes)
+    assert set(MESHIO_SUFFIXES) <= known
+
+
+def test_trimesh_stl_round_trip(tmp_path):
+    import trimesh
+
+    box = trimesh.creation.box(extents=(1.0, 2.0, 3.0))
+    path = tmp_path / "box.stl"
+    box.export(path)
+    mesh = load(path)
+    assert mesh.n_nodes == 8 and mesh.n_elements == 12  # corners shared again
+    assert mesh.is_triangle.all()
+    lo, hi = mesh.bounds()
+    assert np.allclose(lo, [-0.5, -1.0, -1.5]) and np.allclose(hi, [0.5, 1.0, 1.5])
+    area = 0.5 * np.linalg.norm(np.cross(mesh.nodes[mesh.elements[:, 1]] - mesh.nodes[mesh.elements[:, 0]],
+                                         mesh.nodes[mesh.elements[:, 2]] - mesh.nodes[mesh.elements[:, 0]]), axis=1)
+    assert area.sum() == pytest.approx(box.area)
+
+
+def test_trimesh_errors_are_parse_errors(tmp_path):
+    path = tmp_path / "broken.ply"
+    path.write_bytes(b"ply\nformat nonsense\n")
+    with pytest.raises(ParseError, match="trimesh") as info:
+        load(path)
+    assert info.value.path == path

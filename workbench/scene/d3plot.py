@@ -1,0 +1,196 @@
+"""LS-DYNA d3plot reader (through lasso-python): shell geometry of every state plus shell results.
+
+A d3plot's state "displacement" array holds the current node coordinates (the database's IU
+flag writes geometry, not displacement), so it becomes ``FEMesh.steps`` (T, N, 3) as it is;
+``FEMesh.nodes`` is the initial geometry and ``FEMesh.times`` the state times. Shell element
+fields, (T, M) each and present when the file has the data:
+
+* ``"von_mises"``: von Mises stress of the mid-surface integration point (stress units of the
+  model, e.g. MPa for mm/ms/kg... decks), from the six stress components;
+* ``"plastic_strain"``: effective plastic strain of the mid-surface integration point;
+* ``"thickness"``: current shell thickness;
+* ``"alive"``: 1 for an element in use, 0 for a deleted one (nothing is dropped).
+
+The mid-surface point follows the d3plot layer order: with 3 layers (LS-DYNA's default MAXINT)
+they are written mid, inner, outer, so the first; otherwise bottom to top, so the middle one
+(the mean of the two middle ones for an even count). Shells of rigid parts carry no stress,
+strain or thickness in a d3plot; their values are NaN. Beams, solids and thick shells are not
+read. Part ids are the user part ids, names come from the part titles.
+
+Refused with :class:`~workbench.scene.io.ParseError`: a file lasso-python cannot read, or one
+without shell elements.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+from pathlib import Path
+
+import numpy as np
+
+from .io import ParseError, build_mesh
+from .mesh import FEMesh
+
+RIGID_MATERIAL_TYPE = 20
+
+
+def von_mises(stress: np.ndarray) -> np.ndarray:
+    """Von Mises equivalent stress of (..., 6) stress tensors ordered xx, yy, zz, xy, yz, zx.
+
+    sqrt(((sxx - syy)^2 + (syy - szz)^2 + (szz - sxx)^2) / 2 + 3 (sxy^2 + syz^2 + szx^2)), in the
+    units of the input; float64.
+    """
+    s = np.asarray(stress, dtype=np.float64)
+    if s.shape[-1] != 6:
+        raise ValueError(f"stress must be (..., 6), got {s.shape}")
+    xx, yy, zz, xy, yz, zx = np.moveaxis(s, -1, 0)
+    return np.sqrt(0.5 * ((xx - yy) ** 2 + (yy - zz) ** 2 + (zz - xx) ** 2)
+                   + 3.0 * (xy ** 2 + yz ** 2 + zx ** 2))
+
+
+def mid_surface(values: np.ndarray, layer_axis: int = 2) -> np.ndarray:
+    """The mid-surface values of shell data with the through-thickness layers on ``layer_axis``.
+
+    Three layers are in d3plot order mid, inner, outer (the first is taken); any other count is
+    ordered bottom to top (the middle one, or the mean of the two middle ones when even).
+    """
+    values = np.asarray(values)
+    n = values.shape[layer_axis]
+    if n == 0:
+        raise ValueError("no integration-point layers")
+    if n == 3 or n == 1:
+        return np.take(values, 0, axis=layer_axis)
+    if n % 2:
+        return np.take(values, n // 2, axis=layer_axis)
+    pair = np.take(values, [n // 2 - 1, n // 2], axis=layer_axis).astype(np.float64)
+    return pair.mean(axis=layer_axis)
+
+
+def read_d3plot(path, units: str = "mm") -> FEMesh:
+    """Read a d3plot family (``d3plot``, ``d3plot01``, ...) into an :class:`FEMesh` with steps.
+
+    ``path`` is the first file of the family; a later member (``d3plot01``) is read from the
+    first one beside it. See the module notes for the fields. ``units`` labels the coordinates.
+    """
+    from lasso.dyna import ArrayType, D3plot
+
+    path = Path(path)
+    member = re.fullmatch(r"(d3plot.*?)(\d{2,})", path.name, flags=re.IGNORECASE)
+    if member and (path.parent / member.group(1)).is_file():
+        path = path.parent / member.group(1)
+
+    warnings = _LassoWarnings()
+    logger = logging.getLogger("lasso")
+    logger.addHandler(warnings)
+    try:
+        plot = D3plot(str(path))
+    except Exception as exc:  # lasso raises many types; all mean "cannot read this file"
+        raise ParseError(path, f"lasso-python could not read it: {type(exc).__name__}: "
+                               f"{str(exc).strip()}") from exc
+    finally:
+        logger.removeHandler(warnings)
+    arrays = plot.arrays
+
+    def need(key):
+        if key not in arrays:
+            raise ParseError(path, f"no {key} in the d3plot" + warnings.summary())
+        return arrays[key]
+
+    nodes = np.asarray(need(ArrayType.node_coordinates), dtype=np.float64)
+    connectivity = np.asarray(arrays.get(ArrayType.element_shell_node_indexes, np.zeros((0, 4))))
+    if len(connectivity) == 0:
+        raise ParseError(path, "no shell elements in the d3plot (beams, solids and thick "
+                               "shells are not read)" + warnings.summary())
+    n_shells = len(connectivity)
+    part_index = np.asarray(need(ArrayType.element_shell_part_indexes), dtype=np.int64)
+    parts, part_names = _part_ids(arrays, part_index, ArrayType)
+
+    steps = times = None
+    if ArrayType.node_displacement in arrays and len(arrays[ArrayType.node_displacement]):
+        steps = np.asarray(arrays[ArrayType.node_displacement], dtype=np.float64)
+        times = np.asarray(arrays.get(ArrayType.global_timesteps, np.arange(len(steps))),
+                           dtype=np.float64)
+    n_states = 0 if steps is None else len(steps)
+
+    # Rigid-part shells have no stress, strain or thickness records in the state data.
+    deformable = np.ones(n_shells, bool)
+    if ArrayType.part_material_type in arrays:
+        material = np.asarray(arrays[ArrayType.part_material_type])
+        inside = part_index < len(material)
+        deformable[inside] = material[part_index[inside]] != RIGID_MATERIAL_TYPE
+
+    def per_shell(values: np.ndarray) -> np.ndarray | None:
+        values = np.asarray(values, dtype=np.float64)
+        if values.ndim != 2 or len(values) != n_states:
+            return None
+        if values.shape[1] == n_shells:
+            return values
+        if values.shape[1] == deformable.sum():
+            full = np.full((n_states, n_shells), np.nan)
+            full[:, deformable] = values
+            return full
+        return None
+
+    fields = {}
+    if n_states:
+        if ArrayType.element_shell_stress in arrays:
+            fields["von_mises"] = per_shell(von_mises(mid_surface(
+                arrays[ArrayType.element_shell_stress], layer_axis=2)))
+        if ArrayType.element_shell_effective_plastic_strain in arrays:
+            fields["plastic_strain"] = per_shell(mid_surface(
+                arrays[ArrayType.element_shell_effective_plastic_strain], layer_axis=2))
+        if ArrayType.element_shell_thickness in arrays:
+            fields["thickness"] = per_shell(arrays[ArrayType.element_shell_thickness])
+        if ArrayType.element_shell_is_alive in arrays:
+            fields["alive"] = per_shell(arrays[ArrayType.element_shell_is_alive])
+    fields = {k: v for k, v in fields.items() if v is not None}
+
+    node_ids = arrays.get(ArrayType.node_ids)
+    element_ids = arrays.get(ArrayType.element_shell_ids)
+    return build_mesh(
+        path, nodes=nodes, elements=np.asarray(connectivity, dtype=np.int64), parts=parts,
+        steps=steps, times=times, element_fields=fields, part_names=part_names,
+        node_ids=None if node_ids is None else np.asarray(node_ids, dtype=np.int64),
+        element_ids=None if element_ids is None else np.asarray(element_ids, dtype=np.int64),
+        name=path.name, units=units)
+
+
+def _part_ids(arrays, part_index: np.ndarray, ArrayType) -> tuple[np.ndarray, dict[int, str]]:
+    """User part ids of the shells and the part titles.
+
+    The shells name parts by internal index; the user ids come from the numbering section
+    (``part_ids``), else from the part titles section (written in internal order), else the
+    index + 1.
+    """
+    title_ids = arrays.get(ArrayType.part_titles_ids)
+    titles = arrays.get(ArrayType.part_titles)
+    top = int(part_index.max()) + 1 if len(part_index) else 0
+    user = None
+    if ArrayType.part_ids in arrays and len(arrays[ArrayType.part_ids]) >= top:
+        user = np.asarray(arrays[ArrayType.part_ids], dtype=np.int64)
+    elif title_ids is not None and len(title_ids) >= top:
+        user = np.asarray(title_ids, dtype=np.int64)
+    parts = part_index + 1 if user is None else user[part_index]
+    names = {}
+    if title_ids is not None and titles is not None:
+        for pid, title in zip(np.asarray(title_ids).tolist(), list(titles)):
+            text = title.decode("latin-1") if isinstance(title, bytes) else str(title)
+            if text.strip():
+                names[int(pid)] = text.strip()
+    used = set(np.unique(parts).tolist())
+    return parts, {pid: name for pid, name in names.items() if pid in used}
+
+
+class _LassoWarnings(logging.Handler):
+    """Collects lasso-python's warnings (it logs, rather than raises, on damaged sections)."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(record.getMessage().splitlines()[0])
+
+    def summary(self) -> str:
+        return f" (lasso-python: {'; '.join(self.messages[:3])})" if self.messages else ""

@@ -1,0 +1,709 @@
+"""LS-DYNA keyword-deck reader: the shell model of a ``.k`` deck (and its includes) as an FEMesh.
+
+What is read:
+
+* ``*NODE`` (and ``*NODE_MERGE``): node id and x, y, z;
+* ``*ELEMENT_SHELL`` with the options ``_THICKNESS``, ``_BETA``, ``_MCID`` (a thickness card after
+  each element card) and ``_OFFSET`` (one more card): element id, part id and n1..n4. A triangle
+  repeats its third node (``n3 == n4``, or n4 left blank); its nodes n5..n8 (8-node shells) are
+  not kept. The mean nodal thickness (thickness cards, else the part's ``*SECTION_SHELL`` T1..T4)
+  becomes the element field ``"thickness"`` (NaN where neither gives one);
+* ``*PART`` (title line, then the card with pid and secid; several parts per keyword), the
+  part-definition options (``_CONTACT``, ``_PRINT``, ...), titles becoming ``part_names``;
+* ``*SECTION_SHELL`` (and ``_TITLE``) T1..T4, with ``&name`` references to ``*PARAMETER`` values;
+* ``*INCLUDE`` (file names relative to the including file's folder, the master deck's folder or
+  the folders of ``*INCLUDE_PATH``; recursive; a cycle is refused), ``*END`` (ends its file).
+
+Fields are fixed width (blank = 0) or, on a card that holds a comma, comma-separated. The
+standard, I10 (``*KEYWORD I10=Y`` or a ``%`` after a keyword) and long (``*KEYWORD LONG=Y`` or a
+``+`` after a keyword; all fields 20 wide) formats are read; an ``*INCLUDE`` is read in the
+master deck's format unless its keyword names another one (``%``, ``+``, ``-``). Lines starting
+with ``$`` are comments; keywords are case-insensitive; any other keyword is skipped with its
+data. Node and element ids may be any integers; they are kept in ``node_ids`` / ``element_ids``
+and mapped to indices. Coordinates are taken as they are (millimetres by default).
+
+Refused with :class:`~workbench.scene.io.ParseError` (file, 1-based line, card text and what was
+expected): a malformed card, an element that names an undefined node, duplicate node or element
+ids, a deck without shell elements, an undefined parameter, a missing or cyclic include, and
+the variants that would change the geometry if ignored (``*INCLUDE_TRANSFORM``,
+``*ELEMENT_SHELL_COMPOSITE``, ...). Large blocks are converted column by column with numpy; the
+per-card Python path only runs for free-format cards and to locate an error.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from operator import itemgetter
+from pathlib import Path
+
+import numpy as np
+
+from .io import ParseError, build_mesh
+from .mesh import FEMesh
+
+# Card layouts in standard-format column widths; I10 widens fields under 10 to 10, long to 20.
+_NODE = (8, 16, 16, 16, 8, 8)
+_SHELL = (8,) * 10
+_THICKNESS = (16,) * 5
+_TEN = (10,) * 8  # *PART card 2, *SECTION_SHELL cards, *PARAMETER pairs
+_THICKNESS_OPTIONS = {"THICKNESS", "BETA", "MCID"}
+# *PART options that define parts: cards each adds after the title and the part card; the
+# second set has a variable number of cards, so only the first part of such a block is read.
+_PART_EXTRA_CARDS = {"CONTACT": 1, "PRINT": 1, "ATTACHMENT-NODES": 1, "REPOSITION": 1,
+                     "AVERAGED": 0}
+_PART_SINGLE = {"INERTIA", "COMPOSITE", "LONG", "TSHELL"}
+_INCLUDE_REFUSED = ("INCLUDE_TRANSFORM", "INCLUDE_AUTO_OFFSET", "INCLUDE_NASTRAN",
+                    "INCLUDE_BINARY")
+_KEYWORD_LINE = re.compile(r"\*\s*([A-Za-z0-9_]+)\s*([%+-])?(.*)$")
+_SUFFIX_FORMAT = {"%": "i10", "+": "long", "-": "small"}
+
+
+def read_keyword(path, units: str = "mm") -> FEMesh:
+    """Read the LS-DYNA keyword deck ``path`` (with its includes) into an :class:`FEMesh`.
+
+    See the module notes for what is read and what is refused. ``units`` labels the
+    coordinates (they are not scaled).
+    """
+    deck = _Deck(Path(path))
+    deck.read_file(Path(path), None)
+    return deck.build(units)
+
+
+def field_width(width: int, fmt: str) -> int:
+    """The width of a standard-format field of ``width`` columns in format ``fmt``.
+
+    ``fmt`` is "small" (standard), "i10" (fields under 10 columns become 10) or "long" (every
+    field becomes 20 columns).
+    """
+    if fmt == "i10":
+        return max(width, 10)
+    if fmt == "long":
+        return max(width, 20)
+    return width
+
+
+# --------------------------------------------------------------------------- source files
+class _Source:
+    """The lines of one file, with the first byte of each line for fast classification."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        try:
+            data = path.read_bytes()
+        except OSError as exc:
+            raise ParseError(path, f"cannot read: {exc.strerror or exc}") from exc
+        if b"\r" in data:
+            data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+        self.lines = data.split(b"\n")
+        if len(self.lines) > 1 and not self.lines[-1]:
+            self.lines.pop()  # what follows the final newline is no line
+        buf = np.frombuffer(data, np.uint8)
+        starts = np.empty(len(self.lines), np.int64)
+        starts[0] = 0
+        starts[1:] = np.flatnonzero(buf == 10)[:len(self.lines) - 1] + 1
+        first = np.zeros(len(starts), np.uint8)
+        inside = starts < len(buf)
+        first[inside] = buf[starts[inside]]
+        self.first = first
+
+    def card(self, row: int) -> str:
+        return self.lines[row].decode("utf-8", "replace").rstrip()
+
+    def pick(self, rows: np.ndarray) -> list[bytes]:
+        """The lines at ``rows`` (0-based indices)."""
+        if len(rows) == 0:
+            return []
+        if rows[-1] - rows[0] + 1 == len(rows):
+            return self.lines[int(rows[0]):int(rows[-1]) + 1]
+        picked = itemgetter(*rows.tolist())(self.lines)
+        return list(picked) if len(rows) > 1 else [picked]
+
+    def error(self, message: str, row: int | None = None, keyword: str | None = None) -> ParseError:
+        if row is None:
+            return ParseError(self.path, message, keyword=keyword)
+        return ParseError(self.path, message, line=int(row) + 1, card=self.card(row),
+                          keyword=keyword)
+
+
+@dataclass
+class _Block:
+    src: _Source
+    keyword: str  # upper case, without the star
+    fmt: str
+    row: int  # 0-based index of the keyword line
+    rows: np.ndarray  # 0-based indices of its data lines, comments left out
+
+    def error(self, message: str, row: int | None = None) -> ParseError:
+        return self.src.error(message, self.row if row is None else row, self.keyword)
+
+    def blank(self, row) -> bool:
+        return not self.src.lines[row].strip()
+
+    def trimmed(self, period: int) -> np.ndarray:
+        """The data rows less trailing blank lines, as many as keep the count off a multiple of
+        ``period`` (a blank card is valid data; a stray blank line before the next keyword is not).
+        """
+        rows = self.rows
+        end = len(rows)
+        while end % period and end and self.blank(rows[end - 1]):
+            end -= 1
+        return rows[:end]
+
+
+
+# --------------------------------------------------------------------------- field conversion
+@dataclass(frozen=True)
+class _Field:
+    index: int  # position of the field on its card
+    kind: str  # "i" integer, "f" float
+    what: str  # what was expected, for messages
+
+
+def _layout(widths, fmt: str) -> tuple[list[int], list[int]]:
+    widths = [field_width(w, fmt) for w in widths]
+    return widths, np.concatenate([[0], np.cumsum(widths)]).astype(int).tolist()
+
+
+def _card_fields(line: bytes, widths, fmt: str) -> list[bytes]:
+    """The field texts of one card (fixed columns, or comma-separated when it holds a comma)."""
+    if b"," in line:
+        parts = line.split(b",")
+        parts += [b""] * (len(widths) - len(parts))
+        return parts[:len(widths)]
+    widths, starts = _layout(widths, fmt)
+    return [line[starts[i]:starts[i + 1]] for i in range(len(widths))]
+
+
+def _convert(text: bytes, kind: str):
+    """One field's value (blank = 0); ValueError when it is not a number of that kind."""
+    text = text.strip()
+    if not text:
+        return 0 if kind == "i" else 0.0
+    if kind == "i":
+        if not text.lstrip(b"+-").isdigit():
+            raise ValueError(text)
+        value = int(text)
+        if not -2**63 <= value < 2**63:
+            raise ValueError(text)
+        return value
+    return float(text.replace(b"D", b"E").replace(b"d", b"e"))
+
+
+def _shown(text: bytes) -> str:
+    return text.strip().decode("utf-8", "replace")
+
+
+def _diagnose(block: _Block, rows: np.ndarray, widths, fields: list[_Field]) -> ParseError:
+    """The error for the first card of ``rows`` (in file order) that does not convert."""
+    for row in rows.tolist():
+        texts = _card_fields(block.src.lines[row], widths, block.fmt)
+        for f in fields:
+            try:
+                _convert(texts[f.index], f.kind)
+            except ValueError:
+                return block.error(f"expected {f.what}, got {_shown(texts[f.index])!r}", row)
+    return block.error("a card could not be converted", int(rows[0]) if len(rows) else None)
+
+
+_BLANK_FIELD: dict[int, np.ndarray] = {}
+
+
+def _fixed_column(chars: np.ndarray, start: int, width: int, kind: str) -> np.ndarray:
+    """Convert columns ``start:start+width`` of the (n, W) byte array; ValueError when one fails.
+
+    Blank fields (spaces, or NUL padding past the end of a short line) read as 0, a Fortran
+    ``D`` exponent as ``E``; both are only looked for when the plain conversion fails.
+    """
+    sub = np.ascontiguousarray(chars[:, start:start + width])
+    text = sub.view(f"S{width}").ravel()
+    dtype = np.int64 if kind == "i" else np.float64
+    try:
+        return text.astype(dtype)
+    except ValueError:
+        pass
+    blank = (sub <= 32).all(axis=1)
+    if blank.any():
+        if width not in _BLANK_FIELD:
+            _BLANK_FIELD[width] = np.frombuffer(b" " * (width - 1) + b"0", np.uint8)
+        sub[blank] = _BLANK_FIELD[width]
+    if kind == "f":
+        fortran_exponent = (sub == ord("D")) | (sub == ord("d"))
+        sub[fortran_exponent] = ord("E")
+    return text.astype(dtype)  # ``text`` views ``sub``: the repairs show through
+
+
+def _table(block: _Block, rows: np.ndarray, widths, fields: list[_Field],
+           drop_blank: bool = False) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Convert ``fields`` of the cards at ``rows``: (rows read, one array per field).
+
+    Fixed-width cards are converted column by column with numpy; comma-separated cards one by
+    one. ``drop_blank`` leaves out blank lines (keywords whose records are single cards). The
+    first card that does not convert raises :class:`ParseError` with its line.
+    """
+    cols, starts = _layout(widths, block.fmt)
+    span = starts[max(f.index for f in fields) + 1]
+    lines = block.src.pick(rows)
+    chars = np.array(lines, dtype=f"S{span}").view(np.uint8).reshape(len(lines), span)
+    if drop_blank and len(rows):
+        maybe = np.flatnonzero((chars <= 32).all(axis=1))
+        blank = [i for i in maybe.tolist() if not lines[i].strip()]
+        if blank:
+            keep = np.ones(len(rows), bool)
+            keep[blank] = False
+            rows, chars = rows[keep], chars[keep]
+            lines = [line for line, k in zip(lines, keep.tolist()) if k]
+    out = [np.zeros(len(rows), np.int64 if f.kind == "i" else np.float64) for f in fields]
+    if len(rows) == 0:
+        return rows, out
+    if chars.tobytes().find(b",") < 0:  # memchr: cheaper than a per-row test when none
+        free = np.zeros(len(rows), bool)
+    else:
+        free = (chars == ord(",")).any(axis=1)
+    fixed = ~free
+    try:
+        if fixed.all():
+            for f, values in zip(fields, out):
+                values[:] = _fixed_column(chars, starts[f.index], cols[f.index], f.kind)
+        elif fixed.any():
+            subset = chars[fixed]
+            for f, values in zip(fields, out):
+                values[fixed] = _fixed_column(subset, starts[f.index], cols[f.index], f.kind)
+        for i in np.flatnonzero(free).tolist():
+            texts = _card_fields(lines[i], widths, block.fmt)
+            for f, values in zip(fields, out):
+                values[i] = _convert(texts[f.index], f.kind)
+    except (ValueError, OverflowError):
+        raise _diagnose(block, rows, widths, fields) from None
+    return rows, out
+
+
+# --------------------------------------------------------------------------- the deck
+@dataclass
+class _Chunk:
+    src: _Source
+    rows: np.ndarray  # line of each record (its first card)
+
+
+@dataclass
+class _Part:
+    title: str
+    secid: object
+
+
+@dataclass
+class _Section:
+    thickness: list[bytes]  # T1..T4 field texts (numbers or &parameter references)
+    src: _Source
+    row: int
+
+
+@dataclass
+class _Deck:
+    master: Path
+    default_fmt: str = "small"
+    include_dirs: list[Path] = field(default_factory=list)
+    reading: list[Path] = field(default_factory=list)
+    node_ids: list[np.ndarray] = field(default_factory=list)
+    node_xyz: list[np.ndarray] = field(default_factory=list)
+    node_chunks: list[_Chunk] = field(default_factory=list)
+    shell_ids: list[np.ndarray] = field(default_factory=list)
+    shell_parts: list[np.ndarray] = field(default_factory=list)
+    shell_nodes: list[np.ndarray] = field(default_factory=list)
+    shell_thickness: list[np.ndarray] = field(default_factory=list)
+    shell_chunks: list[_Chunk] = field(default_factory=list)
+    parts: dict[int, _Part] = field(default_factory=dict)
+    sections: dict[object, _Section] = field(default_factory=dict)
+    parameters: dict[str, object] = field(default_factory=dict)
+    skipped: dict[str, int] = field(default_factory=dict)
+
+    # ------------------------------------------------------------- files and blocks
+    def read_file(self, path: Path, fmt: str | None) -> None:
+        """Read one file's blocks; ``fmt`` None means the master deck (its format may change)."""
+        src = _Source(path)
+        self.reading.append(path.resolve())
+        keyword_rows = np.flatnonzero(src.first == ord("*"))
+        comment = src.first == ord("$")
+        ends = np.append(keyword_rows[1:], len(src.lines))
+        for row, end in zip(keyword_rows.tolist(), ends.tolist()):
+            header = src.lines[row].decode("utf-8", "replace").strip()
+            match = _KEYWORD_LINE.match(header)
+            if match is None:
+                raise src.error("expected a keyword name after '*'", row)
+            name = match.group(1).upper()
+            if name == "END":
+                break
+            options = match.group(3).strip()
+            if name == "KEYWORD":
+                if fmt is None:
+                    self.default_fmt = _keyword_format(options, self.default_fmt)
+                continue
+            suffix = match.group(2)
+            block_fmt = _SUFFIX_FORMAT[suffix] if suffix else (fmt or self.default_fmt)
+            rows = np.arange(row + 1, end)
+            block = _Block(src, name, block_fmt, row, rows[~comment[row + 1:end]])
+            self._dispatch(block, suffix)
+        self.reading.pop()
+
+    def _dispatch(self, block: _Block, suffix: str | None) -> None:
+        name = block.keyword
+        if name in ("NODE", "NODE_MERGE"):
+            self._nodes(block)
+        elif name.startswith("ELEMENT_SHELL"):
+            self._shells(block)
+        elif name.startswith("ELEMENT_"):
+            self.skipped[name] = self.skipped.get(name, 0) + 1
+        elif name == "PART" or name.startswith("PART_"):
+            self._parts(block)
+        elif name == "SECTION_SHELL" or name.startswith("SECTION_SHELL_"):
+            self._sections(block)
+        elif name in ("PARAMETER", "PARAMETER_LOCAL", "PARAMETER_NOECHO"):
+            self._parameters(block, expressions=False)
+        elif name.startswith("PARAMETER_EXPRESSION"):
+            self._parameters(block, expressions=True)
+        elif name in ("INCLUDE_PATH", "INCLUDE_PATH_RELATIVE"):
+            for text in _file_names(block):
+                folder = Path(text)
+                self.include_dirs.append(folder if folder.is_absolute()
+                                         else block.src.path.parent / folder)
+        elif name == "INCLUDE":
+            self._include(block, suffix)
+        elif name.startswith(_INCLUDE_REFUSED):
+            raise block.error(f"*{name} is not supported (it would renumber or move what it "
+                              "includes); include the file with plain *INCLUDE")
+
+    def _include(self, block: _Block, suffix: str | None) -> None:
+        include_fmt = _SUFFIX_FORMAT[suffix] if suffix else self.default_fmt
+        for text, row in _file_names(block, with_rows=True):
+            target = self._resolve(block.src.path.parent, text)
+            if target is None:
+                raise block.error(f"included file {text!r} not found", row)
+            if target.resolve() in self.reading:
+                chain = " -> ".join(p.name for p in self.reading)
+                raise block.error(f"include cycle: {text!r} is already being read ({chain})", row)
+            self.read_file(target, include_fmt)
+
+    def _resolve(self, folder: Path, text: str) -> Path | None:
+        names = [text] if "\\" not in text else [text, text.replace("\\", "/")]
+        for name in names:
+            candidate = Path(name)
+            if candidate.is_absolute():
+                if candidate.is_file():
+                    return candidate
+                continue
+            for base in [folder, self.master.parent, *self.include_dirs]:
+                if (base / candidate).is_file():
+                    return base / candidate
+        return None
+
+    # ------------------------------------------------------------- nodes and shells
+    def _nodes(self, block: _Block) -> None:
+        rows, (ids, x, y, z) = _table(block, block.rows, _NODE, [
+            _Field(0, "i", "an integer node id"), _Field(1, "f", "3 coordinates"),
+            _Field(2, "f", "3 coordinates"), _Field(3, "f", "3 coordinates")], drop_blank=True)
+        xyz = np.column_stack([x, y, z])
+        bad = ~np.isfinite(xyz).all(axis=1)
+        if bad.any():
+            raise block.error("expected 3 finite coordinates", int(rows[np.argmax(bad)]))
+        self.node_ids.append(ids)
+        self.node_xyz.append(xyz)
+        self.node_chunks.append(_Chunk(block.src, rows))
+
+    def _shells(self, block: _Block) -> None:
+        options = set(filter(None, block.keyword[len("ELEMENT_SHELL"):].split("_")))
+        unknown = options - _THICKNESS_OPTIONS - {"OFFSET"}
+        if unknown:
+            raise block.error(f"*{block.keyword} is not supported (read are *ELEMENT_SHELL and "
+                              "its options THICKNESS, BETA, MCID and OFFSET)")
+        has_thickness = bool(options & _THICKNESS_OPTIONS)
+        per_element = 1 + has_thickness + ("OFFSET" in options)
+        rows = block.trimmed(per_element) if per_element > 1 else block.rows
+        if len(rows) % per_element:
+            start = int(rows[len(rows) - len(rows) % per_element])
+            raise block.error(f"expected {per_element} cards per element, the block ends "
+                              f"after {len(rows) % per_element}", start)
+        cards = rows[::per_element]
+        cards, values = _table(block, cards, _SHELL, [
+            _Field(0, "i", "an integer element id"), _Field(1, "i", "an integer part id"),
+            *[_Field(i, "i", "4 integer node ids") for i in range(2, 6)]],
+            drop_blank=per_element == 1)
+        ids, pids = values[0], values[1]
+        nodes = np.column_stack(values[2:6])
+        thickness = np.full((len(cards), 4), np.nan)
+        if has_thickness:
+            eight = _eight_node(block, cards)
+            if eight is not None:  # n5..n8 would add a card: refuse rather than misread the rest
+                raise block.error("8-node shells with thickness cards are not supported", eight)
+            thickness[:] = np.column_stack(_table(block, rows[1::per_element], _THICKNESS, [
+                _Field(i, "f", "4 thicknesses") for i in range(4)])[1])
+        self.shell_ids.append(ids)
+        self.shell_parts.append(pids)
+        self.shell_nodes.append(nodes)
+        self.shell_thickness.append(thickness)
+        self.shell_chunks.append(_Chunk(block.src, cards))
+
+    # ------------------------------------------------------------- parts, sections, parameters
+    def _parts(self, block: _Block) -> None:
+        options = block.keyword[len("PART"):].replace("ATTACHMENT_NODES", "ATTACHMENT-NODES")
+        tokens = [t for t in options.split("_") if t]
+        if any(t not in _PART_EXTRA_CARDS and t not in _PART_SINGLE for t in tokens):
+            return  # *PART_MOVE, *PART_DUPLICATE, *PART_SENSOR, ...: not part definitions
+        if any(t in _PART_SINGLE for t in tokens):
+            period = None
+        else:
+            period = 2 + sum(_PART_EXTRA_CARDS[t] for t in tokens)
+        rows = block.trimmed(period or 1)
+        starts = [0] if period is None else range(0, len(rows), period)
+        for start in starts:
+            if start + 1 >= len(rows):
+                raise block.error("expected a part card (pid, secid, mid, ...) after the title",
+                                  int(rows[start]) if len(rows) else None)
+            title_row, card_row = int(rows[start]), int(rows[start + 1])
+            texts = _card_fields(block.src.lines[card_row], _TEN, block.fmt)
+            try:
+                pid = _convert(texts[0], "i")
+            except ValueError:
+                raise block.error(f"expected an integer part id, got {_shown(texts[0])!r}",
+                                  card_row) from None
+            title = block.src.lines[title_row].decode("utf-8", "replace").strip()
+            secid = None if "COMPOSITE" in tokens else _section_key(texts[1])
+            self.parts[pid] = _Part(title, secid)
+
+    def _sections(self, block: _Block) -> None:
+        options = set(block.keyword[len("SECTION_SHELL"):].split("_")) - {""}
+        titled = "TITLE" in options
+        repeatable = options <= {"TITLE"}
+        rows = block.rows
+        at = 0
+        while at < len(rows) and not all(block.blank(r) for r in rows[at:].tolist()):
+            at += titled
+            if at + 1 >= len(rows):
+                raise block.error("expected two section cards (secid ...; t1 t2 t3 t4 ...)",
+                                  int(rows[min(at, len(rows) - 1)]))
+            first, second = int(rows[at]), int(rows[at + 1])
+            texts = _card_fields(block.src.lines[first], _TEN, block.fmt)
+            try:
+                elform, nip, icomp = (_convert(texts[i], "i") for i in (1, 3, 6))
+            except ValueError:
+                raise block.error("expected integers ELFORM, NIP and ICOMP", first) from None
+            thickness = _card_fields(block.src.lines[second], _TEN, block.fmt)[:4]
+            self.sections[_section_key(texts[0])] = _Section(thickness, block.src, second)
+            at += 2
+            if icomp == 1:  # one card of 8 layer angles per 8 integration points
+                at += -(-(nip or 2) // 8)
+            if not repeatable or elform >= 101:  # user elements carry more cards
+                break
+
+    def _parameters(self, block: _Block, expressions: bool) -> None:
+        for row in block.rows.tolist():
+            line = block.src.lines[row]
+            if not line.strip():
+                continue
+            if expressions:  # the name only: the expression itself may hold commas
+                head = line[:field_width(10, block.fmt)]
+                names = [head.split(b",")[0] if b"," in head else head]
+                values = [None]
+            else:
+                texts = _card_fields(line, _TEN, block.fmt)
+                names, values = texts[0::2], texts[1::2]
+            for name, value in zip(names, values):
+                name = name.decode("utf-8", "replace").strip()
+                if not name:
+                    continue
+                kind = name[0].upper()
+                if kind in "RIC" and len(name) > 1:
+                    name = name[1:].strip()
+                else:
+                    kind = "R"
+                if value is None:
+                    self.parameters[name] = None  # expression: not evaluated here
+                elif kind == "C":
+                    self.parameters[name] = value.decode("utf-8", "replace").strip()
+                else:
+                    try:
+                        self.parameters[name] = _convert(value, "f")
+                    except ValueError:
+                        raise block.error(f"expected a number for parameter {name!r}, got "
+                                          f"{_shown(value)!r}", row) from None
+
+    def _parameter(self, text: bytes, src: _Source, row: int) -> float:
+        """A section thickness field: a number or a (signed) ``&name`` reference; NaN when the
+        parameter is defined by an expression."""
+        text = text.strip()
+        sign = -1.0 if text.startswith(b"-") else 1.0
+        if text.lstrip(b"+-").startswith(b"&"):
+            name = text.lstrip(b"+-")[1:].decode("utf-8", "replace").strip()
+            if name not in self.parameters:
+                folded = {k.lower(): k for k in self.parameters}
+                if name.lower() not in folded:
+                    raise src.error(f"parameter {name!r} is not defined by *PARAMETER", row,
+                                    "SECTION_SHELL")
+                name = folded[name.lower()]
+            value = self.parameters[name]
+            if value is None:
+                return float("nan")
+            if not isinstance(value, float):
+                raise src.error(f"parameter {name!r} is not a number", row, "SECTION_SHELL")
+            return sign * value
+        try:
+            return _convert(text, "f")
+        except ValueError:
+            raise src.error(f"expected a thickness, got {_shown(text)!r}", row,
+                            "SECTION_SHELL") from None
+
+    # ------------------------------------------------------------- assembly
+    def build(self, units: str) -> FEMesh:
+        if sum(len(ids) for ids in self.shell_ids) == 0:
+            others = ", ".join(f"*{k}" for k in sorted(self.skipped))
+            raise ParseError(self.master, "no shell elements (*ELEMENT_SHELL) in the deck"
+                             + (f"; it has {others}, which are not read" if others else ""))
+        node_ids = np.concatenate(self.node_ids) if self.node_ids else np.zeros(0, np.int64)
+        xyz = np.concatenate(self.node_xyz) if self.node_xyz else np.zeros((0, 3))
+        shell_ids = np.concatenate(self.shell_ids)
+        pids = np.concatenate(self.shell_parts)
+        refs = np.concatenate(self.shell_nodes)
+        order, sorted_ids = _unique_or_raise(node_ids, self.node_chunks, "node")
+        _unique_or_raise(shell_ids, self.shell_chunks, "element")
+
+        if not (node_ids == 0).any():  # n4 left blank on a triangle
+            blank4 = refs[:, 3] == 0
+            refs[blank4, 3] = refs[blank4, 2]
+        if len(sorted_ids):
+            pos = np.searchsorted(sorted_ids, refs).clip(max=len(sorted_ids) - 1)
+            found = sorted_ids[pos] == refs
+            elements = order[pos]
+        else:
+            found = np.zeros(refs.shape, bool)
+            elements = np.zeros(refs.shape, np.int64)
+        if not found.all():
+            bad = np.flatnonzero(~found.all(axis=1))
+            pairs = [(int(shell_ids[e]), int(refs[e][~found[e]][0])) for e in bad[:5]]
+            src, row = _locate(self.shell_chunks, int(bad[0]))
+            listed = ", ".join(f"({e}, {n})" for e, n in pairs)
+            raise src.error(f"{len(bad)} element(s) reference undefined node ids; first "
+                            f"(element id, node id): {listed}", row, "ELEMENT_SHELL")
+        limits = np.iinfo(np.int32)
+        too_big = (pids < limits.min) | (pids > limits.max)
+        if too_big.any():  # FEMesh keeps part ids as int32
+            src, row = _locate(self.shell_chunks, int(np.argmax(too_big)))
+            raise src.error(f"part id {int(pids[too_big][0])} does not fit in 32 bits", row,
+                            "ELEMENT_SHELL")
+
+        element_fields = {}
+        thickness = self._thickness(pids, elements)
+        if np.isfinite(thickness).any():
+            element_fields["thickness"] = thickness
+        used_parts = set(np.unique(pids).tolist())
+        part_names = {pid: part.title for pid, part in self.parts.items()
+                      if part.title and pid in used_parts}
+        return build_mesh(self.master, nodes=xyz, elements=elements, parts=pids,
+                          element_fields=element_fields, part_names=part_names,
+                          node_ids=node_ids, element_ids=shell_ids, name=self.master.name,
+                          units=units)
+
+    def _thickness(self, pids: np.ndarray, elements: np.ndarray) -> np.ndarray:
+        """(M,) mean nodal thickness: element thickness cards, zeros and gaps from the section."""
+        nodal = np.concatenate(self.shell_thickness)
+        unique, inverse = np.unique(pids, return_inverse=True)
+        section_of_part = {}
+        for pid in unique.tolist():
+            part = self.parts.get(pid)
+            section = None if part is None else self.sections.get(part.secid)
+            if section is None:
+                continue
+            t = np.array([self._parameter(text, section.src, section.row)
+                          for text in section.thickness])
+            t[1:][t[1:] == 0] = t[0]  # T2..T4 default to T1
+            section_of_part[pid] = t
+        fallback = np.full((len(pids), 4), np.nan)
+        if section_of_part:
+            table = np.array([section_of_part.get(p, [np.nan] * 4) for p in unique.tolist()])
+            fallback = table[inverse.reshape(-1)]
+        use_section = np.isnan(nodal) | (nodal == 0)
+        nodal = np.where(use_section, fallback, nodal)
+        triangle = elements[:, 3] == elements[:, 2]
+        return np.where(triangle, nodal[:, :3].mean(axis=1), nodal.mean(axis=1))
+
+
+def _eight_node(block: _Block, cards: np.ndarray) -> int | None:
+    """The line of the first element card with a node among n5..n8, or None."""
+    if len(cards) == 0:
+        return None
+    widths, starts = _layout(_SHELL, block.fmt)
+    lines = block.src.pick(cards)
+    chars = np.array(lines, dtype=f"S{starts[10]}").view(np.uint8).reshape(len(lines), -1)
+    tail = chars[:, starts[6]:]
+    suspect = np.flatnonzero(((tail > 32) & (tail != ord("0"))).any(axis=1))
+    for i in suspect.tolist():
+        texts = _card_fields(lines[i], _SHELL, block.fmt)[6:10]
+        try:
+            if any(_convert(t, "i") for t in texts):
+                return int(cards[i])
+        except ValueError:
+            shown = ", ".join(repr(_shown(t)) for t in texts)
+            raise block.error(f"expected integer node ids n5..n8, got {shown}",
+                              int(cards[i])) from None
+    return None
+
+
+def _keyword_format(options: str, current: str) -> str:
+    """The deck format set by the options of a ``*KEYWORD`` line (LONG=Y/S, I10=Y/N)."""
+    text = options.upper().replace(" ", "")
+    match = re.search(r"LONG=([A-Z])", text)
+    if match:
+        return "long" if match.group(1) == "Y" else "small"
+    match = re.search(r"I10=([A-Z])", text)
+    if match:
+        return "i10" if match.group(1) == "Y" else "small"
+    return current
+
+
+def _section_key(text: bytes):
+    text = text.strip().decode("utf-8", "replace")
+    return int(text) if text.lstrip("+-").isdigit() else text.upper()
+
+
+def _file_names(block: _Block, with_rows: bool = False):
+    """The file or folder names of an ``*INCLUDE``-like block (a trailing " +" continues a name)."""
+    names, pending, pending_row = [], "", None
+    for row in block.rows.tolist():
+        text = block.src.lines[row].decode("utf-8", "replace").strip()
+        if not text and not pending:
+            continue
+        if pending_row is None:
+            pending_row = row
+        if text.endswith(" +"):
+            pending += text[:-2].strip()
+            continue
+        names.append((pending + text, pending_row))
+        pending, pending_row = "", None
+    if pending:
+        names.append((pending, pending_row))
+    return names if with_rows else [n for n, _ in names]
+
+
+def _locate(chunks: list[_Chunk], index: int) -> tuple[_Source, int]:
+    """The file and 0-based line of the ``index``-th record over ``chunks``."""
+    for chunk in chunks:
+        if index < len(chunk.rows):
+            return chunk.src, int(chunk.rows[index])
+        index -= len(chunk.rows)
+    raise IndexError(index)
+
+
+def _unique_or_raise(ids: np.ndarray, chunks: list[_Chunk], what: str):
+    """(order, sorted ids) of ``ids``; a repeated id raises ParseError at its second definition."""
+    order = np.argsort(ids, kind="stable")
+    sorted_ids = ids[order]
+    repeated = np.flatnonzero(sorted_ids[1:] == sorted_ids[:-1])
+    if len(repeated):
+        later = order[repeated + 1]
+        second = int(later.min())
+        first = int(order[np.searchsorted(sorted_ids, ids[second])])
+        src0, row0 = _locate(chunks, first)
+        src, row = _locate(chunks, second)
+        keyword = "NODE" if what == "node" else "ELEMENT_SHELL"
+        raise src.error(f"{what} id {int(ids[second])} is defined twice (first at "
+                        f"{src0.path.name}:{row0 + 1}); {len(repeated)} repeated id(s)", row,
+                        keyword)
+    return order, sorted_ids
