@@ -1,7 +1,7 @@
 """GPU timer, occlusion (samples-passed) and primitive queries, wrapped for the measurement harness.
 
 Each query measures the GL commands issued inside ``with query:``; reading its result waits
-for those commands to finish.
+for those commands to finish. moderngl frees a query when it is garbage-collected.
 """
 
 from __future__ import annotations
@@ -21,9 +21,6 @@ class _Query:
 
     def __exit__(self, *exc) -> None:
         self.query.__exit__(*exc)
-
-    def release(self) -> None:
-        self.query.release()
 
 
 class GpuTimer(_Query):
