@@ -417,6 +417,9 @@ def test_crash_sequence_axis_and_refusals():
     c = crash_sequence(m, steps=3, crush=0.2, axis="-z")
     back = np.argmin(m.nodes[:, 2])
     assert np.isclose(c.steps[-1, back, 2] - m.nodes[back, 2], 0.2 * np.ptp(m.nodes[:, 2]))
+    default = crash_sequence(m, steps=2, crush=0.1)            # car body coordinates: front at min x
+    left = np.argmin(m.nodes[:, 0])
+    assert np.isclose(default.steps[-1, left, 0] - m.nodes[left, 0], 0.1 * np.ptp(m.nodes[:, 0]))
     with pytest.raises(MeshError):
         crash_sequence(c)
     with pytest.raises(ValueError):

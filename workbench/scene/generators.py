@@ -789,12 +789,14 @@ def _node_normals(elements: np.ndarray, nodes: np.ndarray) -> np.ndarray:
     return np.divide(out, length, out=np.zeros_like(out), where=length > 0)
 
 
-def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str = "x", *,
+def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str = "-x", *,
                    fold_wavelength: float | None = None, duration: float = 0.1) -> FEMesh:
     """A copy of ``mesh`` with ``steps`` time steps of a smooth, progressive front crush.
 
-    The impactor comes from the ``+axis`` side (``axis`` one of "x", "y", "z", "-x", "-y", "-z";
-    "x" means the nodes of largest x are the front) and pushes the front back along the axis.
+    The impactor comes from the ``axis`` side (one of "x", "y", "z", "-x", "-y", "-z": "x" makes
+    the nodes of largest x the front, "-x" those of smallest x) and pushes the front back along
+    the axis. The default "-x" suits car body coordinates, where x points rearwards (the shared
+    LS-DYNA car deck has its bumper at x = 0 and the barrier at negative x).
     With depth d of a node behind the front, extent E of the model along the axis, progress
     τ = i / (steps - 1) and the smooth ramp c(τ) = crush · E · smoothstep(τ) (the crush depth):
 
