@@ -1,16 +1,14 @@
 #version 330
-// element_color path: one normalised value per triangle (its element's), read by primitive id
+// element_color path: one colour per element (flat varying), flat lighting as the flat path
 #include "headlight.glsl"
 #include "colormap.glsl"
-uniform sampler2D element_values;
 in vec3 eye_position;
+flat in float coord;
 out vec4 frag_color;
 
 void main() {
     float light = headlight(cross(dFdx(eye_position), dFdy(eye_position)), eye_position);
-    int k = gl_PrimitiveID;
-    float t = texelFetch(element_values, ivec2(k % VALUES_WIDTH, k / VALUES_WIDTH), 0).r;
-    vec4 c = colormap_lookup(colormap_coord(t));
+    vec4 c = colormap_lookup(coord);
 #ifdef HIDE
     if (c.a < 0.5) discard;
 #endif

@@ -1,5 +1,5 @@
 #version 330
-// flat and element_color paths: the eye-space position feeds the derivative face normal
+// flat path: the eye-space position feeds the derivative face normal
 #include "common.vert.glsl"
 in vec3 position;
 out vec3 eye_position;

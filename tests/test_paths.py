@@ -11,7 +11,11 @@ import numpy as np
 import pytest
 
 from workbench.gl import Camera, Framebuffer, GLUnavailable, create_context
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
 from workbench.paths import PATHS, ColorScale, Style, colormap_lut, make_path, scale_for
+from workbench.paths.fields import provoking_vertices
 from workbench.scene.mesh import FEMesh
 
 SIZE = 64
@@ -230,12 +234,88 @@ def test_element_color_one_colour_per_element(ctx):
     assert path.vertices == 9 and path.triangles == 8
 
 
+def test_element_color_with_more_elements_than_nodes(ctx):
+    # 4 × 4 quads given as 32 triangle elements over 25 nodes: duplicated provoking vertices
+    quads = grid(4, 4)
+    e = quads.elements
+    tris = np.concatenate([e[:, [0, 1, 2, 2]], e[:, [0, 2, 3, 3]]])
+    values = np.arange(len(tris), dtype=np.float64)[::-1].copy()
+    mesh = FEMesh(quads.nodes, tris, element_fields={"v": values})
+    image, path = render(ctx, "element_color", mesh, camera(), field="v")
+    assert path.vertices > mesh.n_nodes and path.triangles == 32
+    scale = scale_for(mesh, "v")
+    x, y = pixel_centres()
+    for k, t in enumerate(tris[:, :3]):
+        a, b, c = mesh.nodes[t, :2]
+        # pixels at least one pixel inside the triangle (barycentric margin)
+        m = np.linalg.inv(np.array([[b[0] - a[0], c[0] - a[0]], [b[1] - a[1], c[1] - a[1]]]))
+        u = m[0, 0] * (x - a[0]) + m[0, 1] * (y - a[1])
+        v = m[1, 0] * (x - a[0]) + m[1, 1] * (y - a[1])
+        inside = (u > 0.15) & (v > 0.15) & (1 - u - v > 0.15)
+        assert inside.sum() >= 3
+        expected = scale.evaluate(values[k])[:3] * 255
+        assert np.abs(image[inside][:, :3] - expected).max() <= 1.0, k
+
+
 def test_element_color_hides_elements_in_range(ctx):
     mesh = grid(2, 1)
     image, _ = render(ctx, "element_color", mesh, camera(), field="cell", hide_range=(0.5, 2.0))
     mask = covered(image)
     # element 0 (left, value 0) stays, element 1 (right, value 1) is hidden
     assert mask[:, 16:32].sum() == 16 * 32 and not mask[:, 32:].any()
+
+
+@st.composite
+def element_meshes(draw):
+    """Small random shell meshes: quads and triangles over a few nodes (shared a lot)."""
+    n = draw(st.integers(4, 12))
+    m = draw(st.integers(1, 25))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    elements = []
+    for _ in range(m):
+        corners = rng.choice(n, size=4, replace=False)
+        if rng.random() < 0.3:
+            corners[3] = corners[2]
+        elements.append(corners)
+    return FEMesh(rng.random((n, 3)), np.array(elements))
+
+
+@settings(max_examples=60, deadline=None)
+@given(element_meshes())
+def test_provoking_vertices_give_each_element_its_own(mesh):
+    tri, el = mesh.triangles, mesh.triangulation.element_of
+    vertex_node, out, provoking = provoking_vertices(tri, el, mesh.n_nodes, mesh.n_elements)
+    # the same triangles, cyclically rotated (winding kept), duplicates standing for their node
+    nodes = vertex_node[out]
+    assert all(any((np.roll(a, r) == b).all() for r in range(3)) for a, b in zip(nodes, tri))
+    # every element's triangles end in its provoking vertex, and no two elements share one
+    assert (out[:, 2] == provoking[el]).all()
+    drawn = np.unique(el)
+    assert (provoking[drawn] >= 0).all() and len(np.unique(provoking[drawn])) == len(drawn)
+    assert (vertex_node[: mesh.n_nodes] == np.arange(mesh.n_nodes)).all()
+    # as few duplicates as possible: elements minus a maximum matching found by Kuhn's
+    # augmenting paths over the nodes all of an element's triangles share
+    shared = {e: set.intersection(*(set(t) for t in tri[el == e].tolist())) for e in drawn}
+    match: dict[int, int] = {}
+
+    def augment(e, seen):
+        for v in shared[e]:
+            if v not in seen:
+                seen.add(v)
+                if v not in match or augment(match[v], seen):
+                    match[v] = e
+                    return True
+        return False
+
+    matched = sum(augment(e, set()) for e in drawn)
+    assert len(vertex_node) - mesh.n_nodes == len(drawn) - matched
+
+
+def test_provoking_vertices_need_no_duplicate_on_a_grid():
+    mesh = grid(7, 5)
+    vertex_node, _, _ = provoking_vertices(mesh.triangles, mesh.triangulation.element_of,
+                                           mesh.n_nodes, mesh.n_elements)
+    assert len(vertex_node) == mesh.n_nodes
 
 
 # --------------------------------------------------------------------------- lighting
@@ -404,8 +484,8 @@ def test_set_step_uploads_coordinates_only(ctx, name, monkeypatch):
     sent = path.set_step(1)
     per_vertex = 12 + (12 if name in ("gouraud", "vertex_color", "pixel_color") else 0)
     expected = path.vertices * per_vertex
-    if name == "element_color":  # a time-dependent element field: one value per triangle
-        expected += path.triangles * 4
+    if name == "element_color":  # a time-dependent element field: one value per vertex
+        expected += path.vertices * 4
     assert sent == sum(writes) == expected == path.bytes_per_step
     assert len(writes) == per_vertex // 12 + (name == "element_color")
     assert path.bytes_uploaded > path.bytes_per_step  # topology went up once, at prepare

@@ -43,7 +43,6 @@ from .colormap import ColorScale, scale_for
 NEEDS = frozenset({"triangles", "face_normals", "gouraud", "edges", "node_field", "element_field"})
 MAX_CLIP_PLANES = 4
 GL_CLIP_DISTANCE0 = 0x3000
-VALUES_TEXTURE_WIDTH = 4096  # row length of the per-triangle value texture (element fields)
 POLYGON_OFFSET = (1.0, 1.0)  # fill pass under a wire frame: (factor, units)
 
 
@@ -181,10 +180,11 @@ def field_kind(mesh, name: str) -> str:
 class MeshPath(RenderPath):
     """The shared implementation: one indexed triangle VAO, optionally a wire-frame VAO.
 
-    Subclasses choose shaders and three switches: ``split`` (vertices are the crease-split
+    Subclasses choose shaders and two switches: ``split`` (vertices are the crease-split
     Gouraud vertices with per-vertex normals; otherwise the mesh's referenced nodes without
-    normals), ``field_per`` (None, ``"node"`` — a per-vertex attribute — or ``"element"`` — one
-    value per triangle in a float texture read with ``gl_PrimitiveID``).
+    normals) and ``field_per`` (None, ``"node"`` or ``"element"``: the field's normalised
+    values go up as a per-vertex float attribute ``value``); :meth:`topology` may be overridden
+    to number the vertices differently.
     """
 
     vertex_shader: ClassVar[str]
@@ -218,53 +218,49 @@ class MeshPath(RenderPath):
             self.release()
             raise
 
+    def topology(self, mesh) -> tuple[np.ndarray | None, np.ndarray]:
+        """(vertex_node, triangles): the node of each vertex (None: the nodes themselves) and
+        (K, 3) triangles into the vertices; unreferenced vertices are dropped afterwards."""
+        if self.split:
+            self._gouraud = mesh.gouraud(self.style.crease_deg)
+            return np.asarray(self._gouraud.vertex_node, np.int64), self._gouraud.triangles
+        return None, mesh.triangles
+
     def _build(self, ctx: moderngl.Context, camera) -> None:
         mesh, style = self.mesh, self.style
-        if self.split:
-            g = mesh.gouraud(style.crease_deg)
-            self._gouraud = g
-            self._vertex_node = np.asarray(g.vertex_node, np.int64)
-            index = g.triangles
-        else:
-            used = mesh.used_nodes()
-            index = mesh.triangles
-            if len(used) == mesh.n_nodes:
-                self._vertex_node = None
-            else:  # compact away unreferenced nodes
-                remap = np.full(mesh.n_nodes, -1, np.int64)
-                remap[used] = np.arange(len(used))
-                self._vertex_node, index = used, remap[index]
+        vertex_node, index = self.topology(mesh)
+        n_vertices = mesh.n_nodes if vertex_node is None else len(vertex_node)
+        used = np.zeros(n_vertices, bool)
+        used[index.ravel()] = True
+        self._remap = None
+        if not used.all():  # unreferenced nodes are not uploaded
+            keep = np.flatnonzero(used)
+            self._remap = np.full(n_vertices, -1, np.int64)
+            self._remap[keep] = np.arange(len(keep))
+            vertex_node = keep if vertex_node is None else vertex_node[keep]
+            index = self._remap[index]
+            n_vertices = len(keep)
+        self._vertex_node = vertex_node
         index = np.ascontiguousarray(index, dtype=np.int32)
-        n_vertices = mesh.n_nodes if self._vertex_node is None else len(self._vertex_node)
         self.triangles, self.vertices = len(index), n_vertices
         uploaded = 0
 
         defines = {"NUM_CLIP": len(style.clip_planes)}
         if style.hide_range is not None and self.field_per is not None:
             defines["HIDE"] = 1
-        if self.field_per == "element":
-            self._values_width = min(self.triangles, VALUES_TEXTURE_WIDTH)
-            defines["VALUES_WIDTH"] = self._values_width
         self._program = self._keep(load_program(ctx, self.vertex_shader, self.fragment_shader,
                                                 defines=defines))
         self._positions = self._keep(ctx.buffer(reserve=n_vertices * 12))
         self._index = self._keep(ctx.buffer(index.tobytes()))
         uploaded += index.nbytes
         content = [(self._positions, "3f", "position")]
-        self._normals = self._values = self._values_texture = self._colormap = None
+        self._normals = self._values = self._colormap = None
         if self.split:
             self._normals = self._keep(ctx.buffer(reserve=n_vertices * 12))
             content.append((self._normals, "3f", "normal"))
-        if self.field_per == "node":
+        if self.field_per is not None:
             self._values = self._keep(ctx.buffer(reserve=n_vertices * 4))
             content.append((self._values, "1f", "value"))
-        if self.field_per == "element":
-            rows = -(-self.triangles // self._values_width)
-            self._values_texture = self._keep(
-                ctx.texture((self._values_width, rows), 1, dtype="f4"))
-            self._values_texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            self._element_of = mesh.triangulation.element_of
-            self._program["element_values"].value = 1
         if self.scale is not None:
             texels = self.scale.texture_data()
             self._colormap = self._keep(ctx.texture((len(texels), 1), 4, texels.tobytes()))
@@ -320,8 +316,9 @@ class MeshPath(RenderPath):
         kind = field_kind(mesh, name)
         if kind != self.field_per:
             other = "element_color" if kind == "element" else "pixel_color or vertex_color"
-            raise ValueError(f"path {self.name!r} draws {self.field_per} fields, {name!r} is an "
-                             f"{kind} field: draw it with {other}")
+            article = "an" if kind == "element" else "a"
+            raise ValueError(f"path {self.name!r} draws {self.field_per} fields, {name!r} is "
+                             f"{article} {kind} field: draw it with {other}")
 
     def _field_values(self) -> np.ndarray:
         fields = self.mesh.node_fields if self.field_per == "node" else self.mesh.element_fields
@@ -403,30 +400,24 @@ class MeshPath(RenderPath):
         if bad.any():
             raise ValueError(f"field {self.style.field!r} has {int(bad.sum())} non-finite values at "
                              f"step {step} (first at index {int(np.flatnonzero(bad)[0])})")
-        t = self.scale.normalise(values)
-        if self.field_per == "node":
-            if self._vertex_node is not None:
-                t = t[self._vertex_node]
-            data = t.astype(np.float32)
-            self._values.write(data)
-            return data.nbytes
-        texture = self._values_texture
-        data = np.zeros(texture.width * texture.height, np.float32)
-        data[: self.triangles] = t[self._element_of]
-        texture.write(data)
+        data = self.vertex_values(self.scale.normalise(values)).astype(np.float32)
+        self._values.write(data)
         return data.nbytes
+
+    def vertex_values(self, t: np.ndarray) -> np.ndarray:
+        """(V,) per-vertex values from per-node values (element paths override)."""
+        return t if self._vertex_node is None else t[self._vertex_node]
 
     def draw(self) -> None:
         ctx, style = self.ctx, self.style
         ctx.enable_only(moderngl.DEPTH_TEST | (moderngl.CULL_FACE if style.cull_back else 0))
+        ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
         if style.cull_back:
             ctx.front_face, ctx.cull_face = "ccw", "back"
         for i in range(len(style.clip_planes)):
             ctx.enable_direct(GL_CLIP_DISTANCE0 + i)
         if self._colormap is not None:
             self._colormap.use(0)
-        if self._values_texture is not None:
-            self._values_texture.use(1)
         if self._wire_vao is not None:
             ctx.polygon_offset = POLYGON_OFFSET
             self._vao.render(moderngl.TRIANGLES)
