@@ -76,7 +76,7 @@ def cmd_render(args) -> int:
     width, height = args.size
     center, radius = mesh.bounding_sphere(all_steps=True)
     camera = Camera.fit(center, radius, azimuth=args.view[0], elevation=args.view[1],
-                        projection=args.projection, aspect=width / height)
+                        projection=args.projection, aspect=width / height, up=args.up)
     fb = Framebuffer(ctx, (width, height), samples=args.samples)
     path = make_path(path_name, style)
     path.prepare(ctx, mesh, camera)
@@ -150,6 +150,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--wireframe", action="store_true", help="overdraw element edges")
     p.add_argument("--view", type=lambda s: _pair(s, ","), default=(30.0, 25.0), metavar="AZ,EL",
                    help="azimuth and elevation in degrees (default 30,25)")
+    p.add_argument("--up", choices=("y", "z"), default="z",
+                   help="world axis shown upwards (default z, as in most CAE models)")
     p.add_argument("--size", type=_size, default=(1000, 800), metavar="WxH", help="image size (default 1000x800)")
     p.add_argument("--projection", choices=("orthographic", "perspective"), default="orthographic")
     p.add_argument("--step", type=int, default=0, help="time step to draw (default 0)")

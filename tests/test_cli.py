@@ -1,0 +1,88 @@
+"""The workbench command: rendering, experiments, and one-line errors with exit status 2."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from workbench.cli import main
+from workbench.data import CAR_DECK, shared_file
+
+DECK = """*KEYWORD
+*NODE
+       1             0.0             0.0             0.0
+       2           100.0             0.0             0.0
+       3           100.0           100.0             0.0
+       4             0.0           100.0             0.0
+*ELEMENT_SHELL
+       1       1       1       2       3       4
+*END
+"""
+
+
+@pytest.fixture()
+def deck(tmp_path):
+    path = tmp_path / "plate.k"
+    path.write_text(DECK)
+    return path
+
+
+def test_render_writes_the_image_of_a_plate(deck, tmp_path):
+    out = tmp_path / "plate.png"
+    assert main(["render", str(deck), "--view", "0,0", "--up", "y", "--size", "80x60", "--projection",
+                 "orthographic", "-o", str(out)]) == 0
+    image = np.asarray(Image.open(out))
+    assert image.shape[:2] == (60, 80)
+    drawn = (image[..., :3] != 255).any(axis=2)
+    # a 100 x 100 plate fits a view of diameter 141 x 1.05: about 67 % of the 60 rows
+    rows = np.flatnonzero(drawn.any(axis=1))
+    assert 0.55 < len(rows) / 60 < 0.75 and drawn.sum() > 0
+
+
+def test_render_car_with_field_writes_a_colour_bar_figure(tmp_path):
+    if shared_file(CAR_DECK) is None:
+        pytest.skip("shared car deck not found (set WORKBENCH_DATA)")
+    out = tmp_path / "car.png"
+    assert main(["render", "car", "--field", "thickness", "--bands", "4", "--wireframe",
+                 "--size", "320x200", "-o", str(out)]) == 0
+    image = np.asarray(Image.open(out).convert("RGB"))
+    # the figure is wider than the render: a colour bar sits beside it
+    assert image.shape[1] > 320
+
+
+@pytest.mark.parametrize("text, expected", [
+    (DECK.replace("100.0           100.0", "100.0           abc  "), ":5:"),
+    (DECK.replace("       1       1       1       2       3       4",
+                  "       1       1       1       2       3       9"), "9"),
+    ("*KEYWORD\n*END\n", "plate.k"),
+])
+def test_bad_decks_end_with_one_line_and_status_2(tmp_path, text, expected):
+    path = tmp_path / "plate.k"
+    path.write_text(text)
+    proc = subprocess.run([sys.executable, "-m", "workbench.cli", "render", str(path), "-o",
+                           str(tmp_path / "x.png")], capture_output=True, text=True)
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("workbench: error:") and expected in lines[0]
+    assert "Traceback" not in proc.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_missing_file_and_unknown_field_are_bad_input(deck, tmp_path, capsys):
+    assert main(["render", str(tmp_path / "none.k"), "-o", str(tmp_path / "x.png")]) == 2
+    assert main(["render", str(deck), "--field", "stress", "-o", str(tmp_path / "x.png")]) == 2
+    err = capsys.readouterr().err
+    assert "none.k" in err and "no field 'stress'" in err
+
+
+def test_list_names_the_render_paths_experiment(capsys):
+    assert main(["list"]) == 0
+    assert "render_paths" in capsys.readouterr().out
+
+
+def test_info_names_the_renderer(capsys):
+    assert main(["info"]) == 0
+    out = capsys.readouterr().out
+    assert "renderer" in out and "moderngl" in out
