@@ -1,0 +1,169 @@
+"""Every first render path side by side: time against error, on the car model and the es2008 scene.
+
+For each scene the table has one row per path and option — GPU ms, wall ms, read-back ms,
+million triangles per second, bytes uploaded (and per time step) — with the colour error of
+each per-vertex path against the per-pixel path of the same style (the colour reference).
+In the same run the same triangles are drawn by pyrender through EGL at the same size, with
+the same culling and comparable lighting (SSIM against our Gouraud image shows the comparison
+is like for like), and a bare position-only draw gives the floor. ``targets.md`` holds the
+ratios the foundation is judged by.
+
+Run: ``workbench run render_paths [--quick]`` or ``python experiments/render_paths.py [--quick]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from workbench.experiment.compare import compare_images
+from workbench.experiment.figures import save_field_figure, save_image_grid
+from workbench.experiment.reference import PyrenderReference
+from workbench.experiment.registry import experiment, run_experiment
+from workbench.experiment.tables import write_table
+from workbench.experiment.timing import time_call, time_draw
+from workbench.gl import Camera, Framebuffer, create_context, renderer
+from workbench.paths import Style, make_path
+from workbench.scene import generators
+from workbench.scene.builtin import builtin_scene
+
+BANDS = 10
+
+
+def scenes(quick: bool):
+    """(label, mesh, step shown, field, element field or None, units, camera kwargs, image size).
+
+    The car is put through a synthetic frontal crush so that it has time steps and a
+    displacement field; its last step is shown. The semicylinders are the es2008 benchmark.
+    """
+    car = generators.crash_sequence(builtin_scene("car"), steps=4 if quick else 12)
+    yield ("car", car, car.n_steps - 1, "displacement", "thickness", "mm",
+           dict(azimuth=-35.0, elevation=20.0, up="z"), (640, 400) if quick else (1000, 625))
+    n = 64 if quick else 250
+    yield (f"semicylinders n={n}", generators.semicylinders(n=n), 0, "distance", None, "mm",
+           dict(azimuth=25.0, elevation=15.0), (500, 500) if quick else (1000, 1000))
+
+
+def path_configs(step: int, field: str, element_field: str | None, value_range, clip_plane):
+    """(row label, path name, style, reference label or None) — references come first."""
+    plain = Style(step=step)
+    smooth = replace(plain, field=field, value_range=value_range)
+    banded = replace(smooth, bands=BANDS)
+    lo, hi = value_range
+    yield "position", "position", plain, None
+    yield "flat", "flat", plain, None
+    yield "gouraud", "gouraud", plain, None
+    yield "gouraud + wire", "gouraud", replace(plain, wireframe=True), None
+    yield "pixel smooth", "pixel_color", smooth, None
+    yield "vertex smooth", "vertex_color", smooth, "pixel smooth"
+    yield "pixel bands", "pixel_color", banded, None
+    yield "vertex bands", "vertex_color", banded, "pixel bands"
+    yield "pixel bands + wire", "pixel_color", replace(banded, wireframe=True), None
+    yield "pixel transfer (hide low 30 %)", "pixel_color", replace(smooth, hide_range=(lo, lo + 0.3 * (hi - lo))), None
+    yield "pixel bands + clip", "pixel_color", replace(banded, clip_planes=(clip_plane,)), None
+    if element_field is not None:
+        yield "element flat", "element_color", replace(plain, field=element_field), None
+    if step > 0:
+        yield "pixel bands, deformation x3", "pixel_color", replace(banded, magnification=3.0), None
+
+
+@experiment("render_paths", "first render paths on the car and the es2008 semicylinders: time against "
+                            "error, pyrender and a bare draw beside them")
+def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
+    say = progress or (lambda msg: None)
+    ctx = create_context()
+    gl_renderer = renderer(ctx)
+    repeat = 5 if quick else 9
+    rows: list[dict] = []
+    targets: list[dict] = []
+    for label, mesh, step, field, element_field, units, view, size in scenes(quick):
+        say(f"{label}: {mesh.n_elements} elements, {size[0]}x{size[1]}")
+        center, radius = mesh.bounding_sphere(all_steps=True)
+        camera = Camera.fit(center, radius, aspect=size[0] / size[1], **view)
+        fb = Framebuffer(ctx, size)
+        value_range = mesh.field_range(field)
+        clip_plane = (*(-camera.view_matrix()[0, :3]), float(camera.view_matrix()[0, :3] @ center))
+        images: dict[str, np.ndarray] = {}
+        for row_label, name, style, reference in path_configs(step, field, element_field, value_range,
+                                                              clip_plane):
+            path = make_path(name, style)
+            path.prepare(ctx, mesh, camera)
+            timing = time_draw(ctx, fb, path.draw, repeat=repeat)
+            fb.clear()
+            path.draw()
+            images[row_label] = image = fb.read()
+            row = dict(renderer=gl_renderer, scene=label, path=row_label, path_name=name, step=style.step,
+                       width=size[0], height=size[1], triangles=path.triangles, vertices=path.vertices,
+                       bytes_uploaded=path.bytes_uploaded, bytes_per_step=path.bytes_per_step,
+                       **timing.as_row(), mtri_per_s=path.triangles / timing.wall_ms / 1e3)
+            if mesh.n_steps > 1:
+                steps = iter(np.resize(np.arange(mesh.n_steps), 64))
+                row["set_step_ms"] = time_call(lambda: path.set_step(int(next(steps))), repeat=repeat).wall_ms
+            if reference is not None:
+                diff = compare_images(image, images[reference])
+                row.update(reference=reference, max_err_255=diff.max_abs, share_differing=diff.share_differing,
+                           psnr_db=diff.psnr, ssim=diff.ssim)
+            rows.append(row)
+            path.release()
+            say(f"  {row_label}: gpu {timing.gpu_ms:.2f} ms, wall {timing.wall_ms:.2f} ms")
+
+        split = mesh.gouraud(Style().crease_deg)
+        coords = mesh.coordinates(step)
+        ref = PyrenderReference(coords[split.vertex_node], split.triangles, split.normals(coords),
+                                camera=camera, size=size, base_color=Style().base_color)
+        ref_image = ref.render()
+        ref_timing = ref.time(warmup=2, repeat=repeat)
+        ref.release()
+        diff = compare_images(ref_image, images["gouraud"])
+        rows.append(dict(renderer=gl_renderer, scene=label, path="pyrender (EGL)", path_name="pyrender",
+                         width=size[0], height=size[1], triangles=len(split.triangles),
+                         vertices=split.n_vertices, **ref_timing.as_row(),
+                         mtri_per_s=len(split.triangles) / ref_timing.wall_ms / 1e3,
+                         reference="gouraud", max_err_255=diff.max_abs, share_differing=diff.share_differing,
+                         psnr_db=diff.psnr, ssim=diff.ssim))
+        say(f"  pyrender: wall {ref_timing.wall_ms:.2f} ms, SSIM vs gouraud {diff.ssim:.3f}")
+
+        by_path = {r["path"]: r for r in rows if r["scene"] == label}
+        contour = by_path["pixel bands"]
+        ours_with_readback = contour["wall_ms"] + contour["readback_ms"]
+        targets.append(dict(
+            renderer=gl_renderer, scene=label, size=f"{size[0]}x{size[1]}", triangles=contour["triangles"],
+            gouraud_pixel_contour_wall_ms=contour["wall_ms"],
+            position_only_wall_ms=by_path["position"]["wall_ms"],
+            ratio_to_position_only=contour["wall_ms"] / by_path["position"]["wall_ms"],
+            ours_incl_readback_ms=ours_with_readback, pyrender_incl_readback_ms=ref_timing.wall_ms,
+            ratio_to_pyrender=ours_with_readback / ref_timing.wall_ms,
+            bytes_per_step=contour["bytes_per_step"], bytes_topology=contour["bytes_uploaded"],
+        ))
+
+        stem = label.split()[0]
+        save_field_figure(out_dir / f"{stem}_bands_wire.png", images["pixel bands + wire"],
+                          value_range=value_range, colormap=Style().colormap, label=field, units=units,
+                          title=f"{label}: per-pixel bands + element wire frame", bands=BANDS)
+        save_image_grid(out_dir / f"{stem}_vertex_vs_pixel.png",
+                        [images["vertex smooth"], images["pixel smooth"],
+                         _difference(images["vertex smooth"], images["pixel smooth"])],
+                        ["colour per vertex", "colour per pixel (reference)", "|difference| x8"])
+        save_image_grid(out_dir / f"{stem}_pyrender.png", [images["gouraud"], ref_image],
+                        ["workbench gouraud", f"pyrender (SSIM {diff.ssim:.3f})"])
+        fb.release()
+    write_table(targets, out_dir, name="targets", title="Targets: contour path against pyrender and a bare draw")
+    return rows
+
+
+def _difference(a: np.ndarray, b: np.ndarray, gain: int = 8) -> np.ndarray:
+    diff = np.abs(a[..., :3].astype(np.int16) - b[..., :3].astype(np.int16)).max(axis=2)
+    grey = 255 - np.clip(diff * gain, 0, 255).astype(np.uint8)
+    return np.dstack([grey, grey, grey, np.full_like(grey, 255)])
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--figures", default="figures")
+    args = parser.parse_args()
+    rows, out = run_experiment("render_paths", figures_root=Path(args.figures), quick=args.quick, progress=print)
+    print(f"{len(rows)} rows -> {out}")
