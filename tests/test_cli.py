@@ -82,6 +82,12 @@ def test_list_names_the_render_paths_experiment(capsys):
     assert "render_paths" in capsys.readouterr().out
 
 
+def test_run_refuses_an_unknown_experiment_naming_the_known_ones(capsys):
+    assert main(["run", "no_such_experiment", "--quick"]) == 2
+    err = capsys.readouterr().err
+    assert "no_such_experiment" in err and "render_paths" in err
+
+
 def test_info_names_the_renderer(capsys):
     assert main(["info"]) == 0
     out = capsys.readouterr().out

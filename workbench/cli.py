@@ -106,8 +106,9 @@ def cmd_list(args) -> int:
 
 
 def cmd_run(args) -> int:
-    from .experiment.registry import run_experiment
+    from .experiment.registry import discover, run_experiment
 
+    discover()
     rows, out_dir = run_experiment(args.experiment, figures_root=Path(args.figures), quick=args.quick,
                                    progress=lambda msg: print(f"  {msg}", flush=True))
     print(f"{args.experiment}: {len(rows)} rows -> {out_dir}")
