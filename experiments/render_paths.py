@@ -48,26 +48,29 @@ def scenes(quick: bool):
 
 
 def path_configs(step: int, field: str, element_field: str | None, value_range, clip_plane):
-    """(row label, path name, style, reference label or None) — references come first."""
+    """(row label, path name, style, MSAA samples, reference label or None); references come first."""
     plain = Style(step=step)
     smooth = replace(plain, field=field, value_range=value_range)
     banded = replace(smooth, bands=BANDS)
     lo, hi = value_range
-    yield "position", "position", plain, None
-    yield "flat", "flat", plain, None
-    yield "gouraud", "gouraud", plain, None
-    yield "gouraud + wire", "gouraud", replace(plain, wireframe=True), None
-    yield "pixel smooth", "pixel_color", smooth, None
-    yield "vertex smooth", "vertex_color", smooth, "pixel smooth"
-    yield "pixel bands", "pixel_color", banded, None
-    yield "vertex bands", "vertex_color", banded, "pixel bands"
-    yield "pixel bands + wire", "pixel_color", replace(banded, wireframe=True), None
-    yield "pixel transfer (hide low 30 %)", "pixel_color", replace(smooth, hide_range=(lo, lo + 0.3 * (hi - lo))), None
-    yield "pixel bands + clip", "pixel_color", replace(banded, clip_planes=(clip_plane,)), None
+    yield "position", "position", plain, 0, None
+    yield "flat", "flat", plain, 0, None
+    yield "gouraud", "gouraud", plain, 0, None
+    yield "gouraud + wire", "gouraud", replace(plain, wireframe=True), 0, None
+    yield "pixel smooth", "pixel_color", smooth, 0, None
+    yield "vertex smooth", "vertex_color", smooth, 0, "pixel smooth"
+    yield "pixel bands", "pixel_color", banded, 0, None
+    yield "vertex bands", "vertex_color", banded, 0, "pixel bands"
+    yield "pixel bands + wire", "pixel_color", replace(banded, wireframe=True), 0, None
+    yield "pixel transfer (hide low 30 %)", "pixel_color", replace(smooth, hide_range=(lo, lo + 0.3 * (hi - lo))), 0, None
+    yield "pixel bands + clip", "pixel_color", replace(banded, clip_planes=(clip_plane,)), 0, None
     if element_field is not None:
-        yield "element flat", "element_color", replace(plain, field=element_field), None
+        yield "element flat", "element_color", replace(plain, field=element_field), 0, None
     if step > 0:
-        yield "pixel bands, deformation x3", "pixel_color", replace(banded, magnification=3.0), None
+        yield "pixel bands, deformation x3", "pixel_color", replace(banded, magnification=3.0), 0, None
+    # pyrender always draws with 4x multisampling: these rows are its like-for-like peers
+    yield "gouraud, 4x MSAA", "gouraud", plain, 4, None
+    yield "pixel bands, 4x MSAA", "pixel_color", banded, 4, None
 
 
 @experiment("render_paths", "first render paths on the car and the es2008 semicylinders: time against "
@@ -83,12 +86,13 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
         say(f"{label}: {mesh.n_elements} elements, {size[0]}x{size[1]}")
         center, radius = mesh.bounding_sphere(all_steps=True)
         camera = Camera.fit(center, radius, aspect=size[0] / size[1], **view)
-        fb = Framebuffer(ctx, size)
+        framebuffers = {samples: Framebuffer(ctx, size, samples=samples) for samples in (0, 4)}
         value_range = mesh.field_range(field)
         clip_plane = (*(-camera.view_matrix()[0, :3]), float(camera.view_matrix()[0, :3] @ center))
         images: dict[str, np.ndarray] = {}
-        for row_label, name, style, reference in path_configs(step, field, element_field, value_range,
-                                                              clip_plane):
+        for row_label, name, style, samples, reference in path_configs(step, field, element_field,
+                                                                       value_range, clip_plane):
+            fb = framebuffers[samples]
             path = make_path(name, style)
             path.prepare(ctx, mesh, camera)
             timing = time_draw(ctx, fb, path.draw, repeat=repeat)
@@ -96,7 +100,7 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
             path.draw()
             images[row_label] = image = fb.read()
             row = dict(renderer=gl_renderer, scene=label, path=row_label, path_name=name, step=style.step,
-                       width=size[0], height=size[1], triangles=path.triangles, vertices=path.vertices,
+                       width=size[0], height=size[1], msaa=samples, triangles=path.triangles, vertices=path.vertices,
                        bytes_uploaded=path.bytes_uploaded, bytes_per_step=path.bytes_per_step,
                        **timing.as_row(), mtri_per_s=path.triangles / timing.wall_ms / 1e3)
             if mesh.n_steps > 1:
@@ -117,26 +121,26 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
         ref_image = ref.render()
         ref_timing = ref.time(warmup=2, repeat=repeat)
         ref.release()
-        diff = compare_images(ref_image, images["gouraud"])
+        diff = compare_images(ref_image, images["gouraud, 4x MSAA"])
         rows.append(dict(renderer=gl_renderer, scene=label, path="pyrender (EGL)", path_name="pyrender",
-                         width=size[0], height=size[1], triangles=len(split.triangles),
+                         width=size[0], height=size[1], msaa=4, triangles=len(split.triangles),
                          vertices=split.n_vertices, **ref_timing.as_row(),
                          mtri_per_s=len(split.triangles) / ref_timing.wall_ms / 1e3,
-                         reference="gouraud", max_err_255=diff.max_abs, share_differing=diff.share_differing,
+                         reference="gouraud, 4x MSAA", max_err_255=diff.max_abs, share_differing=diff.share_differing,
                          psnr_db=diff.psnr, ssim=diff.ssim))
-        say(f"  pyrender: wall {ref_timing.wall_ms:.2f} ms, SSIM vs gouraud {diff.ssim:.3f}")
+        say(f"  pyrender: wall {ref_timing.wall_ms:.2f} ms, SSIM vs gouraud 4x MSAA {diff.ssim:.3f}")
 
         by_path = {r["path"]: r for r in rows if r["scene"] == label}
-        contour = by_path["pixel bands"]
-        ours_with_readback = contour["wall_ms"] + contour["readback_ms"]
+        contour, contour_msaa = by_path["pixel bands"], by_path["pixel bands, 4x MSAA"]
         targets.append(dict(
             renderer=gl_renderer, scene=label, size=f"{size[0]}x{size[1]}", triangles=contour["triangles"],
-            gouraud_pixel_contour_wall_ms=contour["wall_ms"],
-            position_only_wall_ms=by_path["position"]["wall_ms"],
-            ratio_to_position_only=contour["wall_ms"] / by_path["position"]["wall_ms"],
-            ours_incl_readback_ms=ours_with_readback, pyrender_incl_readback_ms=ref_timing.wall_ms,
-            ratio_to_pyrender=ours_with_readback / ref_timing.wall_ms,
-            bytes_per_step=contour["bytes_per_step"], bytes_topology=contour["bytes_uploaded"],
+            contour_wall_ms=contour["wall_ms"], position_only_wall_ms=by_path["position"]["wall_ms"],
+            contour_over_position_only=contour["wall_ms"] / by_path["position"]["wall_ms"],
+            contour_msaa_incl_readback_ms=contour_msaa["wall_ms"] + contour_msaa["readback_ms"],
+            pyrender_incl_readback_ms=ref_timing.wall_ms,
+            contour_msaa_over_pyrender=(contour_msaa["wall_ms"] + contour_msaa["readback_ms"]) / ref_timing.wall_ms,
+            pyrender_ssim=diff.ssim,
+            bytes_per_step=contour["bytes_per_step"], bytes_at_prepare=contour["bytes_uploaded"],
         ))
 
         stem = label.split()[0]
@@ -147,9 +151,10 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
                         [images["vertex smooth"], images["pixel smooth"],
                          _difference(images["vertex smooth"], images["pixel smooth"])],
                         ["colour per vertex", "colour per pixel (reference)", "|difference| x8"])
-        save_image_grid(out_dir / f"{stem}_pyrender.png", [images["gouraud"], ref_image],
-                        ["workbench gouraud", f"pyrender (SSIM {diff.ssim:.3f})"])
-        fb.release()
+        save_image_grid(out_dir / f"{stem}_pyrender.png", [images["gouraud, 4x MSAA"], ref_image],
+                        ["workbench gouraud, 4x MSAA", f"pyrender (SSIM {diff.ssim:.3f})"])
+        for fb in framebuffers.values():
+            fb.release()
     write_table(targets, out_dir, name="targets", title="Targets: contour path against pyrender and a bare draw")
     return rows
 
