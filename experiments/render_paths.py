@@ -140,6 +140,7 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
             pyrender_incl_readback_ms=ref_timing.wall_ms,
             contour_msaa_over_pyrender=(contour_msaa["wall_ms"] + contour_msaa["readback_ms"]) / ref_timing.wall_ms,
             pyrender_ssim=diff.ssim,
+            nodes=len(mesh.used_nodes()), crease_vertices_added=split.added,
             bytes_per_step=contour["bytes_per_step"], bytes_at_prepare=contour["bytes_uploaded"],
         ))
 

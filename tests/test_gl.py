@@ -116,3 +116,18 @@ def test_msaa_resolves_and_timer_reports(ctx):
     with GpuTimer(ctx) as timer:
         draw_quad(ctx, cam, corners)
     assert timer.elapsed_ms >= 0.0
+
+
+def test_every_shader_ships_with_the_package():
+    from importlib import resources
+    from pathlib import Path
+
+    from workbench.gl.shaders import shader_source
+
+    shipped = {p.name for p in resources.files("workbench.glsl").iterdir() if p.name.endswith(".glsl")}
+    checkout = Path(__file__).resolve().parents[1] / "glsl"
+    if checkout.is_dir():
+        assert shipped == {p.name for p in checkout.glob("*.glsl")}
+    assert shipped
+    for name in shipped:
+        assert shader_source(name).strip()
