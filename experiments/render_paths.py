@@ -27,6 +27,7 @@ from workbench.experiment.tables import write_table
 from workbench.experiment.timing import time_call, time_draw
 from workbench.gl import Camera, Framebuffer, create_context, renderer
 from workbench.paths import Style, make_path
+from workbench.paths.colormap import scale_for
 from workbench.scene import generators
 from workbench.scene.builtin import builtin_scene
 
@@ -87,7 +88,7 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
         center, radius = mesh.bounding_sphere(all_steps=True)
         camera = Camera.fit(center, radius, aspect=size[0] / size[1], **view)
         framebuffers = {samples: Framebuffer(ctx, size, samples=samples) for samples in (0, 4)}
-        value_range = mesh.field_range(field)
+        value_range = scale_for(mesh, field).value_range
         clip_plane = (*(-camera.view_matrix()[0, :3]), float(camera.view_matrix()[0, :3] @ center))
         images: dict[str, np.ndarray] = {}
         for row_label, name, style, samples, reference in path_configs(step, field, element_field,

@@ -8,7 +8,7 @@ import pytest
 from PIL import Image
 
 from workbench.cli import main
-from workbench.data import CAR_DECK, shared_file
+from workbench.data import CAR_DECK, D3PLOT, shared_file
 
 DECK = """*KEYWORD
 *NODE
@@ -50,6 +50,15 @@ def test_render_car_with_field_writes_a_colour_bar_figure(tmp_path):
     image = np.asarray(Image.open(out).convert("RGB"))
     # the figure is wider than the render: a colour bar sits beside it
     assert image.shape[1] > 320
+
+
+def test_render_constant_field_of_the_d3plot(tmp_path):
+    # the sample result has one state with zero stress everywhere: a constant field still gets a scale
+    if shared_file(D3PLOT) is None:
+        pytest.skip("shared d3plot not found (set WORKBENCH_DATA)")
+    out = tmp_path / "d3plot.png"
+    assert main(["render", "d3plot", "--field", "von_mises", "--size", "200x150", "-o", str(out)]) == 0
+    assert out.stat().st_size > 1000
 
 
 @pytest.mark.parametrize("text, expected", [

@@ -88,7 +88,7 @@ def cmd_render(args) -> int:
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
     if args.field is not None and not args.raw:
-        save_field_figure(out, image, value_range=mesh.field_range(args.field), colormap=args.colormap,
+        save_field_figure(out, image, value_range=path.scale.value_range, colormap=args.colormap,
                           label=args.field, units=args.units, title=f"{mesh.name} ({path_name})",
                           bands=args.bands)
     else:
