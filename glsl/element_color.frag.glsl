@@ -8,7 +8,7 @@ out vec4 frag_color;
 
 void main() {
     float light = headlight(cross(dFdx(eye_position), dFdy(eye_position)), eye_position);
-    vec4 c = colormap_lookup(coord);
+    vec4 c = colormap_color(coord);
 #ifdef HIDE
     if (c.a < 0.5) discard;
 #endif

@@ -5,7 +5,7 @@ in float coord;
 out vec4 frag_color;
 
 void main() {
-    vec4 c = colormap_lookup(coord);
+    vec4 c = colormap_color(coord);
 #ifdef HIDE
     if (c.a < 0.5) discard;
 #endif

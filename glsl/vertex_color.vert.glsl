@@ -9,6 +9,6 @@ out vec4 color;
 
 void main() {
     vec3 p = place(position);
-    vec4 c = colormap_lookup(colormap_coord(value));
+    vec4 c = colormap_color(colormap_coord(value));
     color = vec4(c.rgb * headlight(mat3(view) * normal, p), c.a);
 }

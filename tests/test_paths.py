@@ -508,11 +508,37 @@ def test_time_dependent_node_field_goes_up_with_the_step(ctx):
     path.prepare(ctx, mesh, camera())
     assert path.set_step(1) == path.bytes_per_step == path.vertices * (12 + 12 + 4)
     path.release()
-    mesh.node_fields["xt"][1, 0] = np.nan
-    path = make_path("pixel_color", Style(field="xt", step=1))
-    with pytest.raises(ValueError, match="non-finite"):
-        path.prepare(ctx, mesh, camera())
-    assert path.ctx is None  # nothing left half-built
+
+
+def test_missing_element_values_are_drawn_in_the_base_colour(ctx):
+    # 2 × 2 elements, element 3 without a value (a rigid shell's stress): its block is the
+    # uncoloured base colour, the others keep their colormap colours
+    mesh = grid(2, 2)
+    mesh.element_fields["cell"][3] = np.nan
+    base = (0.5, 0.5, 0.5)
+    for hide in (None, (-10.0, 10.0)):
+        image, path = render(ctx, "element_color", mesh, camera(), field="cell", base_color=base,
+                             hide_range=hide)
+        assert path.missing_values == 1
+        missing = image[16:32, 32:48, :3].reshape(-1, 3)  # element 3: top right (rows go up in y)
+        assert np.abs(missing.astype(int) - 128).max() <= 1  # lit face-on: factor 1
+        if hide is None:
+            scale = scale_for(mesh, "cell")
+            block = image[16:32, 16:32, :3].reshape(-1, 3)
+            assert np.abs(block - scale.evaluate(2.0)[:3] * 255).max() <= 1.0
+        else:  # everything with a value is hidden, the missing element is not
+            assert covered(image).sum() == 16 * 16
+
+
+def test_missing_node_value_greys_its_triangles(ctx):
+    mesh = grid(2, 2)
+    mesh.node_fields["x"] = mesh.node_fields["x"].copy()
+    mesh.node_fields["x"][8] = np.nan  # the top right corner node
+    image, path = render(ctx, "pixel_color", mesh, camera(), field="x", base_color=(0.5, 0.5, 0.5))
+    assert path.missing_values == 1
+    grey = (np.abs(image[..., :3].astype(int) - 128) <= 1).all(axis=-1)
+    # the top right element's triangles touching node 8 are grey, the far corner element is not
+    assert grey[17:22, 42:47].all() and not grey[40:47, 17:30].any()
 
 
 def test_unreferenced_nodes_are_not_uploaded(ctx):

@@ -18,7 +18,11 @@ Conventions every path follows (a reference renderer can match them exactly):
   crease-split vertex normal and interpolate the resulting factor (or lit colour) across the
   triangle. A zero normal gets the ambient 0.25 only.
 * **Colour scales**: see :mod:`workbench.paths.colormap` (1-D texture, smooth or bands,
-  transfer-function α with an alpha test that discards fragments with α < ½).
+  transfer-function α with an alpha test that discards fragments with α < ½). A field value
+  that is not finite (the stress of a rigid shell in a d3plot, a thickness nobody gave) is
+  drawn in ``Style.base_color``, never hidden and never given a colour of the scale; per node,
+  every fragment interpolated from such a vertex takes that colour. ``missing_values`` counts
+  them for the step drawn.
 * **Clip planes**: up to four world-space float64 planes ``(a, b, c, d)``; points with
   ``a·x + b·y + c·z + d ≥ 0`` are kept. The plane is moved to the upload origin in float64
   (``d' = d + (a, b, c)·origin``) and applied with ``gl_ClipDistance``.
@@ -38,7 +42,7 @@ import moderngl
 import numpy as np
 
 from ..gl import load_program
-from .colormap import ColorScale, scale_for
+from .colormap import NO_VALUE, ColorScale, scale_for
 
 NEEDS = frozenset({"triangles", "face_normals", "gouraud", "edges", "node_field", "element_field"})
 MAX_CLIP_PLANES = 4
@@ -125,6 +129,7 @@ class RenderPath(ABC):
             self.needs = type(self).needs | {"edges"}
         self.triangles = self.vertices = self.edges = 0
         self.bytes_uploaded = self.bytes_per_step = 0
+        self.missing_values = 0
 
     @abstractmethod
     def prepare(self, ctx: moderngl.Context, mesh, camera) -> None:
@@ -268,6 +273,7 @@ class MeshPath(RenderPath):
             self._colormap.filter = (filt, filt)
             self._colormap.repeat_x = self._colormap.repeat_y = False
             self._program["colormap"].value = 0
+            self._program["missing_color"].value = style.base_color
             self._program["colormap_st"].value = self.scale.coord_transform
             uploaded += texels.nbytes
         self._vao = self._keep(ctx.vertex_array(self._program, content, self._index,
@@ -393,14 +399,15 @@ class MeshPath(RenderPath):
         return sent
 
     def _upload_values(self, step: int) -> int:
-        """Upload the normalised field values of ``step``; refuses non-finite values."""
+        """Upload the normalised field values of ``step``; non-finite ones as ``NO_VALUE``."""
         values = self.mesh.node_field(self.style.field, step) if self.field_per == "node" \
             else self.mesh.element_field(self.style.field, step)
-        bad = ~np.isfinite(values)
-        if bad.any():
-            raise ValueError(f"field {self.style.field!r} has {int(bad.sum())} non-finite values at "
-                             f"step {step} (first at index {int(np.flatnonzero(bad)[0])})")
-        data = self.vertex_values(self.scale.normalise(values)).astype(np.float32)
+        t = self.scale.normalise(values)
+        missing = ~np.isfinite(t)
+        self.missing_values = int(missing.sum())
+        if self.missing_values:
+            t[missing] = NO_VALUE
+        data = self.vertex_values(t).astype(np.float32)
         self._values.write(data)
         return data.nbytes
 

@@ -68,6 +68,9 @@ def _lerp_table(table: np.ndarray, t: np.ndarray) -> np.ndarray:
     return lo + w * (hi - lo)
 
 
+NO_VALUE = -1.0e30  # uploaded for a non-finite field value; shaders draw it in the missing colour
+
+
 @dataclass(frozen=True)
 class ColorScale:
     """A value range mapped through a colormap, smooth or in bands, with an optional hidden range.
