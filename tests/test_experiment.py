@@ -500,3 +500,18 @@ def test_pyrender_reference_refuses_bad_input():
     with pytest.raises(ValueError, match="not both"):
         PyrenderReference(corners, [[0, 1, 2]], normals, camera, (8, 8), colors=BASE,
                           base_color=BASE)
+
+
+def test_tables_are_written_with_ordinary_permissions(tmp_path):
+    import os
+    import stat
+
+    from workbench.experiment.tables import write_table
+
+    mask = os.umask(0o022)
+    try:
+        csv_path, md_path = write_table([{"a": 1}], tmp_path)
+    finally:
+        os.umask(mask)
+    for path in (csv_path, md_path):
+        assert stat.S_IMODE(path.stat().st_mode) == 0o644

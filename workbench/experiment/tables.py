@@ -21,6 +21,12 @@ import numpy as np
 SIGNIFICANT_DIGITS = 4
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 @contextmanager
 def atomic_open(path, mode: str = "w", **kwargs) -> Iterator:
     """Open a temporary file beside ``path`` for writing; move it onto ``path`` on success.
@@ -32,6 +38,7 @@ def atomic_open(path, mode: str = "w", **kwargs) -> Iterator:
         raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; a table is as readable as any file
     try:
         with os.fdopen(fd, mode, **kwargs) as handle:
             yield handle
