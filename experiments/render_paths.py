@@ -85,8 +85,9 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
     targets: list[dict] = []
     for label, mesh, step, field, element_field, units, view, size in scenes(quick):
         say(f"{label}: {mesh.n_elements} elements, {size[0]}x{size[1]}")
-        center, radius = mesh.bounding_sphere(all_steps=True)
-        camera = Camera.fit(center, radius, aspect=size[0] / size[1], **view)
+        lo, hi = mesh.bounds(all_steps=True)
+        center = (lo + hi) / 2.0
+        camera = Camera.fit_box(lo, hi, aspect=size[0] / size[1], **view)
         framebuffers = {samples: Framebuffer(ctx, size, samples=samples) for samples in (0, 4)}
         value_range = scale_for(mesh, field).value_range
         clip_plane = (*(-camera.view_matrix()[0, :3]), float(camera.view_matrix()[0, :3] @ center))

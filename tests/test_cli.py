@@ -36,9 +36,11 @@ def test_render_writes_the_image_of_a_plate(deck, tmp_path):
     image = np.asarray(Image.open(out))
     assert image.shape[:2] == (60, 80)
     drawn = (image[..., :3] != 255).any(axis=2)
-    # a 100 x 100 plate fits a view of diameter 141 x 1.05: about 67 % of the 60 rows
-    rows = np.flatnonzero(drawn.any(axis=1))
-    assert 0.55 < len(rows) / 60 < 0.75 and drawn.sum() > 0
+    # the 100 x 100 plate is framed to 105 units of height (margin 1.05): 57 of the 60 rows,
+    # and 57 of the 80 columns (the view is 140 units wide)
+    rows, cols = np.flatnonzero(drawn.any(axis=1)), np.flatnonzero(drawn.any(axis=0))
+    assert abs(len(rows) - 57) <= 1 and abs(len(cols) - 57) <= 1
+    assert drawn.sum() == len(rows) * len(cols)
 
 
 def test_render_car_with_field_writes_a_colour_bar_figure(tmp_path):

@@ -99,6 +99,21 @@ def test_z_up_frame():
     assert np.allclose(Camera.fit([0, 0, 0], 1, up="z", elevation=90, margin=1).eye / 2, [0, 0, 1])
 
 
+def test_fit_box_frames_a_long_box_tightly():
+    lo, hi = np.array([0.0, 0.0, 0.0]), np.array([4000.0, 1000.0, 1500.0])
+    size = (400, 200)
+    cam = Camera.fit_box(lo, hi, azimuth=-30, elevation=20, up="z", aspect=2.0, margin=1.0)
+    corners = np.array([[x, y, z] for x in (0, 4000) for y in (0, 1000) for z in (0, 1500)])
+    px = cam.project(corners, size)
+    # every corner inside the image, and the outline touches its left/right or top/bottom edges
+    assert (px[:, 0] >= -1e-6).all() and (px[:, 0] <= 400 + 1e-6).all()
+    assert (px[:, 1] >= -1e-6).all() and (px[:, 1] <= 200 + 1e-6).all()
+    assert np.isclose(px[:, 0].min(), 0) or np.isclose(px[:, 1].min(), 0)
+    sphere = Camera.fit((lo + hi) / 2, np.linalg.norm(hi - lo) / 2, azimuth=-30, elevation=20,
+                        up="z", aspect=2.0, margin=1.0)
+    assert cam.half_height < sphere.half_height and (cam.near, cam.far) == (sphere.near, sphere.far)
+
+
 def test_far_origin_keeps_subpixel_precision(ctx):
     # with world-space float32 upload, 1e7 offsets lose ~1 unit; relative upload keeps the edge exact
     o = np.array([1e7, 1e7, 0.0])

@@ -74,8 +74,7 @@ def cmd_render(args) -> int:
                   wireframe=args.wireframe, crease_deg=args.crease)
     ctx = create_context()
     width, height = args.size
-    center, radius = mesh.bounding_sphere(all_steps=True)
-    camera = Camera.fit(center, radius, azimuth=args.view[0], elevation=args.view[1],
+    camera = Camera.fit_box(*mesh.bounds(all_steps=True), azimuth=args.view[0], elevation=args.view[1],
                         projection=args.projection, aspect=width / height, up=args.up)
     fb = Framebuffer(ctx, (width, height), samples=args.samples)
     path = make_path(path_name, style)

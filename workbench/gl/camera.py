@@ -89,6 +89,28 @@ class Camera:
                    up=up, projection=projection, half_height=half_height, fov_deg=fov_deg,
                    aspect=aspect, near=near, far=distance + r)
 
+    @classmethod
+    def fit_box(cls, lo, hi, **kwargs) -> "Camera":
+        """A camera fitted to the axis-aligned box ``lo``–``hi`` (float64 corners).
+
+        Like :meth:`fit` on the box's bounding sphere (same keywords, same near/far), but an
+        orthographic view is then narrowed to the box's projected outline (times ``margin``),
+        so long, flat models such as car bodies fill the image.
+        """
+        lo, hi = np.asarray(lo, np.float64), np.asarray(hi, np.float64)
+        center, radius = (lo + hi) / 2.0, float(np.linalg.norm(hi - lo) / 2.0)
+        camera = cls.fit(center, radius, **kwargs)
+        if camera.projection == "orthographic":
+            corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                                for z in (lo[2], hi[2])]) - camera.origin
+            eye = corners @ camera.view_matrix()[:3, :3].T + camera.view_matrix()[:3, 3]
+            target = camera.view_matrix()[:3, :3] @ camera.target + camera.view_matrix()[:3, 3]
+            half_x = np.abs(eye[:, 0] - target[0]).max()
+            half_y = np.abs(eye[:, 1] - target[1]).max()
+            margin = kwargs.get("margin", 1.05)
+            camera.half_height = max(half_y, half_x / camera.aspect, 1e-12 * radius) * margin
+        return camera
+
     def view_matrix(self) -> np.ndarray:
         """(4, 4) float64: coordinates relative to ``origin`` → eye space."""
         return _look_at(np.asarray(self.eye, np.float64), np.asarray(self.target, np.float64),
