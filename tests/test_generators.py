@@ -428,3 +428,18 @@ def test_crash_sequence_axis_and_refusals():
         crash_sequence(m, axis="w")
     with pytest.raises(ValueError):
         crash_sequence(m, steps=1)
+
+
+def test_crash_sequence_keeps_still_parts_in_place():
+    # two sheets; with sheet 0 held still only sheet 1 is crushed, measured from its own front
+    m = semicylinders(sheets=2, n=8)
+    c = crash_sequence(m, steps=3, crush=0.2, axis="-z", still_parts=(0,))
+    d = c.node_fields["displacement"]
+    still = np.unique(m.elements[m.parts == 0])
+    assert np.all(d[:, still] == 0)
+    moving = np.unique(m.elements[m.parts == 1])
+    z = m.nodes[moving, 2]
+    front = moving[np.argmin(z)]
+    assert np.isclose(c.steps[-1, front, 2] - m.nodes[front, 2], 0.2 * np.ptp(z))
+    with pytest.raises(MeshError):
+        crash_sequence(m, still_parts=(0, 1))

@@ -790,7 +790,8 @@ def _node_normals(elements: np.ndarray, nodes: np.ndarray) -> np.ndarray:
 
 
 def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str = "-x", *,
-                   fold_wavelength: float | None = None, duration: float = 0.1) -> FEMesh:
+                   fold_wavelength: float | None = None, duration: float = 0.1,
+                   still_parts=()) -> FEMesh:
     """A copy of ``mesh`` with ``steps`` time steps of a smooth, progressive front crush.
 
     The impactor comes from the ``axis`` side (one of "x", "y", "z", "-x", "-y", "-z": "x" makes
@@ -812,8 +813,10 @@ def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str
     from step 0 in model units, and element field ``"plastic_strain"`` (T, M): a proxy from the
     element edges' stretch and the rotation of the element normal since step 0, beyond a 0.2 %
     yield, accumulated (it never decreases). Step 0 equals the input geometry; topology, parts and
-    static fields are kept. Refused: meshes that already have time steps, steps < 2, crush not
-    in (0, 1), an unknown axis, a model with no extent along the axis.
+    static fields are kept. ``still_parts``: part ids that do not move (a rigid barrier or pole);
+    the front and extent are those of the other parts, and a node moves unless only still parts
+    use it. Refused: meshes that already have time steps, steps < 2, crush not in (0, 1), an
+    unknown axis, a model with no extent along the axis, only still parts.
     """
     if mesh.steps is not None:
         raise MeshError(f"{mesh.name}: already has {mesh.n_steps} time steps; crash a static mesh")
@@ -831,7 +834,11 @@ def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str
     a[a_idx] = sign
 
     nodes = mesh.nodes
-    used = mesh.used_nodes()
+    moving = np.zeros(len(nodes), bool)
+    moving[mesh.elements[~np.isin(mesh.parts, np.asarray(still_parts, np.int64))].ravel()] = True
+    if not moving.any():
+        raise MeshError(f"{mesh.name}: every part is in still_parts {tuple(still_parts)}; nothing to crush")
+    used = np.flatnonzero(moving)
     along = nodes @ a
     front, back = along[used].max(), along[used].min()
     extent = front - back
@@ -855,7 +862,7 @@ def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str
     coords = np.empty((steps, len(nodes), 3))
     coords[0] = nodes
     for i in range(1, steps):
-        phi = 1.0 - _smoothstep(depth / (2.5 * c[i]))
+        phi = (1.0 - _smoothstep(depth / (2.5 * c[i]))) * moving
         amp = 0.25 * lam * np.tanh(c[i] / lam)
         coords[i] = nodes - np.outer(c[i] * phi, a) + (amp * wave * phi)[:, None] * lateral
     displacement = np.linalg.norm(coords - nodes[None], axis=2)
