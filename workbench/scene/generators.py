@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .derived import element_normals, node_normals
 from .mesh import FEMesh, MeshError
 
 __all__ = ["semicylinders", "stamped_panel", "stamped_panels", "refine", "crash_sequence"]
@@ -773,22 +774,6 @@ def refine(mesh: FEMesh, k: int) -> FEMesh:
 _AXES = {"x": 0, "y": 1, "z": 2}
 
 
-def _node_normals(elements: np.ndarray, nodes: np.ndarray) -> np.ndarray:
-    """(N, 3) area-weighted unit node normals (zero where no element has an area)."""
-    p = nodes[elements]
-    # quad: half the cross product of the diagonals; triangle (p3 == p2): the ordinary one
-    n = np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1])
-    tri = elements[:, 3] == elements[:, 2]
-    n[tri] = np.cross(p[tri, 1] - p[tri, 0], p[tri, 2] - p[tri, 0])
-    out = np.zeros_like(nodes)
-    for c in range(4):
-        w = np.ones(len(elements)) if c < 3 else (~tri).astype(np.float64)
-        for d in range(3):
-            out[:, d] += np.bincount(elements[:, c], weights=n[:, d] * w, minlength=len(nodes))
-    length = np.linalg.norm(out, axis=1, keepdims=True)
-    return np.divide(out, length, out=np.zeros_like(out), where=length > 0)
-
-
 def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str = "-x", *,
                    fold_wavelength: float | None = None, duration: float = 0.1,
                    still_parts=()) -> FEMesh:
@@ -851,7 +836,7 @@ def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str
     # where the normal is along the axis), so that lateral and axial motion are perpendicular
     fallback = np.zeros(3)
     fallback[(a_idx + 2) % 3] = 1.0
-    normal = _node_normals(mesh.elements, nodes)
+    normal = node_normals(mesh.elements, nodes)
     lateral = normal - np.outer(normal @ a, a) + 0.05 * fallback
     norm = np.linalg.norm(lateral, axis=1, keepdims=True)
     lateral = np.where(norm > 1e-9, lateral / np.maximum(norm, 1e-300), fallback)
@@ -877,7 +862,7 @@ def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str
         following[tri, 2] = corners[tri, 0]                   # triangle edges 0-1, 1-2, 2-0
         d = following - corners
         lengths = np.sqrt(np.einsum("mkc,mkc->mk", d, d))
-        return lengths, _element_normals(e, p, corners)
+        return lengths, element_normals(e, p)
 
     l0, n0 = edges_and_normals(nodes)
     strain = np.zeros((steps, len(e)))
@@ -908,13 +893,3 @@ def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str
         name=f"{mesh.name}_crash",
         units=mesh.units,
     )
-
-
-def _element_normals(elements: np.ndarray, nodes: np.ndarray, p: np.ndarray | None = None) -> np.ndarray:
-    """(M, 3) unit element normals (zero for degenerate elements); ``p`` = nodes[elements] if at hand."""
-    p = nodes[elements] if p is None else p
-    n = np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1])
-    tri = elements[:, 3] == elements[:, 2]
-    n[tri] = np.cross(p[tri, 1] - p[tri, 0], p[tri, 2] - p[tri, 0])
-    length = np.linalg.norm(n, axis=1, keepdims=True)
-    return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
