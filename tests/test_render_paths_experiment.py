@@ -58,3 +58,16 @@ def test_tables_and_figures_are_written(result):
     assert len(read_table(out_dir / "targets.csv")) == 2
     for name in ("car_bands_wire.png", "car_vertex_vs_pixel.png", "semicylinders_bands_wire.png"):
         assert (out_dir / name).stat().st_size > 1000
+
+
+def test_without_the_shared_data_the_car_is_skipped_with_a_message(tmp_path, monkeypatch):
+    import workbench.experiments.render_paths as render_paths
+
+    discover()
+    monkeypatch.setattr(render_paths, "shared_file", lambda relative: None)
+    messages = []
+    rows, out_dir = run_experiment("render_paths", figures_root=tmp_path, quick=True,
+                                   progress=messages.append)
+    assert {r["scene"] for r in rows} == {"semicylinders n=64"}
+    assert any("car skipped" in m for m in messages)
+    assert len(read_table(out_dir / "targets.csv")) == 1
