@@ -146,3 +146,42 @@ def test_every_shader_ships_with_the_package():
     assert shipped
     for name in shipped:
         assert shader_source(name).strip()
+
+
+@pytest.mark.parametrize("samples", [0, 4])
+def test_float_depth_framebuffer_draws_like_the_fixed_point_one(ctx, samples):
+    cam = Camera.fit([0, 0, 0], 1.0, margin=1.0)
+    corners = np.array([[-0.5, -0.5, 0.2], [0.5, -0.5, -0.2], [0.5, 0.5, -0.2], [-0.5, 0.5, 0.2]])
+    images = {}
+    for bits in (24, 32):
+        fb = Framebuffer(ctx, (48, 48), samples=samples, depth_bits=bits)
+        assert fb.attachment_depth_bits() == bits
+        prog = ctx.program(vertex_shader=VERT, fragment_shader=FRAG)
+        prog["mvp"].write(cam.mvp_bytes())
+        vbo = ctx.buffer(cam.relative(corners)[[0, 1, 2, 0, 2, 3]].tobytes())
+        vao = ctx.vertex_array(prog, [(vbo, "3f", "position")])
+        fb.clear()
+        ctx.enable(ctx.DEPTH_TEST)
+        vao.render()
+        images[bits] = fb.read()
+        if not samples:
+            depth = fb.read_depth()
+            # the tilted quad's depth runs linearly across x; the far background stays 1
+            inside = red_mask(images[bits])
+            assert (depth[~inside] == 1.0).all() and np.ptp(depth[inside]) > 0.01
+        for obj in (vao, vbo, prog):
+            obj.release()
+        fb.release()
+    assert red_mask(images[24]).sum() == red_mask(images[32]).sum() == 24 * 24
+    with pytest.raises(ValueError):
+        Framebuffer(ctx, (8, 8), depth_bits=16)
+
+
+def test_releasing_a_bound_framebuffer_leaves_no_gl_error(ctx):
+    ctx.error  # reading the error flag clears it
+    for bits in (24, 32):
+        fb = Framebuffer(ctx, (16, 16), depth_bits=bits)
+        fb.clear()
+        fb.release()
+        Framebuffer(ctx, (16, 16)).release()
+        assert ctx.error == "GL_NO_ERROR"

@@ -24,12 +24,12 @@ from __future__ import annotations
 
 import ctypes
 import math
-import os
 import time
 from contextlib import contextmanager
 
 import numpy as np
 
+from ..gl.context import raw_gl
 from .timing import Timing, check_counts
 
 AMBIENT, DIFFUSE = 0.25, 0.75  # the workbench paths' lighting model
@@ -46,12 +46,9 @@ def _headlight_intensity() -> float:
 
 def _load():
     """Import pyrender and PyOpenGL on EGL (never another platform)."""
-    platform = os.environ.get("PYOPENGL_PLATFORM")
-    if platform not in (None, "egl"):
-        raise RuntimeError(f"PYOPENGL_PLATFORM is {platform!r}; the pyrender reference needs 'egl'")
-    os.environ["PYOPENGL_PLATFORM"] = "egl"
+    GL = raw_gl()
     import pyrender
-    from OpenGL import EGL, GL
+    from OpenGL import EGL
 
     return pyrender, EGL, GL
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import moderngl
 
 EGL_PACKAGES = "libegl1 libegl-mesa0 libgl1-mesa-dri"
@@ -34,3 +36,18 @@ def renderer(ctx: moderngl.Context) -> str:
 
 def gl_version(ctx: moderngl.Context) -> str:
     return str(ctx.info["GL_VERSION"])
+
+
+def raw_gl():
+    """PyOpenGL's ``GL`` module bound through EGL, for the few calls moderngl does not wrap.
+
+    Calls act on whatever context is current (a moderngl standalone context is current after
+    :func:`create_context`). Refuses a PYOPENGL_PLATFORM other than "egl".
+    """
+    platform = os.environ.get("PYOPENGL_PLATFORM")
+    if platform not in (None, "egl"):
+        raise GLUnavailable(f"PYOPENGL_PLATFORM is {platform!r}; the workbench needs 'egl'")
+    os.environ["PYOPENGL_PLATFORM"] = "egl"
+    from OpenGL import GL
+
+    return GL
