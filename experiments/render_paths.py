@@ -110,7 +110,7 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
             fb.clear()
             path.draw()
             images[row_label] = image = fb.read()
-            row = dict(renderer=gl_renderer, scene=label, path=row_label, path_name=name, step=style.step,
+            row = dict(renderer=gl_renderer, scene=label, path=row_label, path_name=name, parameters=style.summary(),
                        width=size[0], height=size[1], msaa=samples, triangles=path.triangles, vertices=path.vertices,
                        bytes_uploaded=path.bytes_uploaded, bytes_per_step=path.bytes_per_step,
                        **timing.as_row(), mtri_per_s=path.triangles / timing.wall_ms / 1e3)

@@ -587,3 +587,9 @@ def test_repeated_draws_are_byte_identical(ctx, name):
     assert covered(out[0]).any() and out[0].tobytes() == out[1].tobytes()
     path.release()
     fb.release()
+
+
+def test_style_summary_names_what_differs_from_the_defaults():
+    assert Style().summary() == ""
+    words = Style(field="x", bands=10, wireframe=True, value_range=(0.0, 2.5)).summary().split()
+    assert words == ["field=x", "value_range=(0, 2.5)", "bands=10", "wireframe=True"]

@@ -109,6 +109,22 @@ class Style:
             setattr(self, name, color)
 
 
+    def summary(self) -> str:
+        """The fields that differ from the defaults, as ``name=value`` words (for table rows)."""
+        default = Style()
+        words = []
+        for name in self.__dataclass_fields__:
+            value = getattr(self, name)
+            if value != getattr(default, name):
+                if isinstance(value, tuple):
+                    value = "(" + ", ".join(f"{v:.6g}" if isinstance(v, float) else str(v)
+                                            for v in value) + ")"
+                elif isinstance(value, float):
+                    value = f"{value:.6g}"
+                words.append(f"{name}={value}")
+        return " ".join(words)
+
+
 class RenderPath(ABC):
     """One way of drawing an FE mesh, built once (``prepare``) and drawn many times (``draw``).
 
