@@ -592,4 +592,4 @@ def test_repeated_draws_are_byte_identical(ctx, name):
 def test_style_summary_names_what_differs_from_the_defaults():
     assert Style().summary() == ""
     words = Style(field="x", bands=10, wireframe=True, value_range=(0.0, 2.5)).summary().split()
-    assert words == ["field=x", "value_range=(0, 2.5)", "bands=10", "wireframe=True"]
+    assert words == ["field=x", "value_range=(0,2.5)", "bands=10", "wireframe=True"]

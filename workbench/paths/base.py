@@ -117,7 +117,7 @@ class Style:
             value = getattr(self, name)
             if value != getattr(default, name):
                 if isinstance(value, tuple):
-                    value = "(" + ", ".join(f"{v:.6g}" if isinstance(v, float) else str(v)
+                    value = "(" + ",".join(f"{v:.6g}" if isinstance(v, float) else str(v)
                                             for v in value) + ")"
                 elif isinstance(value, float):
                     value = f"{value:.6g}"
