@@ -112,17 +112,15 @@ class Style:
     def summary(self) -> str:
         """The fields that differ from the defaults, as ``name=value`` words (for table rows)."""
         default = Style()
-        words = []
-        for name in self.__dataclass_fields__:
-            value = getattr(self, name)
-            if value != getattr(default, name):
-                if isinstance(value, tuple):
-                    value = "(" + ",".join(f"{v:.6g}" if isinstance(v, float) else str(v)
-                                            for v in value) + ")"
-                elif isinstance(value, float):
-                    value = f"{value:.6g}"
-                words.append(f"{name}={value}")
-        return " ".join(words)
+        return " ".join(f"{name}={_word(getattr(self, name))}" for name in self.__dataclass_fields__
+                        if getattr(self, name) != getattr(default, name))
+
+
+def _word(value) -> str:
+    """A value written without spaces: floats to 6 significant digits, tuples as (a,b,...)."""
+    if isinstance(value, tuple):
+        return "(" + ",".join(_word(v) for v in value) + ")"
+    return f"{value:.6g}" if isinstance(value, float) else str(value)
 
 
 class RenderPath(ABC):
