@@ -341,8 +341,8 @@ class MeshPath(RenderPath):
                              f"{article} {kind} field: draw it with {other}")
 
     def _field_values(self) -> np.ndarray:
-        fields = self.mesh.node_fields if self.field_per == "node" else self.mesh.element_fields
-        return fields[self.style.field]
+        by_name = self.mesh.node_fields if self.field_per == "node" else self.mesh.element_fields
+        return by_name[self.style.field]
 
     def _vertex_of_node(self) -> np.ndarray:
         """(N,) one vertex index per referenced node (the first split vertex of each)."""
