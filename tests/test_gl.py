@@ -21,9 +21,13 @@ def ctx():
     return create_context()
 
 
-def draw_quad(ctx, camera, corners, size=(64, 48), samples=0):
-    """Draw the float64 quad ``corners`` (4, 3) in red on white; return the image and samples passed."""
-    fb = Framebuffer(ctx, size, samples=samples)
+def draw_quad(ctx, camera, corners, size=(64, 48), samples=0, depth_bits=24, depth=None):
+    """Draw the float64 quad ``corners`` (4, 3) in red on white; return the image and samples passed.
+
+    ``depth``, a list, receives the depth image (single-sampled targets only).
+    """
+    fb = Framebuffer(ctx, size, samples=samples, depth_bits=depth_bits)
+    assert fb.attachment_depth_bits() == depth_bits
     prog = ctx.program(vertex_shader=VERT, fragment_shader=FRAG)
     prog["mvp"].write(camera.mvp_bytes())
     vbo = ctx.buffer(camera.relative(corners)[[0, 1, 2, 0, 2, 3]].tobytes())
@@ -33,6 +37,8 @@ def draw_quad(ctx, camera, corners, size=(64, 48), samples=0):
     with SamplesPassed(ctx) as occlusion:
         vao.render()
     image = fb.read()
+    if depth is not None:
+        depth.append(fb.read_depth())
     for obj in (vao, vbo, prog):
         obj.release()
     fb.release()
@@ -154,24 +160,12 @@ def test_float_depth_framebuffer_draws_like_the_fixed_point_one(ctx, samples):
     corners = np.array([[-0.5, -0.5, 0.2], [0.5, -0.5, -0.2], [0.5, 0.5, -0.2], [-0.5, 0.5, 0.2]])
     images = {}
     for bits in (24, 32):
-        fb = Framebuffer(ctx, (48, 48), samples=samples, depth_bits=bits)
-        assert fb.attachment_depth_bits() == bits
-        prog = ctx.program(vertex_shader=VERT, fragment_shader=FRAG)
-        prog["mvp"].write(cam.mvp_bytes())
-        vbo = ctx.buffer(cam.relative(corners)[[0, 1, 2, 0, 2, 3]].tobytes())
-        vao = ctx.vertex_array(prog, [(vbo, "3f", "position")])
-        fb.clear()
-        ctx.enable(ctx.DEPTH_TEST)
-        vao.render()
-        images[bits] = fb.read()
-        if not samples:
-            depth = fb.read_depth()
-            # the tilted quad's depth runs linearly across x; the far background stays 1
+        depth = None if samples else []
+        images[bits], _ = draw_quad(ctx, cam, corners, (48, 48), samples, bits, depth)
+        if depth:
+            # the tilted quad's depth varies across it; the far background stays 1
             inside = red_mask(images[bits])
-            assert (depth[~inside] == 1.0).all() and np.ptp(depth[inside]) > 0.01
-        for obj in (vao, vbo, prog):
-            obj.release()
-        fb.release()
+            assert (depth[0][~inside] == 1.0).all() and np.ptp(depth[0][inside]) > 0.01
     assert red_mask(images[24]).sum() == red_mask(images[32]).sum() == 24 * 24
     with pytest.raises(ValueError):
         Framebuffer(ctx, (8, 8), depth_bits=16)
