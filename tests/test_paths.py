@@ -21,6 +21,8 @@ from workbench.scene.mesh import FEMesh
 SIZE = 64
 BACKGROUND = np.array([255, 255, 255, 255], np.uint8)
 FIELD_PATHS = {"vertex_color": "x", "pixel_color": "x", "element_color": "cell"}
+# quad_wire draws its own wire frame in the fill pass and refuses the line-overdraw one
+LINE_WIRE = {name: name != "quad_wire" for name in PATHS}
 
 
 @pytest.fixture(scope="module")
@@ -79,7 +81,7 @@ def colors(image, mask):
 # --------------------------------------------------------------------------- registry, errors
 def test_registry_and_bad_names():
     assert set(PATHS) == {"position", "flat", "gouraud", "vertex_color", "pixel_color",
-                          "element_color"}
+                          "element_color", "quad_wire"}
     with pytest.raises(ValueError, match="known paths"):
         make_path("phong")
     for name, cls in PATHS.items():
@@ -467,7 +469,8 @@ def test_magnification_moves_by_multiple_of_displacement(ctx, name):
 def test_set_step_uploads_coordinates_only(ctx, name, monkeypatch):
     mesh = two_step_mesh()
     fb = Framebuffer(ctx, (SIZE, SIZE))
-    path = make_path(name, Style(field=FIELD_PATHS.get(name), magnification=2.0, wireframe=True))
+    path = make_path(name, Style(field=FIELD_PATHS.get(name), magnification=2.0,
+                                 wireframe=LINE_WIRE[name]))
     path.prepare(ctx, mesh, camera())
     fb.clear()
     path.draw()
@@ -482,7 +485,7 @@ def test_set_step_uploads_coordinates_only(ctx, name, monkeypatch):
 
         monkeypatch.setattr(cls, "write", spy)
     sent = path.set_step(1)
-    per_vertex = 12 + (12 if name in ("gouraud", "vertex_color", "pixel_color") else 0)
+    per_vertex = 12 + (12 if name in ("gouraud", "vertex_color", "pixel_color", "quad_wire") else 0)
     expected = path.vertices * per_vertex
     if name == "element_color":  # a time-dependent element field: one value per vertex
         expected += path.vertices * 4
@@ -497,7 +500,7 @@ def test_set_step_uploads_coordinates_only(ctx, name, monkeypatch):
     fb.release()
     # the stepped draw equals a path prepared directly at step 1
     direct, _ = render(ctx, name, mesh, camera(), step=1, field=FIELD_PATHS.get(name),
-                       magnification=2.0, wireframe=True)
+                       magnification=2.0, wireframe=LINE_WIRE[name])
     assert stepped.tobytes() == direct.tobytes() != first.tobytes()
 
 
@@ -566,7 +569,7 @@ def test_far_translation_renders_same_image(ctx, name):
         field = {"vertex_color": "xy", "pixel_color": "xy"}.get(name, FIELD_PATHS.get(name))
         image, _ = render(ctx, name, mesh, camera(centre, azimuth=30, elevation=25,
                                                   projection="perspective"),
-                          field=field, wireframe=True)
+                          field=field, wireframe=LINE_WIRE[name])
         images.append(image)
     differ = (np.abs(images[0].astype(int) - images[1].astype(int)) > 1).any(axis=-1)
     assert covered(images[0]).sum() > 500
@@ -577,7 +580,7 @@ def test_far_translation_renders_same_image(ctx, name):
 def test_repeated_draws_are_byte_identical(ctx, name):
     mesh = curved_mesh()
     fb = Framebuffer(ctx, (SIZE, SIZE))
-    path = make_path(name, Style(field=FIELD_PATHS.get(name), wireframe=True))
+    path = make_path(name, Style(field=FIELD_PATHS.get(name), wireframe=LINE_WIRE[name]))
     path.prepare(ctx, mesh, camera(azimuth=30, elevation=25))
     out = []
     for _ in range(2):

@@ -39,7 +39,8 @@ import numpy as np
 
 from ..scene.derived import _as_elements, _classify, triangulate
 
-__all__ = ["QuadStrips", "TriStrips", "quad_strips", "tri_strips", "unstripify"]
+__all__ = ["RESTART", "QuadStrips", "TriStrips", "join_strips", "quad_strips", "tri_strips",
+           "unstripify"]
 
 RESTART = 0xFFFFFFFF
 
@@ -52,7 +53,9 @@ class QuadStrips:
     ``elements`` (M, 4) int32: the input. ``vertices`` (V,) int32: the strips' vertex sequences
     concatenated; strip s is ``vertices[vertex_starts[s]:vertex_starts[s + 1]]``, 2·(quads + 1)
     long. ``quads`` (Q,) int32: the element of each strip quad, strip by strip, in strip order;
-    strip s holds ``quads[quad_starts[s]:quad_starts[s + 1]]``. ``leftover``: quads in no band
+    strip s holds ``quads[quad_starts[s]:quad_starts[s + 1]]``; ``entry_edges`` (Q,) int8: the
+    local edge j (corners j, j+1) through which the strip enters each quad, so that the quad is
+    (c[j], c[j+1], c[j+2], c[j+3]) = (v2k, v2k+1, v2k+3, v2k+2). ``leftover``: quads in no band
     (their maximal band was shorter than ``cutoff``); ``triangles``: triangle elements;
     ``degenerate``: zero-area elements, drawn nowhere (all int32 element indices, ascending).
     ``passes``: bandification passes that accepted a band.
@@ -63,6 +66,7 @@ class QuadStrips:
     vertex_starts: np.ndarray
     quads: np.ndarray
     quad_starts: np.ndarray
+    entry_edges: np.ndarray
     leftover: np.ndarray
     triangles: np.ndarray
     degenerate: np.ndarray
@@ -97,12 +101,24 @@ class QuadStrips:
         """(L, 4) leftover quads (a, b, c, d) as the one-quad strips (a, b, d, c)."""
         return self.elements[self.leftover][:, [0, 1, 3, 2]]
 
-    def _triangle_nodes(self) -> np.ndarray:
-        """(T, 3) the distinct nodes of each triangle element in winding order."""
+    def triangle_nodes(self) -> np.ndarray:
+        """(T, 3) int32 the distinct nodes of each triangle element, in winding order."""
         if not len(self.triangles):
             return np.zeros((0, 3), np.int32)
         return triangulate(self.elements[self.triangles],
                            np.zeros((int(self.elements.max()) + 1, 3))).triangles
+
+    def draw_sequences(self) -> tuple[np.ndarray, np.ndarray]:
+        """Everything as triangle-strip vertex sequences: (flat int32 vertices, int64 lengths).
+
+        The strips, then each leftover quad (a, b, c, d) as (a, b, d, c), then each triangle as
+        its three distinct nodes.
+        """
+        flat = np.concatenate([self.vertices, self._leftover_sequences().ravel(),
+                               self.triangle_nodes().ravel()]).astype(np.int32)
+        lengths = np.concatenate([np.diff(self.vertex_starts), np.full(len(self.leftover), 4),
+                                  np.full(len(self.triangles), 3)]).astype(np.int64)
+        return flat, lengths
 
     def triangle_list(self) -> np.ndarray:
         """(K, 3) int32 the triangles the strips draw, as an unstripped list.
@@ -121,30 +137,24 @@ class QuadStrips:
         left = self._leftover_sequences()
         left_tris = np.stack([left[:, [0, 1, 2]], left[:, [2, 1, 3]]], axis=1).reshape(-1, 3)
         return np.ascontiguousarray(np.concatenate(
-            [quads.reshape(-1, 3), left_tris, self._triangle_nodes()]), dtype=np.int32)
+            [quads.reshape(-1, 3), left_tris, self.triangle_nodes()]), dtype=np.int32)
 
     def restart_indices(self, restart: int = RESTART) -> np.ndarray:
-        """(L,) uint32 ``GL_TRIANGLE_STRIP`` indices with primitive restart: every strip, then
-        each leftover quad as the strip (a, b, d, c), then each triangle as a 3-vertex strip,
-        separated by ``restart`` (none at the end). Draws exactly :meth:`triangle_list`."""
-        pieces = [self.vertices]
-        lengths = [np.diff(self.vertex_starts)]
-        pieces.append(self._leftover_sequences().ravel())
-        lengths.append(np.full(len(self.leftover), 4))
-        pieces.append(self._triangle_nodes().ravel())
-        lengths.append(np.full(len(self.triangles), 3))
-        return _join_with_restart(np.concatenate(pieces), np.concatenate(lengths), restart)
+        """(L,) uint32 ``GL_TRIANGLE_STRIP`` indices with primitive restart: the
+        :meth:`draw_sequences` separated by ``restart`` (none at the end). Draws exactly
+        :meth:`triangle_list`."""
+        return join_strips(*self.draw_sequences(), restart)
 
 
-def _join_with_restart(flat: np.ndarray, lengths: np.ndarray, restart: int) -> np.ndarray:
-    """Sequences of the given lengths, concatenated in ``flat``, joined by ``restart``."""
+def join_strips(flat: np.ndarray, lengths: np.ndarray, restart: int = RESTART) -> np.ndarray:
+    """(L,) uint32: sequences of the given ``lengths``, concatenated in ``flat``, joined by
+    ``restart`` (none at the end)."""
     n = len(lengths)
     if n == 0:
         return np.zeros(0, np.uint32)
     out = np.full(len(flat) + n - 1, restart, np.uint32)
     # an entry of sequence i moves right by the i restarts before it
-    seq_of = np.repeat(np.arange(n), lengths)
-    out[np.arange(len(flat)) + seq_of] = flat
+    out[np.arange(len(flat)) + np.repeat(np.arange(n), lengths)] = flat
     return out
 
 
@@ -184,6 +194,7 @@ def quad_strips(elements, cutoff: int = 1) -> QuadStrips:
         vertex_starts=(2 * quad_starts + 2 * np.arange(n_strips + 1)).astype(np.int64),
         quads=order.astype(np.int32),
         quad_starts=quad_starts,
+        entry_edges=entry.astype(np.int8),
         leftover=np.flatnonzero(leftover).astype(np.int32),
         triangles=np.flatnonzero(tri).astype(np.int32),
         degenerate=np.flatnonzero(degenerate).astype(np.int32),

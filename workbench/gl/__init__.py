@@ -3,8 +3,9 @@
 from .camera import Camera
 from .context import GLUnavailable, create_context, renderer
 from .framebuffer import Framebuffer
-from .queries import GpuTimer, PrimitivesGenerated, SamplesPassed
+from .queries import GpuTimer, PrimitivesGenerated, SamplesPassed, VertexShaderInvocations
 from .shaders import load_program
 
 __all__ = ["Camera", "Framebuffer", "GLUnavailable", "GpuTimer", "PrimitivesGenerated",
-           "SamplesPassed", "create_context", "load_program", "renderer"]
+           "SamplesPassed", "VertexShaderInvocations", "create_context", "load_program",
+           "renderer"]

@@ -7,6 +7,7 @@ for those commands to finish. moderngl frees a query when it is garbage-collecte
 from __future__ import annotations
 
 import moderngl
+import numpy as np
 
 
 class _Query:
@@ -51,3 +52,53 @@ class PrimitivesGenerated(_Query):
     @property
     def primitives(self) -> int:
         return int(self.query.primitives)
+
+
+GL_VERTEX_SHADER_INVOCATIONS = 0x82F0  # ARB_pipeline_statistics_query, core in GL 4.6
+
+
+class VertexShaderInvocations:
+    """GL_VERTEX_SHADER_INVOCATIONS: vertex shader runs inside ``with query:`` (pipeline
+    statistics). The count includes runs a post-transform vertex cache did not save; it is the
+    number the driver reports, not a computed one.
+
+    :meth:`supported` says whether the context exposes the query (GL 4.6 or
+    ``GL_ARB_pipeline_statistics_query``); constructing one without it raises RuntimeError.
+    """
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        if not self.supported(ctx):
+            raise RuntimeError("this GL context has no pipeline statistics queries "
+                               "(GL 4.6 or GL_ARB_pipeline_statistics_query)")
+        from .context import raw_gl
+
+        self._gl = raw_gl()
+        self._id = int(np.ravel(self._gl.glGenQueries(1))[0])
+        self._count: int | None = None
+
+    @staticmethod
+    def supported(ctx: moderngl.Context) -> bool:
+        return ctx.version_code >= 460 or "GL_ARB_pipeline_statistics_query" in ctx.extensions
+
+    def __enter__(self):
+        self._count = None
+        self._gl.glBeginQuery(GL_VERTEX_SHADER_INVOCATIONS, self._id)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._gl.glEndQuery(GL_VERTEX_SHADER_INVOCATIONS)
+
+    @property
+    def invocations(self) -> int:
+        """Vertex shader invocations counted (waits for the measured commands to finish)."""
+        if self._count is None:
+            # 32-bit result: PyOpenGL's 64-bit variant fails on its own type table, and one draw
+            # here never runs the vertex shader 2^32 times
+            self._count = int(np.ravel(self._gl.glGetQueryObjectuiv(
+                self._id, self._gl.GL_QUERY_RESULT))[0])
+        return self._count
+
+    def release(self) -> None:
+        if self._id:
+            self._gl.glDeleteQueries(1, [self._id])
+            self._id = 0

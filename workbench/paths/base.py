@@ -26,6 +26,13 @@ Conventions every path follows (a reference renderer can match them exactly):
 * **Clip planes**: up to four world-space float64 planes ``(a, b, c, d)``; points with
   ``a·x + b·y + c·z + d ≥ 0`` are kept. The plane is moved to the upload origin in float64
   (``d' = d + (a, b, c)·origin``) and applied with ``gl_ClipDistance``.
+* **Strips** (``Style.strips``): ``"none"`` draws an indexed triangle list; ``"triangle"``
+  draws meshoptimizer's triangle strips of the same triangles and ``"quad"`` the bandified quad
+  strips (:mod:`workbench.algo.strips`), both as ``GL_TRIANGLE_STRIP`` with primitive restart at
+  index 0xFFFFFFFF (which moderngl enables in every context). Quad strips split each quad along
+  its strip's diagonal; ``Style.quad_diagonal = "strip"`` gives the unstripped list and the
+  triangle strips those same triangles, so all three draw identical images. Strips are built
+  over the drawn vertices (crease-split ones for Gouraud paths), so a crease ends a strip.
 * **Wire frame** (``Style.wireframe``): the element edges (quad edges, no diagonals) drawn as a
   second pass of ``GL_LINES``; the fill pass uses polygon offset (factor 1, units 1) so the
   lines win the depth test — the "standard wire frame" line overdraw of fe2003 Table 3.
@@ -41,6 +48,7 @@ from typing import ClassVar
 import moderngl
 import numpy as np
 
+from ..algo.strips import RESTART, quad_strips, tri_strips
 from ..gl import load_program
 from .colormap import NO_VALUE, ColorScale, scale_for
 
@@ -48,6 +56,8 @@ NEEDS = frozenset({"triangles", "face_normals", "gouraud", "edges", "node_field"
 MAX_CLIP_PLANES = 4
 GL_CLIP_DISTANCE0 = 0x3000
 POLYGON_OFFSET = (1.0, 1.0)  # fill pass under a wire frame: (factor, units)
+STRIPS = ("none", "triangle", "quad")
+QUAD_DIAGONALS = ("auto", "shorter", "strip")
 
 
 @dataclass
@@ -63,6 +73,10 @@ class Style:
     magnification / reference_step: deformation plot, shown = reference + magnification·(step −
     reference). wireframe: line-overdraw element wire frame in ``wire_color``. base_color: RGB in
     [0, 1] of the uncoloured paths. cull_back: cull back faces (default off: shells are two-sided).
+    strips: "none" (triangle list), "triangle" (meshoptimizer triangle strips) or "quad" (quad
+    strips by bandification, quads shorter than ``strip_cutoff`` drawn one by one).
+    quad_diagonal: how quads are split, "shorter" (the shorter diagonal), "strip" (the diagonal
+    of the quad's strip) or "auto" ("strip" for quad strips, else "shorter").
 
     Refused with ValueError: more than 4 clip planes, a plane that is not 4 finite numbers with a
     non-zero normal, a negative step, a non-finite magnification, a crease angle outside
@@ -83,6 +97,9 @@ class Style:
     wire_color: tuple = (0.0, 0.0, 0.0)
     base_color: tuple = (0.75, 0.75, 0.78)
     cull_back: bool = False
+    strips: str = "none"
+    strip_cutoff: int = 1
+    quad_diagonal: str = "auto"
 
     def __post_init__(self) -> None:
         planes = np.asarray(self.clip_planes, np.float64).reshape(-1, 4) if len(self.clip_planes) \
@@ -107,6 +124,24 @@ class Style:
             if len(color) != 3 or not all(0.0 <= c <= 1.0 for c in color):
                 raise ValueError(f"{name} must be 3 numbers in [0, 1], got {getattr(self, name)}")
             setattr(self, name, color)
+        if self.strips not in STRIPS:
+            raise ValueError(f"strips must be one of {STRIPS}, got {self.strips!r}")
+        if self.quad_diagonal not in QUAD_DIAGONALS:
+            raise ValueError(f"quad_diagonal must be one of {QUAD_DIAGONALS}, "
+                             f"got {self.quad_diagonal!r}")
+        if self.strips == "quad" and self.quad_diagonal == "shorter":
+            raise ValueError("quad strips split each quad along the strip's diagonal: "
+                             "quad_diagonal='shorter' cannot be drawn with strips='quad'")
+        if int(self.strip_cutoff) != self.strip_cutoff or self.strip_cutoff < 1:
+            raise ValueError(f"strip_cutoff must be an integer >= 1, got {self.strip_cutoff}")
+        self.strip_cutoff = int(self.strip_cutoff)
+
+    @property
+    def diagonal(self) -> str:
+        """The quad split in use: "strip" or "shorter" (``quad_diagonal`` with "auto" resolved)."""
+        if self.quad_diagonal != "auto":
+            return self.quad_diagonal
+        return "strip" if self.strips == "quad" else "shorter"
 
 
     def summary(self) -> str:
@@ -130,8 +165,10 @@ class RenderPath(ABC):
     ``{"triangles", "face_normals", "gouraud", "edges", "node_field", "element_field"}``); an
     instance drawing a wire frame adds ``"edges"`` to its own ``needs``. After ``prepare``:
     ``triangles``, ``vertices`` and ``edges`` (wire-frame lines, 0 without) drawn,
-    ``bytes_uploaded`` (everything uploaded by prepare, textures included) and
-    ``bytes_per_step`` (what one ``set_step`` uploads).
+    ``bytes_uploaded`` (everything uploaded by prepare, textures included),
+    ``bytes_per_step`` (what one ``set_step`` uploads), ``vertices_sent`` (vertex indices one
+    draw sends down the pipeline, restart markers excluded: 3 per listed triangle) and
+    ``strips`` (primitives restarted, 0 for a triangle list).
     """
 
     name: ClassVar[str]
@@ -142,6 +179,7 @@ class RenderPath(ABC):
         if self.style.wireframe:
             self.needs = type(self).needs | {"edges"}
         self.triangles = self.vertices = self.edges = 0
+        self.vertices_sent = self.strips = 0
         self.bytes_uploaded = self.bytes_per_step = 0
         self.missing_values = 0
 
@@ -245,23 +283,70 @@ class MeshPath(RenderPath):
             return np.asarray(self._gouraud.vertex_node, np.int64), self._gouraud.triangles
         return None, mesh.triangles
 
+    def static_attributes(self) -> list[tuple[np.ndarray, str, str]]:
+        """Extra per-vertex attributes uploaded once, as (float32 data, format, name)."""
+        return []
+
+    def layout(self, mesh, triangles: np.ndarray, n_vertices: int) -> np.ndarray:
+        """The index buffer content for ``Style.strips`` and ``Style.quad_diagonal``: (K, 3)
+        triangles for a list, a 1-D strip index array with ``RESTART`` markers otherwise. Sets
+        ``mode``, ``triangles``, ``strips`` and ``vertices_sent``."""
+        style = self.style
+        self.mode, self.strips = moderngl.TRIANGLES, 0
+        self.triangles = len(triangles)
+        if style.strips == "none" and style.diagonal == "shorter":
+            self.vertices_sent = triangles.size
+            return triangles
+        if type(self).topology is not MeshPath.topology:
+            raise ValueError(f"path {self.name!r} gives every triangle its own provoking vertex; "
+                             f"strips and strip diagonals need shared vertices: draw it with "
+                             f"strips='none' and quad_diagonal='shorter'")
+        if style.diagonal == "strip":
+            elements = self._gouraud.elements if self.split else mesh.elements
+            quads = quad_strips(elements, style.strip_cutoff)
+            if style.strips == "quad":
+                index = quads.restart_indices(RESTART)
+                self.mode = moderngl.TRIANGLE_STRIP
+                self.strips = quads.n_strips + len(quads.leftover) + len(quads.triangles)
+                self.vertices_sent = len(index) - max(self.strips - 1, 0)
+                return index
+            triangles = quads.triangle_list()
+            self.triangles = len(triangles)
+        if style.strips == "triangle":
+            tri = tri_strips(triangles, n_vertices, RESTART)
+            self.mode, self.strips, self.vertices_sent = (moderngl.TRIANGLE_STRIP, tri.n_strips,
+                                                          tri.n_vertices)
+            return tri.indices
+        self.vertices_sent = triangles.size
+        return triangles
+
     def _build(self, ctx: moderngl.Context, camera) -> None:
         mesh, style = self.mesh, self.style
-        vertex_node, index = self.topology(mesh)
+        # row in the crease split of each vertex (None: vertex i is split vertex i)
+        self._split_rows = None
+        vertex_node, triangles = self.topology(mesh)
         n_vertices = mesh.n_nodes if vertex_node is None else len(vertex_node)
+        index = self.layout(mesh, triangles, n_vertices)
         used = np.zeros(n_vertices, bool)
-        used[index.ravel()] = True
+        used[triangles.ravel()] = True
         self._remap = None
         if not used.all():  # unreferenced nodes are not uploaded
             keep = np.flatnonzero(used)
             self._remap = np.full(n_vertices, -1, np.int64)
             self._remap[keep] = np.arange(len(keep))
             vertex_node = keep if vertex_node is None else vertex_node[keep]
-            index = self._remap[index]
+            if self.split:
+                self._split_rows = keep if self._split_rows is None else self._split_rows[keep]
+            if index.ndim == 1:  # strip indices: restart markers stay
+                marker = index == RESTART
+                index = np.where(marker, RESTART, self._remap[np.where(marker, 0, index)])
+                index = index.astype(np.uint32)
+            else:
+                index = self._remap[index]
             n_vertices = len(keep)
         self._vertex_node = vertex_node
-        index = np.ascontiguousarray(index, dtype=np.int32)
-        self.triangles, self.vertices = len(index), n_vertices
+        index = np.ascontiguousarray(index, dtype=np.uint32 if index.ndim == 1 else np.int32)
+        self.vertices = n_vertices
         uploaded = 0
 
         defines = {"NUM_CLIP": len(style.clip_planes)}
@@ -280,6 +365,12 @@ class MeshPath(RenderPath):
         if self.field_per is not None:
             self._values = self._keep(ctx.buffer(reserve=n_vertices * 4))
             content.append((self._values, "1f", "value"))
+        for data, fmt, name in self.static_attributes():
+            data = np.ascontiguousarray(data, np.float32)
+            if self._remap is not None:
+                data = data[keep]
+            content.append((self._keep(ctx.buffer(data.tobytes())), fmt, name))
+            uploaded += data.nbytes
         if self.scale is not None:
             texels = self.scale.texture_data()
             self._colormap = self._keep(ctx.texture((len(texels), 1), 4, texels.tobytes()))
@@ -404,7 +495,10 @@ class MeshPath(RenderPath):
         self._positions.write(data)
         sent = data.nbytes
         if self.split:
-            normals = np.asarray(self._gouraud.normals(shown), np.float32)
+            normals = self._gouraud.normals(shown)
+            if self._split_rows is not None:
+                normals = normals[self._split_rows]
+            normals = normals.astype(np.float32)
             self._normals.write(normals)
             sent += normals.nbytes
         if self.field_per is not None and not self._static_values:
@@ -441,11 +535,11 @@ class MeshPath(RenderPath):
             self._colormap.use(0)
         if self._wire_vao is not None:
             ctx.polygon_offset = POLYGON_OFFSET
-            self._vao.render(moderngl.TRIANGLES)
+            self._vao.render(self.mode)
             ctx.polygon_offset = (0.0, 0.0)
             self._wire_vao.render(moderngl.LINES)
         else:
-            self._vao.render(moderngl.TRIANGLES)
+            self._vao.render(self.mode)
         for i in range(len(style.clip_planes)):
             ctx.disable_direct(GL_CLIP_DISTANCE0 + i)
 
@@ -457,4 +551,4 @@ class MeshPath(RenderPath):
 
 
 # the path modules register themselves in PATHS on import
-from . import fields, surface  # noqa: E402,F401
+from . import fields, surface, wire  # noqa: E402,F401
