@@ -43,6 +43,18 @@ def test_render_writes_the_image_of_a_plate(deck, tmp_path):
     assert drawn.sum() == len(rows) * len(cols)
 
 
+def test_render_draws_the_same_plate_with_quad_strips(deck, tmp_path, capsys):
+    images = []
+    for strips in ("none", "quad"):
+        out = tmp_path / f"plate_{strips}.png"
+        assert main(["render", str(deck), "--view", "0,0", "--up", "y", "--size", "80x60",
+                     "--strips", strips, "-o", str(out)]) == 0
+        images.append(np.asarray(Image.open(out)))
+    assert (images[0] == images[1]).all()
+    printed = capsys.readouterr().out
+    assert "6 vertices sent" in printed and "4 vertices sent, 1 strip," in printed
+
+
 def test_render_car_with_field_writes_a_colour_bar_figure(tmp_path):
     if shared_file(CAR_DECK) is None:
         pytest.skip("shared car deck not found (set WORKBENCH_DATA)")

@@ -71,7 +71,7 @@ def cmd_render(args) -> int:
         else:
             path_name = "element_color" if args.field in mesh.element_fields else "pixel_color"
     style = Style(field=args.field, step=args.step, colormap=args.colormap, bands=args.bands,
-                  wireframe=args.wireframe, crease_deg=args.crease)
+                  wireframe=args.wireframe, crease_deg=args.crease, strips=args.strips)
     ctx = create_context()
     width, height = args.size
     camera = Camera.fit_box(*mesh.bounds(all_steps=True), azimuth=args.view[0], elevation=args.view[1],
@@ -92,7 +92,9 @@ def cmd_render(args) -> int:
                           bands=args.bands)
     else:
         save_png(out, image)
-    print(f"{out}: {mesh.name}, {path.triangles} triangles, path {path_name}")
+    strips = f", {path.strips} strip{'s' * (path.strips != 1)}" if path.strips else ""
+    print(f"{out}: {mesh.name}, {path.triangles} triangles, {path.vertices_sent} vertices sent"
+          f"{strips}, path {path_name}")
     return 0
 
 
@@ -148,6 +150,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--field", help="node or element field to colour by")
     p.add_argument("--path", help="render path (default: gouraud; pixel_color or element_color with --field)")
     p.add_argument("--wireframe", action="store_true", help="overdraw element edges")
+    p.add_argument("--strips", choices=("none", "triangle", "quad"), default="none",
+                   help="draw a triangle list (default), meshoptimizer triangle strips or quad strips")
     p.add_argument("--view", type=lambda s: _pair(s, ","), default=(30.0, 25.0), metavar="AZ,EL",
                    help="azimuth and elevation in degrees (default 30,25)")
     p.add_argument("--up", choices=("y", "z"), default="z",
