@@ -621,3 +621,11 @@ def test_tri_strips_on_a_grid_save_vertices(restart):
 def test_tri_strips_bad_input_refused(bad):
     with pytest.raises(ValueError):
         tri_strips(bad)
+
+
+def test_a_restart_value_that_is_a_vertex_index_is_refused():
+    e = np.array(grid(3, 2))
+    with pytest.raises(ValueError, match="must exceed every vertex index"):
+        quad_strips(e).restart_indices(restart=int(e.max()))
+    with pytest.raises(ValueError, match="must exceed every vertex index"):
+        tri_strips(tri_soup(e), restart=2)

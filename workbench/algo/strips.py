@@ -142,8 +142,16 @@ class QuadStrips:
     def restart_indices(self, restart: int = RESTART) -> np.ndarray:
         """(L,) uint32 ``GL_TRIANGLE_STRIP`` indices with primitive restart: the
         :meth:`draw_sequences` separated by ``restart`` (none at the end). Draws exactly
-        :meth:`triangle_list`."""
-        return join_strips(*self.draw_sequences(), restart)
+        :meth:`triangle_list`. Refuses (ValueError) a ``restart`` that is also a vertex index."""
+        flat, lengths = self.draw_sequences()
+        _check_restart(restart, int(flat.max()) if len(flat) else -1)
+        return join_strips(flat, lengths, restart)
+
+
+def _check_restart(restart: int, largest_index: int) -> None:
+    if not largest_index < restart <= RESTART:
+        raise ValueError(f"restart index {restart} must exceed every vertex index (largest "
+                         f"{largest_index}) and fit 32 bits")
 
 
 def join_strips(flat: np.ndarray, lengths: np.ndarray, restart: int = RESTART) -> np.ndarray:
@@ -434,7 +442,7 @@ def tri_strips(triangles, vertex_count: int | None = None, restart: int = RESTAR
     library recommends for stripping), then ``meshopt_stripify`` joins them into strips separated
     by ``restart``; swaps inside a strip are degenerate triangles. ``vertex_count`` defaults to
     max index + 1. Refuses (ValueError) arrays that are not (K, 3) non-negative integers below
-    ``vertex_count`` and triangles with a repeated vertex.
+    ``vertex_count``, triangles with a repeated vertex and a ``restart`` below ``vertex_count``.
     """
     t = np.asarray(triangles)
     if t.ndim != 2 or t.shape[1] != 3 or (t.size and t.dtype.kind not in "iu"):
@@ -447,6 +455,7 @@ def tri_strips(triangles, vertex_count: int | None = None, restart: int = RESTAR
     n = int(t.max()) + 1 if vertex_count is None else int(vertex_count)
     if t.max() >= n:
         raise ValueError(f"triangles reference vertex {int(t.max())} but vertex_count is {n}")
+    _check_restart(restart, n - 1)
     repeated = (t[:, 0] == t[:, 1]) | (t[:, 1] == t[:, 2]) | (t[:, 0] == t[:, 2])
     if repeated.any():
         raise ValueError(f"{int(repeated.sum())} triangles repeat a vertex, first "
