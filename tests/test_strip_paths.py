@@ -1,6 +1,7 @@
 """Stripped drawing: quad strips and triangle strips against the unstripped triangle list, and the
 single-pass quad wire frame against the line-overdraw wire frame."""
 
+import moderngl
 import numpy as np
 import pytest
 from skimage.morphology import dilation, footprint_rectangle
@@ -88,6 +89,35 @@ def test_triangle_strips_draw_the_same_triangles(ctx, name):
     diff = np.abs(listed.astype(int) - stripped.astype(int)).max(axis=-1)
     assert diff.max() <= 1 and (diff > 0).mean() <= 0.002
     assert path.strips > 1
+
+
+@pytest.mark.parametrize("name", ["gouraud", "vertex_color"])
+def test_triangle_strips_equal_their_own_triangles_listed(ctx, name):
+    # the 1/255 differences above come from the corner each triangle starts at: listed with the
+    # corners in the strips' order, the same triangles draw the same image pixel for pixel
+    from workbench.algo.strips import tri_strips, unstripify
+    from workbench.paths import PATHS
+
+    class StripOrderList(PATHS[name]):
+        def layout(self, mesh, triangles, n_vertices):
+            listed = super().layout(mesh, triangles, n_vertices)
+            self.mode = moderngl.TRIANGLES
+            return unstripify(tri_strips(listed, n_vertices).indices)
+
+    mesh, cam = scene_with_defects(), oblique()
+    kw = dict(field=SHADED[name], bands=7 if name == "vertex_color" else 0,
+              quad_diagonal="strip")
+    stripped, _ = draw(ctx, name, mesh, cam, size=240, strips="triangle", **kw)
+    fb = Framebuffer(ctx, (240, 240))
+    path = StripOrderList(Style(**kw))
+    path.prepare(ctx, mesh, cam)
+    fb.clear()
+    path.draw()
+    listed = fb.read()
+    path.release()
+    fb.release()
+    assert (listed != BACKGROUND).any(axis=-1).sum() > 10000
+    assert stripped.tobytes() == listed.tobytes()
 
 
 def test_strips_change_the_diagonal_not_the_outline(ctx):
