@@ -244,44 +244,39 @@ def _quad_neighbours(e: np.ndarray, quad: np.ndarray, tri: np.ndarray):
 
 
 @numba.njit(cache=True)
+def _walk_away(cur, edge, neighbour, neighbour_edge, active, seen, stamp, out_q, out_e, n,
+               backward):
+    """Append to out_q/out_e from index n the quads met leaving ``cur`` through ``edge`` and
+    onwards; return the new n. Walking backward, a quad's entry edge in band order is the one
+    opposite the edge it was reached through."""
+    while True:
+        r = neighbour[cur, edge]
+        if r < 0 or not active[r] or seen[r] == stamp:
+            return n
+        k = neighbour_edge[cur, edge]
+        seen[r] = stamp
+        out_q[n] = r
+        out_e[n] = (k + 2) % 4 if backward else k
+        n += 1
+        cur, edge = r, (k + 2) % 4
+
+
+@numba.njit(cache=True)
 def _walk(i, d, neighbour, neighbour_edge, active, seen, stamp, out_q, out_e):
     """The band through quad i in direction d into out_q/out_e (quads, entry edges); its length.
 
     ``seen[q] == stamp`` marks the quads already in this band.
     """
-    nb = 0
     seen[i] = stamp
-    # backward: collected farthest-last, reversed below
-    cur, edge = i, d
-    while True:
-        r = neighbour[cur, edge]
-        if r < 0 or not active[r] or seen[r] == stamp:
-            break
-        k = neighbour_edge[cur, edge]
-        seen[r] = stamp
-        out_q[nb] = r
-        out_e[nb] = (k + 2) % 4  # r precedes cur in band order: it leaves through k
-        nb += 1
-        cur, edge = r, (k + 2) % 4
-    # reverse the backward part in place, then append i and the forward walk
+    nb = _walk_away(i, d, neighbour, neighbour_edge, active, seen, stamp, out_q, out_e, 0, True)
+    # the backward part was collected farthest-last: reverse it, then append i and walk forward
     for j in range(nb // 2):
         out_q[j], out_q[nb - 1 - j] = out_q[nb - 1 - j], out_q[j]
         out_e[j], out_e[nb - 1 - j] = out_e[nb - 1 - j], out_e[j]
     out_q[nb] = i
     out_e[nb] = d
-    n = nb + 1
-    cur, edge = i, (d + 2) % 4
-    while True:
-        r = neighbour[cur, edge]
-        if r < 0 or not active[r] or seen[r] == stamp:
-            break
-        k = neighbour_edge[cur, edge]
-        seen[r] = stamp
-        out_q[n] = r
-        out_e[n] = k
-        n += 1
-        cur, edge = r, (k + 2) % 4
-    return n
+    return _walk_away(i, (d + 2) % 4, neighbour, neighbour_edge, active, seen, stamp, out_q,
+                      out_e, nb + 1, False)
 
 
 @numba.njit(cache=True)
