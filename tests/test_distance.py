@@ -1,0 +1,109 @@
+"""Exact point-to-triangle distances and certified triangle bounds against brute force."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from workbench.algo.distance import (closest_point_on_triangle, point_triangle_distance,
+                                     points_triangles_distance, triangle_bounds)
+
+coords = st.floats(-10, 10, allow_nan=False, width=64)
+vec3 = arrays(np.float64, 3, elements=coords)
+
+
+def dense_min(p, a, b, c, n=120):
+    """Smallest distance from p to a dense barycentric grid on abc, and the grid's spacing."""
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1))
+    keep = i + j <= n
+    u, v = i[keep] / n, j[keep] / n
+    pts = a + u[:, None] * (b - a) + v[:, None] * (c - a)
+    spacing = max(np.linalg.norm(b - a), np.linalg.norm(c - a), np.linalg.norm(c - b)) / n
+    return np.sqrt(((pts - p) ** 2).sum(axis=1)).min(), spacing
+
+
+@settings(max_examples=300, deadline=None)
+@given(p=vec3, a=vec3, b=vec3, c=vec3)
+def test_distance_matches_dense_sampling(p, a, b, c):
+    d = point_triangle_distance(p, a, b, c)
+    brute, spacing = dense_min(p, a, b, c)
+    # the exact minimum is at most any sample, and a sample lies within one spacing of it
+    assert d <= brute + 1e-9
+    assert d >= brute - spacing - 1e-9
+
+
+@settings(max_examples=200, deadline=None)
+@given(p=vec3, a=vec3, b=vec3, c=vec3)
+def test_closest_point_lies_on_the_triangle(p, a, b, c):
+    out = np.empty(3)
+    d2 = closest_point_on_triangle(p, a, b, c, out)
+    assert np.isfinite(out).all() and d2 >= 0
+    assert abs(np.sqrt(d2) - np.linalg.norm(p - out)) <= 1e-9 * (1 + np.sqrt(d2))
+    # out is in the triangle: the distance from out to the triangle is ~0
+    assert point_triangle_distance(out, a, b, c) <= 1e-7 * (1 + np.abs([a, b, c]).max())
+
+
+@pytest.mark.parametrize("tri", [
+    [[0, 0, 0], [0, 0, 0], [0, 0, 0]],            # a point
+    [[0, 0, 0], [1, 0, 0], [1, 0, 0]],            # repeated vertex: a segment
+    [[0, 0, 0], [1, 0, 0], [3, 0, 0]],            # collinear
+    [[0, 0, 0], [1, 1e-13, 0], [2, 0, 0]],        # zero area to rounding
+])
+def test_degenerate_triangles_are_their_edges(tri):
+    a, b, c = (np.array(v, np.float64) for v in tri)
+    rng = np.random.default_rng(3)
+    for p in rng.normal(size=(50, 3)) * 3:
+        brute, _ = dense_min(p, a, b, c, n=400)
+        d = point_triangle_distance(p, a, b, c)
+        assert np.isfinite(d) and abs(d - brute) <= 0.02
+
+
+def test_points_far_away_keep_their_distance():
+    a, b, c = np.eye(3)
+    p = np.array([1e8, 0.0, 0.0])
+    assert point_triangle_distance(p, a, b, c) == pytest.approx(1e8 - 1.0, rel=1e-15)
+    # a point above the face centroid: distance along the normal
+    centroid = (a + b + c) / 3
+    normal = np.ones(3) / np.sqrt(3)
+    assert point_triangle_distance(centroid + 0.25 * normal, a, b, c) == pytest.approx(0.25, abs=1e-15)
+
+
+def test_brute_force_table_agrees_with_single_calls():
+    rng = np.random.default_rng(0)
+    pts, tris = rng.normal(size=(7, 3)), rng.normal(size=(5, 3, 3))
+    table = points_triangles_distance(pts, tris)
+    for i, p in enumerate(pts):
+        for j, t in enumerate(tris):
+            assert table[i, j] == point_triangle_distance(p, *t)
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 10**6), n_faces=st.integers(1, 4))
+def test_triangle_bounds_bracket_the_farthest_point(seed, n_faces):
+    rng = np.random.default_rng(seed)
+    t = rng.normal(size=(3, 3))
+    faces = t[None] + 0.4 * rng.normal(size=(n_faces, 3, 3))
+    lower, upper = triangle_bounds(t, faces, 0.0, 6)
+    # the 2^6 barycentric grid holds every corner the bounds looked at, and more: its largest
+    # distance to the union lies inside the bracket
+    n = 64
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1))
+    keep = i + j <= n
+    u, v = i[keep] / n, j[keep] / n
+    pts = t[0] + u[:, None] * (t[1] - t[0]) + v[:, None] * (t[2] - t[0])
+    sampled = points_triangles_distance(pts, faces).min(axis=1).max()
+    assert lower <= sampled + 1e-9
+    assert sampled <= upper + 1e-12
+    # refining deeper never widens the bracket
+    lower2, upper2 = triangle_bounds(t, faces, 0.0, 8)
+    assert lower2 >= lower - 1e-12 and upper2 <= upper + 1e-12
+
+
+def test_a_triangle_on_its_own_face_is_at_distance_zero():
+    t = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float64)
+    assert triangle_bounds(t, t[None], 0.0, 4) == (0.0, 0.0)
+    # split in two faces along the diagonal: the union covers t exactly
+    halves = np.array([[[0, 0, 0], [1, 0, 0], [0.5, 0.5, 0]], [[0, 0, 0], [0.5, 0.5, 0], [0, 1, 0]]])
+    lower, upper = triangle_bounds(t, halves, 1e-3, 12)
+    assert lower == 0.0 and upper <= 1e-3
