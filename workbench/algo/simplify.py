@@ -71,8 +71,9 @@ class Decimation:
     """Result of :func:`hausdorff_decimate`.
 
     ``triangles`` index the caller's vertex array (no vertex is moved or added); ``parts`` is
-    the part label of each output triangle. ``tol_abs`` maps each part label to its tolerance
-    in model units. ``bounds`` has one entry per input triangle: a certified upper bound of the
+    the part label of each output triangle. ``part_labels`` (P,) are the input's part labels,
+    sorted, and ``tol_abs`` (P,) each one's tolerance in model units (:meth:`tol_for` looks one
+    up by label). ``bounds`` has one entry per input triangle: a certified upper bound of the
     largest distance from a point of that triangle to the simplified surface (model units; NaN
     for input triangles with a repeated vertex index, which were dropped); ``certified_max`` is
     their maximum, an upper bound of the one-sided Hausdorff distance original → simplified.
@@ -90,7 +91,8 @@ class Decimation:
 
     triangles: np.ndarray
     parts: np.ndarray
-    tol_abs: dict[int, float]
+    part_labels: np.ndarray
+    tol_abs: np.ndarray
     collapses: int
     rejected: dict[str, int]
     seconds: float
@@ -101,6 +103,13 @@ class Decimation:
     passes: int
     dropped: int = 0
     notes: list[str] = field(default_factory=list)
+
+    def tol_for(self, label: int) -> float:
+        """The tolerance (model units) of the part labelled ``label``; KeyError if none."""
+        hit = np.flatnonzero(self.part_labels == label)
+        if len(hit) == 0:
+            raise KeyError(f"no part {label}")
+        return float(self.tol_abs[hit[0]])
 
     @property
     def ratio(self) -> float:
@@ -959,13 +968,11 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
 
     # per part tolerance from its bounding box diagonal
     labels, part_index = np.unique(p_orig, return_inverse=True)
-    tol_abs: dict[int, float] = {}
     tol_of_label = np.empty(len(labels))
     for i, label in enumerate(labels):
         used = np.unique(t_orig[part_index == i])
         lo, hi = v_in[used].min(axis=0), v_in[used].max(axis=0)
         tol_of_label[i] = tol * float(np.linalg.norm(hi - lo)) if relative else tol
-        tol_abs[int(label)] = float(tol_of_label[i])
 
     used_all = np.unique(t_orig)
     centre = 0.5 * (v_in[used_all].min(axis=0) + v_in[used_all].max(axis=0))
@@ -1068,7 +1075,8 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     return Decimation(
         triangles=out,
         parts=np.ascontiguousarray(fpart[out_faces]),
-        tol_abs=tol_abs,
+        part_labels=labels.astype(np.int32),
+        tol_abs=tol_of_label,
         collapses=int(collapses),
         rejected={name: int(c) for name, c in zip(REJECT_REASONS, rejected)},
         seconds=time.perf_counter() - start,
