@@ -18,18 +18,22 @@ collapse is undone unless all pass. The new support is the set of faces that cer
 one leaf piece, so supports stay small.
 
 Collapse order: a priority queue of half-edges by a quadric error (the mean squared distance of
-v from the planes of the original triangles that have collapsed into u, plus a small share of
-the squared edge length, which orders flat regions by edge length), with lazy invalidation by
-per-vertex version stamps; when the queue runs dry every remaining half-edge is tried once more
-(``passes``), because re-supported neighbours can make earlier rejections feasible.
+v from the planes of the original triangles around u and around the vertices already collapsed
+into it, plus a small share of the squared edge length, which orders flat regions by edge
+length), with lazy invalidation by per-vertex version stamps. After a collapse the half-edges
+out of v, out of its neighbours that saw a rejection since they were last queued, and the new
+ones towards v are queued; when the queue runs dry every remaining half-edge is tried once more
+(``passes``), since re-certified supports elsewhere can make earlier rejections feasible.
 
 Topology and shape rules (a collapse that breaks one is rejected and counted by reason):
 
 * ``topology`` -- the edge has more than two faces, u is a non-manifold vertex (its faces do not
   form one fan), the link condition fails (u and v share a neighbour that is not opposite the
   edge), or an interior edge joins two boundary vertices;
-* ``fixed`` -- u is used by faces of more than one part, by a zero-area input face, touches a
-  non-manifold edge, or is a corner (1 or >= 3 feature/boundary edges);
+* ``fixed`` -- u never moves: it is used by faces of more than one part, by a zero-area input
+  face, touches a non-manifold edge, or is a corner (on 1 or >= 3 feature/boundary edges, or
+  where its feature/boundary polyline turns by more than ``feature_deg``). Such vertices are
+  not queued at all; the count is of vertices that became corners on the way;
 * ``feature`` -- u lies on two feature/boundary edges and uv is not one of them (u may only
   slide along its feature line);
 * ``normal`` -- a changed face would turn by more than ``max_normal_deg`` from its normal
@@ -149,9 +153,10 @@ def _gather(x, head, tail, nxt, alive, out):
 
 
 @numba.njit(cache=True)
-def _neighbours(x, faces, nf, F, fpart, part, nb, cnt):
+def _neighbours(x, faces, nf, F, fpart, part, nb, cnt, pos):
     """Distinct neighbours of x over faces[:nf] (of ``part`` only when part >= 0) into nb, and
-    the number of those faces on each edge (x, nb[j]) into cnt; returns their count."""
+    the number of those faces on each edge (x, nb[j]) into cnt; returns their count.
+    ``pos`` (N,) is -1 everywhere on entry and on return."""
     n = 0
     for i in range(nf):
         f = faces[i]
@@ -161,15 +166,15 @@ def _neighbours(x, faces, nf, F, fpart, part, nb, cnt):
             w = F[f, k]
             if w == x:
                 continue
-            j = 0
-            while j < n and nb[j] != w:
-                j += 1
-            if j == n:
+            if pos[w] < 0:
+                pos[w] = n
                 nb[n] = w
                 cnt[n] = 1
                 n += 1
             else:
-                cnt[j] += 1
+                cnt[pos[w]] += 1
+    for j in range(n):
+        pos[nb[j]] = -1
     return n
 
 
@@ -428,6 +433,7 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
         constrained[ckeys[i]] = np.int8(1)
 
     dead = np.zeros(n_vert, np.bool_)
+    pos = np.full(n_vert, -1, np.int64)
     version = np.zeros(n_vert, np.int32)
     retry = np.zeros(n_vert, np.bool_)
     near_u = np.full(n_vert, -1, np.int64)
@@ -470,7 +476,7 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
             if dead[x] or fixed[x] or not (cdeg[x] == 0 or cdeg[x] == 2):
                 continue
             nfx = _gather(x, head, tail, nxt, alive, fu)
-            nnx = _neighbours(x, fu, nfx, F, fpart, -1, nbu, cntu)
+            nnx = _neighbours(x, fu, nfx, F, fpart, -1, nbu, cntu, pos)
             for j in range(nnx):
                 y = nbu[j]
                 if cdeg[x] == 2 and _edge_key(x, y, n_vert) not in constrained:
@@ -489,11 +495,19 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
             if nfu == 0:
                 continue
             part = fpart[fu[0]]
-            nnu = _neighbours(u, fu, nfu, F, fpart, -1, nbu, cntu)
+            nnu = _neighbours(u, fu, nfu, F, fpart, -1, nbu, cntu, pos)
             n_uv = 0
-            for j in range(nnu):
-                if nbu[j] == v:
-                    n_uv = cntu[j]
+            opp0 = -1
+            opp1 = -1
+            for i in range(nfu):
+                f = fu[i]
+                if F[f, 0] == v or F[f, 1] == v or F[f, 2] == v:
+                    n_uv += 1
+                    w = F[f, 0] + F[f, 1] + F[f, 2] - u - v
+                    if opp0 < 0:
+                        opp0 = w
+                    else:
+                        opp1 = w
             if n_uv == 0:
                 continue  # no longer an edge
             if cdeg[u] == 2 and _edge_key(u, v, n_vert) not in constrained:
@@ -514,28 +528,16 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
             nnv = 0
             if ok:
                 nfv = _gather(v, head, tail, nxt, alive, fv)
-                nnv = _neighbours(v, fv, nfv, F, fpart, -1, nbv, cntv)
+                nnv = _neighbours(v, fv, nfv, F, fpart, -1, nbv, cntv, pos)
                 # link condition: common neighbours of u and v are opposite the edge
+                for i in range(nnv):
+                    pos[nbv[i]] = 0
                 for j in range(nnu):
                     w = nbu[j]
-                    if w == v:
-                        continue
-                    common = False
-                    for i in range(nnv):
-                        if nbv[i] == w:
-                            common = True
-                            break
-                    if not common:
-                        continue
-                    opposite = False
-                    for i in range(nfu):
-                        f = fu[i]
-                        if (F[f, 0] == v or F[f, 1] == v or F[f, 2] == v) and \
-                                (F[f, 0] == w or F[f, 1] == w or F[f, 2] == w):
-                            opposite = True
-                    if not opposite:
+                    if w != v and pos[w] == 0 and w != opp0 and w != opp1:
                         ok = False
-                        break
+                for i in range(nnv):
+                    pos[nbv[i]] = -1
             if ok and n_uv == 2 and u_boundary:
                 # an interior edge between two boundary vertices would pinch the surface
                 mixed = False
@@ -543,7 +545,7 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
                     if fpart[fv[i]] != part:
                         mixed = True
                 if mixed:
-                    nnw = _neighbours(v, fv, nfv, F, fpart, part, nbu[nnu:], cntu[nnu:])
+                    nnw = _neighbours(v, fv, nfv, F, fpart, part, nbu[nnu:], cntu[nnu:], pos)
                     for i in range(nnw):
                         if cntu[nnu + i] == 1:
                             ok = False
@@ -794,7 +796,7 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
             for j in range(nnv):
                 near_v[nbv[j]] = collapses
             nfv = _gather(v, head, tail, nxt, alive, fv)
-            nnv = _neighbours(v, fv, nfv, F, fpart, -1, nbv, cntv)
+            nnv = _neighbours(v, fv, nfv, F, fpart, -1, nbv, cntv, pos)
             for j in range(-1, nnv):
                 a = v if j < 0 else nbv[j]
                 if fixed[a] or not (cdeg[a] == 0 or cdeg[a] == 2):
@@ -803,7 +805,7 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
                     version[a] += 1
                     retry[a] = False
                     nfa = _gather(a, head, tail, nxt, alive, fu)
-                    nna = _neighbours(a, fu, nfa, F, fpart, -1, nbu, cntu)
+                    nna = _neighbours(a, fu, nfa, F, fpart, -1, nbu, cntu, pos)
                     for i in range(nna):
                         b = nbu[i]
                         if cdeg[a] == 2 and _edge_key(a, b, n_vert) not in constrained:
@@ -904,8 +906,8 @@ def _group_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _edges_of(F: np.ndarray, n_vert: int):
-    """Per directed face edge: (part, edge key) group id, key, face, forward flag; and the
-    group counts."""
+    """Per face corner k, the edge to the next corner: its two vertices a, b, the face, the
+    undirected key ``min * n_vert + max`` and whether it runs from the lower vertex."""
     a = F.ravel().astype(np.int64)
     b = F[:, [1, 2, 0]].ravel().astype(np.int64)
     face = np.repeat(np.arange(len(F)), 3)
@@ -932,7 +934,8 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     than one part never move. Feature edges (the angle between the orientation-corrected
     normals of their two faces above ``feature_deg`` degrees) and, with ``keep_boundary``,
     boundary edges are kept as polylines: a vertex on two of them only slides along them, a
-    vertex on one or on three or more never moves. ``max_normal_deg`` bounds how far a changed
+    vertex on one or on three or more, or where its polyline turns by more than
+    ``feature_deg``, never moves. ``max_normal_deg`` bounds how far a changed
     face may turn per collapse and from the face it descends from; ``max_depth`` is the
     subdivision depth of the certification (deeper certifies closer to tol, slower);
     ``passes`` is how often the queue is refilled with every remaining half-edge.
@@ -945,8 +948,9 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
 
     Non-manifold input (edges with three or more faces, bow-tie vertices) and duplicate faces
     are accepted: what cannot be collapsed safely is left as it is, duplicate faces are kept
-    once (the others are certified against it), triangles with a repeated vertex index are
-    dropped (they have no area; their ``bounds`` are NaN). Refused with ValueError: arrays of
+    once (the others are certified against it), zero-area triangles keep their vertices in
+    place, triangles with a repeated vertex index are dropped (they have no area; their
+    ``bounds`` are NaN). Refused with ValueError: arrays of
     the wrong shape or type, indices out of range, non-finite coordinates, no triangles, a
     non-positive tol, angles out of range, max_depth outside [0, 12], passes < 1.
     """
@@ -968,11 +972,14 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
 
     # per part tolerance from its bounding box diagonal
     labels, part_index = np.unique(p_orig, return_inverse=True)
-    tol_of_label = np.empty(len(labels))
-    for i, label in enumerate(labels):
-        used = np.unique(t_orig[part_index == i])
-        lo, hi = v_in[used].min(axis=0), v_in[used].max(axis=0)
-        tol_of_label[i] = tol * float(np.linalg.norm(hi - lo)) if relative else tol
+    part_index = part_index.ravel()
+    corner_part = np.repeat(part_index, 3)
+    lo = np.full((len(labels), 3), np.inf)
+    hi = np.full((len(labels), 3), -np.inf)
+    np.minimum.at(lo, corner_part, v_in[t_orig.ravel()])
+    np.maximum.at(hi, corner_part, v_in[t_orig.ravel()])
+    diagonal = np.linalg.norm(hi - lo, axis=1)
+    tol_of_label = tol * diagonal if relative else np.full(len(labels), tol)
 
     used_all = np.unique(t_orig)
     centre = 0.5 * (v_in[used_all].min(axis=0) + v_in[used_all].max(axis=0))
@@ -1060,7 +1067,7 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
         np.add.at(area, F[:, k], face_area)
 
     alive = np.ones(m, np.bool_)
-    orig_tol = tol_of_label[part_index.ravel()]
+    orig_tol = tol_of_label[part_index]
     cos_max = float(np.cos(np.radians(float(max_normal_deg))))
     sup, sup_n, collapses, rejected, n_passes = _decimate(
         V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ckeys, cdeg, Q, area,
