@@ -115,3 +115,46 @@ def test_info_names_the_renderer(capsys):
     assert main(["info"]) == 0
     out = capsys.readouterr().out
     assert "renderer" in out and "moderngl" in out
+
+
+def test_hausdorff_of_a_plate_and_its_lifted_copy(deck, tmp_path, capsys):
+    lifted = tmp_path / "lifted.k"
+    lifted.write_text(DECK.replace("             0.0\n", "             5.0\n"))
+    assert main(["hausdorff", str(deck), str(lifted), "--width", "0"]) == 0
+    out = capsys.readouterr().out
+    assert "5 <= H <= 5 mm" in out and "reached" in out
+
+
+def test_simplify_writes_a_surface_within_the_tolerance(tmp_path, capsys):
+    # a 10 x 10 grid of unit quads, slightly curved: most of it collapses at 2 %
+    rows = ["*KEYWORD", "*NODE"]
+    for j in range(11):
+        for i in range(11):
+            z = 0.01 * (i - 5) ** 2
+            rows.append(f"{j * 11 + i + 1:8d}{i:16.4f}{j:16.4f}{z:16.4f}")
+    rows.append("*ELEMENT_SHELL")
+    for j in range(10):
+        for i in range(10):
+            n = j * 11 + i + 1
+            rows.append(f"{j * 10 + i + 1:8d}{1:8d}{n:8d}{n + 1:8d}{n + 12:8d}{n + 11:8d}")
+    rows.append("*END")
+    deck = tmp_path / "curved.k"
+    deck.write_text("\n".join(rows) + "\n")
+    out = tmp_path / "curved.ply"
+    assert main(["simplify", str(deck), "--tol", "2", "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "200 -> " in printed and out.stat().st_size > 0
+    import trimesh
+
+    from workbench.algo.hausdorff import hausdorff
+    from workbench.scene.io import load
+
+    original = load(deck)
+    simplified = trimesh.load(out, process=False)
+    assert len(simplified.faces) < 200
+    # the written surface is within 2 % of the bounding-sphere diameter of the original
+    lo, hi = original.nodes.min(axis=0), original.nodes.max(axis=0)
+    tol = 0.02 * float(np.linalg.norm(hi - lo))
+    h = hausdorff(original.nodes, original.triangles, np.asarray(simplified.vertices),
+                  np.asarray(simplified.faces), tol=1e-6)
+    assert h.upper <= tol * (1 + 1e-6)
