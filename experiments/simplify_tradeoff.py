@@ -113,10 +113,12 @@ def _diagonal(v: np.ndarray, f: np.ndarray) -> float:
 
 
 def float32_slack(*vertex_arrays) -> float:
-    """How far a float32 tool's distance may stray by rounding alone: 1e-6 (about 8 float32
+    """How far a float32 tool's distance may stray by rounding alone: 1e-5 (about 80 float32
     ulps) of the largest coordinate magnitude. pymeshlab (MeshLab's float scalars) and open3d's
-    raycasting scene compute in float32; a value beyond our bracket by more than this is flagged."""
-    return 1e-6 * max(float(np.abs(v).max()) for v in vertex_arrays)
+    raycasting scene compute in float32, and on a flat plate whose exact distance is 1e-13
+    pymeshlab returns up to 2e-6 of the coordinates; a value beyond our bracket by more than
+    this is flagged."""
+    return 1e-5 * max(float(np.abs(v).max()) for v in vertex_arrays)
 
 
 def measure(model: Model, v: np.ndarray, f: np.ndarray, samples: int, bracket: float) -> dict:
@@ -205,7 +207,8 @@ def metric_rows(quick: bool, say) -> list[dict]:
         brackets[width_pct] = h
         rows.append(dict(pair=f"car {len(f)} → pymeshlab {len(g)} triangles",
                          tool=f"ours, bracket width {width_pct} % of diagonal", value=h.max,
-                         lower=h.lower, upper=h.upper, seconds=h.seconds, samples=h.samples))
+                         lower=h.lower, upper=h.upper, width_reached=h.tol_reached,
+                         seconds=h.seconds, samples=h.samples))
         say(f"  metric: ours {width_pct} %: [{h.lower:.6g}, {h.upper:.6g}] in {h.seconds:.2f} s")
     tight = brackets[min(brackets)]
     slack = float32_slack(v, u)

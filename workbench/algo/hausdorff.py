@@ -43,7 +43,7 @@ from .distance import closest_point_on_triangle, triangle_bounds
 __all__ = ["HausdorffResult", "hausdorff"]
 
 DEFAULT_REL_TOL = 1e-4  # of A's bounding-box diagonal
-DEFAULT_MAX_DEPTH = 10
+DEFAULT_MAX_DEPTH = 16
 MAX_DEPTH_LIMIT = 30
 SPLITS = ("planes", "midpoint")
 # distances closer than this share of the coordinates are equal to rounding
