@@ -15,7 +15,6 @@ Run: ``workbench run render_paths [--quick]`` or ``python experiments/render_pat
 
 from __future__ import annotations
 
-import argparse
 from dataclasses import replace
 from pathlib import Path
 
@@ -25,7 +24,7 @@ from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.compare import compare_images, coverage
 from workbench.experiment.figures import save_field_figure, save_image_grid
 from workbench.experiment.reference import PyrenderReference
-from workbench.experiment.registry import experiment, run_experiment
+from workbench.experiment.registry import experiment, main
 from workbench.experiment.tables import write_table
 from workbench.experiment.timing import time_call, time_draw
 from workbench.gl import Camera, Framebuffer, create_context, renderer
@@ -183,9 +182,4 @@ def _difference(a: np.ndarray, b: np.ndarray, gain: int = 8) -> np.ndarray:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true")
-    parser.add_argument("--figures", default="figures")
-    args = parser.parse_args()
-    rows, out = run_experiment("render_paths", figures_root=Path(args.figures), quick=args.quick, progress=print)
-    print(f"{len(rows)} rows -> {out}")
+    raise SystemExit(main('render_paths', __doc__.splitlines()[0]))

@@ -25,7 +25,6 @@ Run: ``workbench run simplify_tradeoff [--quick]`` or
 
 from __future__ import annotations
 
-import argparse
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,7 +35,7 @@ from workbench.algo.bvh import TriangleBVH
 from workbench.algo.hausdorff import hausdorff
 from workbench.algo.simplify import hausdorff_decimate
 from workbench.data import CAR_DECK, D3PLOT, shared_file
-from workbench.experiment.registry import experiment, run_experiment
+from workbench.experiment.registry import experiment, main
 from workbench.experiment.simplifiers import (SIMPLIFIERS, igl_hausdorff, open3d_distances,
                                               pymeshlab_hausdorff, simplify_with)
 from workbench.experiment.tables import atomic_open, write_table
@@ -288,10 +287,4 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true")
-    parser.add_argument("--figures", default="figures")
-    args = parser.parse_args()
-    rows, out = run_experiment("simplify_tradeoff", figures_root=Path(args.figures),
-                               quick=args.quick, progress=print)
-    print(f"{len(rows)} rows -> {out}")
+    raise SystemExit(main('simplify_tradeoff', __doc__.splitlines()[0]))

@@ -24,7 +24,6 @@ Run: ``workbench run table_quad_strips [--quick]`` or
 
 from __future__ import annotations
 
-import argparse
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,7 +32,7 @@ import numpy as np
 from workbench.algo.strips import quad_strips, tri_strips
 from workbench.data import CAR_DECK, D3PLOT, shared_file
 from workbench.experiment.figures import save_image_grid
-from workbench.experiment.registry import experiment, run_experiment
+from workbench.experiment.registry import experiment, main
 from workbench.experiment.tables import atomic_open, write_table
 from workbench.experiment.timing import time_call, time_draw
 from workbench.gl import Camera, Framebuffer, VertexShaderInvocations, create_context, renderer
@@ -289,10 +288,4 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true")
-    parser.add_argument("--figures", default="figures")
-    args = parser.parse_args()
-    rows, out = run_experiment("table_quad_strips", figures_root=Path(args.figures),
-                               quick=args.quick, progress=print)
-    print(f"{len(rows)} rows -> {out}")
+    raise SystemExit(main('table_quad_strips', __doc__.splitlines()[0]))

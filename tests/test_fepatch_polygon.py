@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from matplotlib.path import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -43,12 +44,8 @@ def interiors_overlap(pts, tris, rel_tol=1e-12):
 
 
 def inside(pts, loop, p):
-    a = pts[loop]
-    b = np.roll(a, -1, axis=0)
-    straddle = (a[:, 1] > p[1]) != (b[:, 1] > p[1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x = a[:, 0] + (p[1] - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
-    return bool(np.count_nonzero(straddle & (x > p[0])) % 2)
+    """Point in polygon by matplotlib's Path (independent of the module's crossing test)."""
+    return bool(Path(pts[loop]).contains_point(p))
 
 
 def angles_deg(pts, tris):

@@ -1,6 +1,8 @@
 """Stripped drawing: quad strips and triangle strips against the unstripped triangle list, and the
 single-pass quad wire frame against the line-overdraw wire frame."""
 
+import functools
+
 import moderngl
 import numpy as np
 import pytest
@@ -11,6 +13,8 @@ from workbench.gl import (Camera, Framebuffer, GLUnavailable, VertexShaderInvoca
                           create_context)
 from workbench.paths import Style, make_path
 from workbench.scene.mesh import FEMesh
+
+from test_paths import render
 
 BACKGROUND = np.array([255, 255, 255, 255], np.uint8)
 SHADED = {"position": None, "flat": None, "gouraud": None, "pixel_color": "h",
@@ -52,16 +56,8 @@ def oblique():
     return Camera.fit(np.array([0.0, 0.0, 0.2]), 1.0, azimuth=25, elevation=35)
 
 
-def draw(ctx, name, mesh, cam, size=160, **style):
-    fb = Framebuffer(ctx, (size, size))
-    path = make_path(name, Style(**style))
-    path.prepare(ctx, mesh, cam)
-    fb.clear()
-    path.draw()
-    image = fb.read()
-    path.release()
-    fb.release()
-    return image, path
+# one image of one path on white, the path released (larger than test_paths' default)
+draw = functools.partial(render, size=160)
 
 
 @pytest.mark.parametrize("name", sorted(SHADED))

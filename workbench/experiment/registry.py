@@ -110,3 +110,18 @@ def run_experiment(name: str, figures_root: Path = Path("figures"), quick: bool 
         raise TypeError(f"experiment {name!r} returned rows that are not dicts: {bad[:3]}")
     write_table(rows, out_dir, "table", title=f"{exp.name}: {exp.description}")
     return rows, out_dir
+
+
+def main(name: str, description: str, argv: list[str] | None = None) -> int:
+    """Command line of an experiment script (``python experiments/<name>.py [--quick]``): run
+    experiment ``name`` into ``--figures`` (default ``figures/``) and print where it went."""
+    import argparse
+
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--quick", action="store_true", help="small sizes and few repetitions")
+    parser.add_argument("--figures", default="figures", help="output folder (default figures/)")
+    args = parser.parse_args(argv)
+    rows, out = run_experiment(name, figures_root=Path(args.figures), quick=args.quick,
+                               progress=print)
+    print(f"{len(rows)} rows -> {out}")
+    return 0
