@@ -16,10 +16,11 @@ shared edge keeps its own element's positive distance, so the edge has no zero c
 at best partly (where the sampled distances dip below the line's half width):
 :func:`checkerboard` reports those edges for drawing as lines.
 
-Where elements of one pair meet (diagonal neighbours on a grid), a texel keeps the values of the
-element it lies deepest inside; within about two texels of a node the diagonal neighbour's field
-can therefore replace an element's own outside the element. The outline stays within a texel of
-the element edges there (the test suite checks this on jittered grids).
+Where elements of one pair meet (diagonal neighbours on a grid), a texel inside one of them keeps
+that element's values and a texel outside all of them the smallest value per channel among those
+that reach it: a channel is then positive only inside the strip of an element's own edges, and
+the diagonal neighbours' fields never make a zero crossing between them. This needs elements
+about three texels across; at two, the rings of opposite edges overlap and outlines break up.
 
 A triangle (a, b, c, c) has edges ab and ca in the first channel and bc alone in the second; the
 two lines in the first channel meet at a, where the bilinear lookup rounds the corner slightly.
@@ -160,7 +161,7 @@ def _edge_lines(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 @njit(cache=True)
-def _raster_wire(lines, pair, valid, box, ring, best, val):  # pragma: no cover - compiled
+def _raster_wire(lines, pair, valid, box, ring, best, val, outside):  # pragma: no cover
     for m in range(lines.shape[0]):
         if not valid[m]:
             continue
@@ -177,10 +178,14 @@ def _raster_wire(lines, pair, valid, box, ring, best, val):  # pragma: no cover 
                 c1 = min(d0, d2)
                 c2 = min(d1, d3)
                 inner = min(c1, c2)
-                if inner >= -ring and inner > best[i, j, p]:
-                    best[i, j, p] = inner
-                    val[i, j, p, 0] = c1
-                    val[i, j, p, 1] = c2
+                if inner >= 0.0:
+                    if inner > best[i, j, p]:
+                        best[i, j, p] = inner
+                        val[i, j, p, 0] = c1
+                        val[i, j, p, 1] = c2
+                elif inner >= -ring:
+                    outside[i, j, p, 0] = min(outside[i, j, p, 0], c1)
+                    outside[i, j, p, 1] = min(outside[i, j, p, 1], c2)
 
 
 def wire_texture(corners_uv, colour, size, wire_range: float = WIRE_RANGE,
@@ -192,8 +197,11 @@ def wire_texture(corners_uv, colour, size, wire_range: float = WIRE_RANGE,
     Each element writes its two channels (see the module docstring) into the pair
     ``WIRE_PAIRS[colour]`` at every texel whose centre lies inside it or at most ``ring`` texels
     outside (the smaller channel ≥ −ring) and within its bounding box grown by ``ring``. Where
-    elements of one pair meet, a texel keeps both channels of the element it lies deepest inside
-    (largest smaller channel). Distances are clamped to ±``wire_range`` texels and stored as
+    elements of one pair meet, a texel inside one of them keeps both channels of the element it
+    lies deepest inside (largest smaller channel); a texel outside all of them keeps, per
+    channel, the smallest value among the elements that reach it, so that no channel turns
+    positive outside every element and two elements meeting at a node draw no spurious
+    diagonals between them. Distances are clamped to ±``wire_range`` texels and stored as
     ``round(127.5 + 127.5·d/wire_range)``; texels no element writes hold −wire_range (byte 0),
     so a ring fades into "outside" without a zero crossing. Elements with fewer than three
     distinct corners or no area write nothing. Refuses bad shapes, non-finite corners, colours
@@ -222,7 +230,10 @@ def wire_texture(corners_uv, colour, size, wire_range: float = WIRE_RANGE,
     # float32 is ample for values quantised to 1/127.5 of wire_range
     best = np.full((h, w, 2), -np.inf, np.float32)
     val = np.full((h, w, 2, 2), -float(wire_range), np.float32)
-    _raster_wire(lines, col.astype(np.int64), valid, box, float(ring), best, val)
+    outside = np.full((h, w, 2, 2), np.inf, np.float32)
+    _raster_wire(lines, col.astype(np.int64), valid, box, float(ring), best, val, outside)
+    use = ~(best >= 0.0) & np.isfinite(outside[..., 0])
+    val[use] = outside[use]
 
     byte = np.clip(np.floor(127.5 + 127.5 * val / wire_range + 0.5), 0, 255).astype(np.uint8)
     tex = np.empty((h, w, 4), np.uint8)

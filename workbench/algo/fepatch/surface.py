@@ -1,0 +1,104 @@
+"""The textured surface that fe2003's render paths draw: triangles with atlas coordinates, the
+two-component normal map and the wire-frame distance texture.
+
+Both the original mesh (every element, split into triangles) and its simplification are
+described this way; vertices are duplicated per subpatch, since a node on a subpatch border has
+one atlas position in each chart.
+
+Texture conventions (shared with the shaders):
+
+* ``uv`` is in texel units: texel (row i, column j) has its centre at (j + ½, i + ½); the GL
+  texture coordinate is ``uv / (W, H)`` with row 0 of the arrays uploaded first.
+* ``normal_map`` (H, W, 2) uint8 holds two components of the unit normal in model coordinates,
+  ``q = round((c + 1)·127.5)``, see :mod:`workbench.algo.fepatch.normalmap`; the vertex's
+  ``normal_axis`` says which component was dropped (0, 1, 2) and is restored as the positive
+  square root.
+* ``wire_map`` (H, W, 4) uint8 holds signed distances in texels, positive inside the outlining
+  element: byte ``b`` stands for ``(b − 127.5)/127.5 · wire_range``. Elements of checkerboard
+  colour 0 write the channel pair (G, B), colour 1 the pair (R, A); in each pair the first channel
+  is the distance to the nearer of the element's edges 0 and 2, the second to the nearer of
+  edges 1 and 3 (a triangle (a, b, c, c): its edges ab and ca, element edges 0 and 3, in the
+  first, bc alone in the second). Where elements of one pair overlap, a texel inside one keeps
+  that element's channels, a texel outside all of them the smallest value per channel; texels
+  no element writes hold −wire_range (byte 0). A fragment is on an outline when, in either pair, one channel is within half a
+  pixel of zero while the other is not below minus half a pixel.
+* ``line_edges`` are element edges the texture cannot show -- two neighbours of the same colour,
+  and the outer boundary, which the texture would draw on its inner half only: they are drawn
+  as lines in the same frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["TexturedSurface", "WIRE_PAIRS"]
+
+WIRE_PAIRS = ((1, 2), (0, 3))  # channels of checkerboard colour 0 (G, B) and colour 1 (R, A)
+
+
+@dataclass
+class TexturedSurface:
+    """Triangles in model units with atlas coordinates and textures (see the module docstring).
+
+    ``positions`` (V, 3) float64 model units; ``triangles`` (T, 3) int32; ``uv`` (V, 2) float64
+    texels; ``normal_axis`` (V,) int8 in 0..2; ``normals`` (V, 3) float64 unit vertex normals or
+    None (needed by per-vertex shading only); ``normal_map`` (H, W, 2) uint8 or None;
+    ``wire_map`` (H, W, 4) uint8 or None; ``wire_range`` texels of byte 0/255; ``line_edges``
+    (E, 2) int32 vertex pairs drawn as lines.
+    """
+
+    positions: np.ndarray
+    triangles: np.ndarray
+    uv: np.ndarray
+    normal_axis: np.ndarray
+    normals: np.ndarray | None = None
+    normal_map: np.ndarray | None = None
+    wire_map: np.ndarray | None = None
+    wire_range: float = 2.0
+    line_edges: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        self.positions = np.asarray(self.positions, np.float64)
+        self.triangles = np.asarray(self.triangles, np.int32).reshape(-1, 3)
+        self.uv = np.asarray(self.uv, np.float64)
+        self.normal_axis = np.asarray(self.normal_axis, np.int8)
+        v = len(self.positions)
+        if self.positions.shape != (v, 3) or self.uv.shape != (v, 2) or \
+                self.normal_axis.shape != (v,):
+            raise ValueError(f"positions (V, 3), uv (V, 2) and normal_axis (V,) must agree, got "
+                             f"{self.positions.shape}, {self.uv.shape}, {self.normal_axis.shape}")
+        if len(self.triangles) and (self.triangles.min() < 0 or self.triangles.max() >= v):
+            raise ValueError(f"triangles index outside 0..{v - 1}")
+        if self.normals is not None:
+            self.normals = np.asarray(self.normals, np.float64)
+            if self.normals.shape != (v, 3):
+                raise ValueError(f"normals must be (V, 3), got {self.normals.shape}")
+        for name, channels in (("normal_map", 2), ("wire_map", 4)):
+            tex = getattr(self, name)
+            if tex is not None:
+                tex = np.asarray(tex)
+                if tex.dtype != np.uint8 or tex.ndim != 3 or tex.shape[2] != channels:
+                    raise ValueError(f"{name} must be (H, W, {channels}) uint8, got "
+                                     f"{tex.shape} {tex.dtype}")
+                setattr(self, name, tex)
+        if self.normal_map is not None and self.wire_map is not None and \
+                self.normal_map.shape[:2] != self.wire_map.shape[:2]:
+            raise ValueError("normal_map and wire_map must share the atlas size")
+        if self.line_edges is None:
+            self.line_edges = np.zeros((0, 2), np.int32)
+        self.line_edges = np.asarray(self.line_edges, np.int32).reshape(-1, 2)
+        if not self.wire_range > 0:
+            raise ValueError(f"wire_range must be positive, got {self.wire_range}")
+
+    @property
+    def size(self) -> tuple[int, int] | None:
+        """(W, H) of the atlas, None without textures."""
+        tex = self.wire_map if self.wire_map is not None else self.normal_map
+        return None if tex is None else (tex.shape[1], tex.shape[0])
+
+    @property
+    def texture_bytes(self) -> int:
+        """Bytes of both textures."""
+        return sum(t.nbytes for t in (self.normal_map, self.wire_map) if t is not None)
