@@ -45,6 +45,7 @@ class Atlas:
 
     size: tuple[int, int]
     scale: float
+    scales: dict  # {label: (s_u, s_v)} texels per model unit along the plane axes
     border: int
     offsets: dict
     extents: dict
@@ -61,9 +62,27 @@ def _min_projected_edge(c2: np.ndarray, elements_local: np.ndarray) -> float:
     return float(d.min()) if d.size else np.inf
 
 
+def _min_extents(c2: np.ndarray, elements_local: np.ndarray) -> np.ndarray:
+    """(2,) the smallest non-zero extent of any element along each plane axis."""
+    corners = c2[elements_local]
+    ext = corners.max(axis=1) - corners.min(axis=1)
+    out = np.full(2, np.inf)
+    for k in range(2):
+        positive = ext[:, k][ext[:, k] > 0]
+        if positive.size:
+            out[k] = positive.min()
+    return out
+
+
 def build_atlas(coords, elements, labels, *, texels_per_edge: float = 2.0, border: int = 2,
-                width: int | None = None) -> Atlas:
+                width: int | None = None, per_subpatch: bool = False,
+                max_scale: float | None = None) -> Atlas:
     """Project every subpatch of ``labels`` ((M,) per element) onto its plane and pack them.
+
+    With ``per_subpatch`` each subpatch gets its own scale per plane axis, so that its smallest
+    element extent along that axis spans ``texels_per_edge`` texels (the paper's per-dimension
+    factors); ``scales`` then holds {label: (s_u, s_v)} and ``scale`` their smallest value.
+    ``max_scale`` (texels per model unit) caps the scales, for elements collapsed along an axis.
 
     ``coords`` (N, 3) float64, ``elements`` (M, 4) node indices (a triangle repeats its third
     node). ``width`` of the atlas in texels defaults to the square root of the rectangles' total
@@ -87,10 +106,23 @@ def build_atlas(coords, elements, labels, *, texels_per_edge: float = 2.0, borde
     if not np.isfinite(min_edge) or min_edge <= 0:
         raise ValueError("no element has a projected edge of non-zero length")
     scale = texels_per_edge / min_edge
+    if max_scale is not None:
+        scale = min(scale, max_scale)
+    scales = {}
+    for label, (nodes, c2) in local.items():
+        if per_subpatch:
+            sel = e[lab == label]
+            ext = _min_extents(c2, np.searchsorted(nodes, sel))
+            su = np.where(np.isfinite(ext), texels_per_edge / ext, scale)
+            if max_scale is not None:
+                su = np.minimum(su, max_scale)
+            scales[label] = (float(su[0]), float(su[1]))
+        else:
+            scales[label] = (scale, scale)
     rects = {}
     for label, (nodes, c2) in local.items():
         lo, hi = c2.min(axis=0), c2.max(axis=0)
-        w, h = np.ceil((hi - lo) * scale).astype(int) + 1 + 2 * border
+        w, h = np.ceil((hi - lo) * np.array(scales[label])).astype(int) + 1 + 2 * border
         rects[label] = (int(w), int(h), lo)
     total = sum(w * h for w, h, _ in rects.values())
     if width is None:
@@ -107,10 +139,12 @@ def build_atlas(coords, elements, labels, *, texels_per_edge: float = 2.0, borde
         offsets[label] = (x, y)
         extents[label] = (w, h)
         nodes, c2 = local[label]
-        uv[label] = (nodes, (c2 - lo) * scale + border + np.array([x, y]))
+        uv[label] = (nodes, (c2 - lo) * np.array(scales[label]) + border + np.array([x, y]))
         x += w
         shelf = max(shelf, h)
     height = y + shelf
-    return Atlas(size=(int(width), int(height)), scale=float(scale), border=int(border),
+    return Atlas(size=(int(width), int(height)),
+                 scale=float(min(min(v) for v in scales.values())), scales=scales,
+                 border=int(border),
                  offsets=offsets, extents=extents, uv=uv,
                  texels_per_element=width * height / len(e), fill=total / (width * height))

@@ -1,0 +1,535 @@
+"""fe2003's preprocessing, stage by stage: from an FE shell mesh to a simplified surface with a
+normal map and a wire-frame texture, and the original mesh with the same wire-frame texture.
+
+Stages (timed separately, as in the paper's Table 2):
+
+1. **features, subpatches, lines** -- G0/G1/closing feature edges, feature-divided patches,
+   least-squares planar subpatches within ``d``, the line network of subpatch borders, and its
+   simplification within eq. 1's bound (a node where the line's neighbourhood changes -- three
+   or more border edges, or other subpatches on either side -- is fixed).
+2. **retriangulation** -- each subpatch's border loops, with the removed line nodes left out,
+   projected on its plane and triangulated by hole bridging and ear clipping. A subpatch whose
+   loops are not simple polygons in its plane (a fold, a pinch, a line simplified into its
+   neighbour) keeps its original elements, and its border lines are restored in every
+   neighbour, so that no crack opens between them; this repeats until no subpatch fails.
+3. **textures** -- the atlas of the subpatch planes, the two-component normal map of the
+   original crease-split vertex normals (dilated at subpatch borders) and the wire-frame
+   distance texture of every original element.
+
+Everything is float64 and GL-free; the result is two :class:`TexturedSurface`: ``original``
+(every element, triangulated) and ``simplified``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...scene.derived import _as_coords, _as_elements, gouraud_split, triangulate
+from .atlas import build_atlas, plane_frames
+from .features import G0, feature_edges, patches, planar_subpatches
+from .lines import line_tolerance, simplify_polyline
+from .normalmap import dropped_axis
+from .polygon import polygon_area, triangulate_polygon
+from .surface import TexturedSurface
+
+__all__ = ["FEPatchParams", "PARAMETER_SETS", "FEModel", "parse_params", "build_model",
+           "border_network", "simplified_triangles"]
+
+STAGES = ("features, subpatches, lines", "retriangulation", "textures")
+
+
+@dataclass(frozen=True)
+class FEPatchParams:
+    """fe2003 Table 1 parameters: G1 angle (degrees), subpatch distance ``d`` and line bounds
+    ``l_outer``/``l_inner`` (model units)."""
+
+    alpha_g1_deg: float
+    d: float
+    l_outer: float
+    l_inner: float
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.alpha_g1_deg < 180.0:
+            raise ValueError(f"alpha_g1_deg must be in (0, 180), got {self.alpha_g1_deg}")
+        for key in ("d", "l_outer", "l_inner"):
+            if not np.isfinite(getattr(self, key)) or getattr(self, key) < 0:
+                raise ValueError(f"{key} must be finite and >= 0, got {getattr(self, key)}")
+
+    @property
+    def label(self) -> str:
+        return self.name or (f"{self.alpha_g1_deg:g},{self.d:g},{self.l_outer:g},"
+                             f"{self.l_inner:g}")
+
+
+PARAMETER_SETS = {"A": FEPatchParams(12.0, 1.0, 0.5, 8.0, "A"),
+                  "B": FEPatchParams(18.0, 3.0, 2.5, 15.0, "B")}
+
+
+def parse_params(spec) -> FEPatchParams:
+    """``"A"``, ``"B"``, ``"alpha_g1,d,l_outer,l_inner"`` or an :class:`FEPatchParams`."""
+    if isinstance(spec, FEPatchParams):
+        return spec
+    text = str(spec).strip()
+    if text.upper() in PARAMETER_SETS:
+        return PARAMETER_SETS[text.upper()]
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) != 4:
+        raise ValueError(f"fe2003 parameters must be 'A', 'B' or 'alpha_g1,d,l_outer,l_inner', "
+                         f"got {spec!r}")
+    return FEPatchParams(*values)
+
+
+@dataclass
+class FEModel:
+    """The result of :func:`build_model`: both surfaces and what each stage did.
+
+    ``seconds`` per stage of :data:`STAGES`; ``subpatch`` (M,) labels; ``fallback`` the labels of
+    subpatches kept as original elements; counts of features, patches, lines and line nodes.
+    """
+
+    params: FEPatchParams
+    original: TexturedSurface
+    simplified: TexturedSurface
+    subpatch: np.ndarray
+    n_elements: int
+    n_patches: int
+    n_subpatches: int
+    features: dict
+    line_nodes: int
+    line_nodes_kept: int
+    n_lines: int
+    fallback: np.ndarray
+    atlas_size: tuple[int, int]
+    seconds: dict = field(default_factory=dict)
+
+    @property
+    def rgba_texels_per_element(self) -> float:
+        """Texture memory of both maps in RGBA texels (4 bytes) per original element."""
+        return self.simplified.texture_bytes / 4.0 / max(self.n_elements, 1)
+
+
+# --------------------------------------------------------------------------- line network
+@dataclass
+class BorderNetwork:
+    """Subpatch borders: directed border edges per subpatch and the undirected line network.
+
+    ``directed`` (B, 3) rows (a, b, subpatch) in element winding; ``bad`` labels of subpatches
+    with an edge used three or more times inside them; ``lines`` list of (node array, closed,
+    subpatch labels); ``fixed`` (N,) bool.
+    """
+
+    directed: np.ndarray
+    bad: np.ndarray
+    lines: list
+    fixed: np.ndarray
+
+
+def _border_edges(elements, labels, n_nodes: int) -> tuple[np.ndarray, np.ndarray]:
+    """((B, 3) directed border edges (a, b, subpatch) in element winding, labels of subpatches
+    with an edge used three or more times inside them)."""
+    e = np.asarray(elements, np.int64)
+    lab = np.asarray(labels, np.int64)
+    a = e.ravel()
+    b = e[:, [1, 2, 3, 0]].ravel()
+    s = np.repeat(lab, 4)
+    ok = a != b
+    a, b, s = a[ok], b[ok], s[ok]
+    key = np.minimum(a, b) * n_nodes + np.maximum(a, b)
+    order = np.lexsort((key, s))
+    ks, kk = s[order], key[order]
+    start = np.r_[True, (ks[1:] != ks[:-1]) | (kk[1:] != kk[:-1])]
+    group = np.cumsum(start) - 1
+    per = np.bincount(group)[group]
+    border = order[per == 1]
+    return np.c_[a[border], b[border], s[border]], np.unique(ks[per >= 3])
+
+
+def unpinched(elements, labels, n_nodes: int, rounds: int = 8) -> np.ndarray:
+    """``labels`` with pinches removed: where a subpatch's border passes a node twice (the
+    subpatch touches itself there), its elements at that node become subpatches of their own,
+    for a few rounds. Returns (M,) int64 labels 0..S-1."""
+    lab = np.asarray(labels, np.int64).copy()
+    e = np.asarray(elements, np.int64)
+    for _ in range(rounds):
+        directed, _ = _border_edges(e, lab, n_nodes)
+        key = directed[:, 2] * n_nodes + directed[:, 0]
+        u, count = np.unique(key, return_counts=True)
+        pinch = u[count > 1]
+        if not len(pinch):
+            break
+        corner_key = lab[:, None] * n_nodes + e
+        hit = np.isin(corner_key, pinch).any(axis=1)
+        idx = np.flatnonzero(hit)
+        lab[idx] = lab.max() + 1 + np.arange(len(idx))
+    _, lab = np.unique(lab, return_inverse=True)
+    return lab.astype(np.int64)
+
+
+def border_network(elements, labels, n_nodes: int) -> BorderNetwork:
+    """The borders of the subpatches ``labels`` ((M,) per element) of ``elements`` (M, 4): an
+    element edge is a border edge of subpatch s when s's elements use it once. Lines run between
+    fixed nodes: nodes with other than two border edges, or whose two border edges separate
+    other subpatches; closed lines without a fixed node are reported with ``closed`` True."""
+    directed, bad = _border_edges(elements, labels, n_nodes)
+    a, b, s = directed[:, 0], directed[:, 1], directed[:, 2]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    key = lo * n_nodes + hi
+    # undirected line network: unique border edges with their subpatch signature
+    ukey, inverse, ucount = np.unique(key, return_inverse=True, return_counts=True)
+    bs = s
+    smin = np.full(len(ukey), np.iinfo(np.int64).max)
+    smax = np.full(len(ukey), -1)
+    np.minimum.at(smin, inverse, bs)
+    np.maximum.at(smax, inverse, bs)
+    ulo, uhi = ukey // n_nodes, ukey % n_nodes
+    sig = np.c_[ucount, smin, smax]
+    degree = np.bincount(np.r_[ulo, uhi], minlength=n_nodes)
+    fixed = degree != 2
+    fixed &= degree > 0
+    # degree-2 nodes whose two edges carry different signatures are fixed too
+    ends = np.r_[ulo, uhi]
+    eid = np.r_[np.arange(len(ukey)), np.arange(len(ukey))]
+    o = np.argsort(ends, kind="stable")
+    ends_s, eid_s = ends[o], eid[o]
+    first = np.searchsorted(ends_s, np.arange(n_nodes))
+    two = np.flatnonzero(degree == 2)
+    e1, e2 = eid_s[first[two]], eid_s[first[two] + 1]
+    fixed[two[(sig[e1] != sig[e2]).any(axis=1)]] = True
+    # walk the lines
+    deg_first = first
+    visited = np.zeros(len(ukey), bool)
+    lines = []
+
+    def other(edge: int, node: int) -> int:
+        return int(uhi[edge] if ulo[edge] == node else ulo[edge])
+
+    def walk(node: int, edge: int) -> list[int]:
+        nodes = [node]
+        while True:
+            visited[edge] = True
+            node = other(edge, node)
+            nodes.append(node)
+            if fixed[node]:
+                return nodes
+            f = deg_first[node]
+            nxt = eid_s[f] if eid_s[f] != edge else eid_s[f + 1]
+            if visited[nxt]:
+                return nodes  # closed line back at its start
+            edge = int(nxt)
+
+    for node in np.flatnonzero(fixed):
+        f = deg_first[node]
+        for k in range(degree[node]):
+            edge = int(eid_s[f + k])
+            if not visited[edge]:
+                nodes = walk(int(node), edge)
+                lines.append((np.array(nodes), False, _labels_of(sig[edge])))
+    for edge in np.flatnonzero(~visited):
+        if visited[edge]:
+            continue
+        nodes = walk(int(ulo[edge]), int(edge))
+        if nodes[-1] == nodes[0]:
+            nodes = nodes[:-1]
+        lines.append((np.array(nodes), True, _labels_of(sig[edge])))
+    return BorderNetwork(directed=directed, bad=bad, lines=lines, fixed=fixed)
+
+
+def _labels_of(sig) -> tuple[int, ...]:
+    count, lo, hi = (int(v) for v in sig)
+    if count == 1:
+        return (lo,)
+    if count == 2:
+        return (lo, hi)
+    return (lo, hi) + (-1,) * (count - 2)  # non-manifold: more than two subpatches
+
+
+def _simplify_lines(network: BorderNetwork, coords, frames, params) -> np.ndarray:
+    """(N,) bool: nodes removed from the line network.
+
+    Two lines between the same two fixed nodes would both become the same chord and close
+    nothing: each of them keeps at least its node farthest from the chord. A line that returns
+    to its start node is simplified as a closed line around it.
+    """
+    removed = np.zeros(len(coords), bool)
+    pairs: dict = {}
+    for nodes, closed, _ in network.lines:
+        if not closed:
+            key = (min(nodes[0], nodes[-1]), max(nodes[0], nodes[-1]))
+            pairs[key] = pairs.get(key, 0) + 1
+    for nodes, closed, labels in network.lines:
+        fixed = None
+        if not closed and nodes[0] == nodes[-1]:
+            nodes, closed = nodes[:-1], True
+            fixed = np.zeros(len(nodes), bool)
+            fixed[0] = True
+        if len(labels) > 2 or len(nodes) < (4 if closed else 3):
+            continue
+        normals = [frames[s][1][2] for s in labels]
+        if len(labels) == 1:
+            tol = params.l_outer
+        else:
+            tol = line_tolerance(normals[0], normals[1], params.l_inner, params.l_outer)
+        points = coords[nodes]
+        if not closed and pairs[(min(nodes[0], nodes[-1]), max(nodes[0], nodes[-1]))] > 1:
+            chord = points[-1] - points[0]
+            off = points - points[0]
+            length = np.linalg.norm(chord)
+            dist = np.linalg.norm(off if length == 0 else np.cross(off, chord / length), axis=1)
+            fixed = np.zeros(len(nodes), bool)
+            fixed[int(np.argmax(dist[1:-1])) + 1] = True
+        planes = [(n, -float(n @ frames[s][0])) for n, s in zip(normals, labels)]
+        keep = simplify_polyline(points, tol, fixed=fixed, planes=planes, d=params.d,
+                                 closed=closed)
+        gone = np.ones(len(nodes), bool)
+        gone[keep] = False
+        removed[nodes[gone]] = True
+    return removed
+
+
+# --------------------------------------------------------------------------- retriangulation
+def _loops(directed: np.ndarray) -> list[np.ndarray] | None:
+    """Closed node loops of one subpatch's directed border edges; None where a node has two
+    outgoing edges or an edge leads nowhere (pinched or inconsistently wound borders)."""
+    a, b = directed[:, 0], directed[:, 1]
+    if len(np.unique(a)) != len(a):
+        return None
+    succ = dict(zip(a.tolist(), b.tolist()))
+    seen = set()
+    loops = []
+    for start in a.tolist():
+        if start in seen:
+            continue
+        loop = [start]
+        seen.add(start)
+        node = succ[start]
+        while node != start:
+            if node in seen or node not in succ:
+                return None
+            loop.append(node)
+            seen.add(node)
+            node = succ[node]
+        loops.append(np.array(loop))
+    return loops
+
+
+def _triangulate_subpatch(loops, removed, coords, frame) -> np.ndarray | None:
+    """(K, 3) node triangles of one subpatch's simplified loops in its plane, wound like the
+    elements; None when the loops do not form a simple polygon with holes."""
+    kept = [loop[~removed[loop]] for loop in loops]
+    if any(len(k) < 3 for k in kept):
+        return None
+    nodes = np.concatenate(kept)
+    origin, axes = frame
+    pts = (coords[nodes] - origin) @ axes[:2].T
+    local, start = [], 0
+    for k in kept:
+        local.append(np.arange(start, start + len(k)))
+        start += len(k)
+    areas = [polygon_area(pts, loop) for loop in local]
+    outer = int(np.argmax(np.abs(areas)))
+    holes = [loop for i, loop in enumerate(local) if i != outer]
+    # a hole runs against the outer loop when the elements are wound consistently
+    if any(np.sign(areas[i]) == np.sign(areas[outer]) for i in range(len(local)) if i != outer):
+        return None
+    try:
+        tri = triangulate_polygon(pts, local[outer], holes)
+    except ValueError:
+        return None
+    if areas[outer] < 0:  # elements wound clockwise in this frame
+        tri = tri[:, ::-1]
+    return nodes[tri]
+
+
+def simplified_triangles(elements, coords, labels, network: BorderNetwork,
+                         removed: np.ndarray, frames) -> tuple[dict, np.ndarray, np.ndarray]:
+    """({label: (K, 3) node triangles}, fallback labels, final ``removed``): every subpatch
+    retriangulated from its simplified border loops; those that fail keep their original
+    element triangles and restore their border nodes, which re-triangulates the neighbours."""
+    e = np.asarray(elements, np.int64)
+    lab = np.asarray(labels, np.int64)
+    removed = removed.copy()
+    d = network.directed
+    order = np.argsort(d[:, 2], kind="stable")
+    d = d[order]
+    bounds = np.searchsorted(d[:, 2], np.arange(lab.max() + 2))
+    loops = {}
+    for s in range(lab.max() + 1):
+        if bounds[s] == bounds[s + 1]:
+            continue
+        loops[s] = None if s in set(network.bad.tolist()) else _loops(d[bounds[s]:bounds[s + 1]])
+    result: dict = {}
+    failed: set[int] = set()  # kept as original elements
+    restored: set[int] = set()  # border lines restored after a failure with simplified ones
+    todo = set(loops)
+    while todo:
+        new_fail = []
+        for s in sorted(todo):
+            tri = None if loops[s] is None else _triangulate_subpatch(loops[s], removed, coords,
+                                                                    frames[s])
+            if tri is None:
+                new_fail.append(s)
+            else:
+                result[s] = tri
+        todo = set()
+        restore = []
+        for s in new_fail:
+            result.pop(s, None)
+            if s in restored or loops[s] is None:
+                failed.add(s)
+            else:
+                restored.add(s)
+                todo.add(s)
+            nodes = np.unique(d[bounds[s]:bounds[s + 1], :2])
+            restore.append(nodes[removed[nodes]])
+        restore = np.concatenate(restore) if restore else np.zeros(0, np.int64)
+        if len(restore):
+            removed[restore] = False
+            mark = np.zeros(len(removed), bool)
+            mark[restore] = True
+            touched = np.unique(d[mark[d[:, 0]] | mark[d[:, 1]], 2])
+            todo |= {int(s) for s in touched if s not in failed}
+    fallback = np.array(sorted(failed), np.int64)
+    if len(fallback):
+        tri = triangulate(e, coords)
+        of = lab[tri.element_of]
+        for s in fallback:
+            result[int(s)] = tri.triangles[of == s].astype(np.int64)
+    return result, fallback, removed
+
+
+# --------------------------------------------------------------------------- textures
+def _corner_normals(e: np.ndarray, coords: np.ndarray, crease_deg: float,
+                    plane_normal: np.ndarray) -> np.ndarray:
+    """(M, 4, 3) unit normals at the element corners, smooth across edges flatter than
+    ``crease_deg``; a zero normal (degenerate element) takes its subpatch's plane normal."""
+    split = gouraud_split(e, [coords], crease_deg, triangulate(e, coords))
+    n = split.normals(coords)[split.elements]
+    zero = np.linalg.norm(n, axis=2) < 0.5
+    if zero.any():
+        rows = np.nonzero(zero)[0]
+        n[zero] = plane_normal[rows]
+    return n
+
+
+def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, border: int = 3,
+                wire_range: float = 2.0, atlas_scale: str = "subpatch") -> FEModel:
+    """Run every stage on ``elements`` (M, 4) and ``coords`` (N, 3) float64 (model units).
+
+    ``params``: see :func:`parse_params`. ``texels_per_edge``: texels across the smallest element
+    (the paper's Nyquist rule asks for 2; the wire texture's outlines stay whole from about 3,
+    see :mod:`workbench.algo.fepatch.wiretex`); ``border``: texels around each subpatch in the
+    atlas (the wire texture's ring and the normal map's dilation); ``atlas_scale``: "subpatch" (one scale per subpatch and axis, as the
+    paper) or "global". Refuses empty meshes and non-finite coordinates.
+    """
+    from .bake import normal_map
+    from .wiretex import checkerboard, wire_texture
+
+    p = parse_params(params)
+    e = _as_elements(elements).astype(np.int64)
+    c = _as_coords(coords, e)
+    if len(e) == 0:
+        raise ValueError("the mesh has no elements")
+    seconds = {}
+    t0 = time.perf_counter()
+    fe = feature_edges(e, c, p.alpha_g1_deg)
+    patch = patches(e, fe)
+    sub = unpinched(e, planar_subpatches(e, c, patch, p.d), len(c))
+    frames = plane_frames(c, e, sub)
+    network = border_network(e, sub, len(c))
+    removed = _simplify_lines(network, c, frames, p)
+    seconds[STAGES[0]] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    tris, fallback, removed = simplified_triangles(e, c, sub, network, removed, frames)
+    seconds[STAGES[1]] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    atlas = build_atlas(c, e, sub, texels_per_edge=texels_per_edge, border=border,
+                        per_subpatch=atlas_scale == "subpatch")
+    labels = sorted(atlas.uv)
+    # vertices: one per (subpatch, node) of the atlas
+    vnodes = [atlas.uv[s][0] for s in labels]
+    offsets = np.cumsum([0] + [len(v) for v in vnodes])
+    start = dict(zip(labels, offsets[:-1]))
+    node_of = np.concatenate(vnodes)
+    uv = np.concatenate([atlas.uv[s][1] for s in labels])
+    label_of = np.repeat(labels, [len(v) for v in vnodes])
+    plane_n = np.array([frames[s][1][2] for s in range(len(frames))])
+    axis_of_label = dropped_axis(plane_n)
+    normal_axis = axis_of_label[label_of]
+
+    def vertex(s_arr, n_arr):
+        """Vertex ids of (subpatch, node) pairs."""
+        out = np.empty(n_arr.shape, np.int64)
+        for s in np.unique(s_arr):
+            sel = s_arr == s
+            out[sel] = start[int(s)] + np.searchsorted(vnodes[labels.index(int(s))], n_arr[sel])
+        return out
+
+    corner_vertex = vertex(np.repeat(sub, 4).reshape(-1, 4), e)
+    corners_uv = uv[corner_vertex]
+    corner_n = _corner_normals(e, c, p.alpha_g1_deg, plane_n[sub])
+    vertex_normals = np.zeros((len(node_of), 3))
+    vertex_normals[corner_vertex.ravel()] = corner_n.reshape(-1, 3)
+    size = atlas.size
+    nmap = normal_map(corners_uv, corner_n, axis_of_label[sub], size, dilate=border)
+    colour, line_nodes = checkerboard(e)
+    wmap = wire_texture(corners_uv, colour, size, wire_range=wire_range)
+    seconds[STAGES[2]] = time.perf_counter() - t0
+
+    # the line pass: edges the texture cannot show (same-colour neighbours) and the outer
+    # boundary, whose outline the texture could draw only on its inner half
+    line_nodes = np.concatenate([np.asarray(line_nodes, np.int64).reshape(-1, 2),
+                                 fe.of_kind(G0).astype(np.int64)])
+    line_edges = _edge_vertices(e, corner_vertex, line_nodes, len(c))
+    orig_tri = triangulate(e, c)
+    original = TexturedSurface(
+        positions=c[node_of], triangles=_element_triangles(corner_vertex, orig_tri),
+        uv=uv, normal_axis=normal_axis, normals=vertex_normals, normal_map=nmap,
+        wire_map=wmap, wire_range=wire_range, line_edges=line_edges)
+    # simplified: the same vertices, only those the new triangles (and the line pass) use
+    s_tri = np.concatenate([vertex(np.full(t.shape, s), t) for s, t in sorted(tris.items())])
+    used = np.zeros(len(node_of), bool)
+    used[s_tri.ravel()] = True
+    used[line_edges.ravel()] = True
+    remap = np.cumsum(used) - 1
+    simplified = TexturedSurface(
+        positions=c[node_of[used]], triangles=remap[s_tri], uv=uv[used],
+        normal_axis=normal_axis[used], normals=vertex_normals[used], normal_map=nmap,
+        wire_map=wmap, wire_range=wire_range, line_edges=remap[line_edges])
+    on_lines = np.unique(np.concatenate([n for n, _, _ in network.lines])) if network.lines \
+        else np.zeros(0, np.int64)
+    return FEModel(
+        params=p, original=original, simplified=simplified, subpatch=sub, n_elements=len(e),
+        n_patches=int(patch.max()) + 1, n_subpatches=int(sub.max()) + 1,
+        features=fe.counts(), line_nodes=len(on_lines),
+        line_nodes_kept=int(len(on_lines) - removed[on_lines].sum()), n_lines=len(network.lines),
+        fallback=fallback, atlas_size=size, seconds=seconds)
+
+
+def _edge_vertices(e: np.ndarray, corner_vertex: np.ndarray, pairs: np.ndarray,
+                   n_nodes: int) -> np.ndarray:
+    """(K, 2) vertex pairs of node ``pairs``: the corners of the first element using each edge."""
+    if not len(pairs):
+        return np.zeros((0, 2), np.int64)
+    a, b = e.ravel(), e[:, [1, 2, 3, 0]].ravel()
+    key = np.minimum(a, b) * n_nodes + np.maximum(a, b)
+    order = np.argsort(key, kind="stable")
+    want = np.unique(np.minimum(pairs[:, 0], pairs[:, 1]) * n_nodes
+                     + np.maximum(pairs[:, 0], pairs[:, 1]))
+    slot = order[np.searchsorted(key[order], want)]
+    va = corner_vertex.ravel()[slot]
+    vb = corner_vertex[:, [1, 2, 3, 0]].ravel()[slot]
+    return np.c_[va, vb]
+
+
+def _element_triangles(corner_vertex: np.ndarray, tri) -> np.ndarray:
+    """The triangulation's triangles with element corners replaced by (subpatch, node) vertices."""
+    return corner_vertex[tri.element_of[:, None], tri.corners.astype(np.intp)]
