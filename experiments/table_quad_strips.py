@@ -31,6 +31,7 @@ import numpy as np
 
 from workbench.algo.strips import quad_strips, tri_strips
 from workbench.data import CAR_DECK, D3PLOT, shared_file
+from workbench.experiment.compare import wire_agreement
 from workbench.experiment.figures import save_image_grid
 from workbench.experiment.registry import experiment, main
 from workbench.experiment.tables import atomic_open, write_table
@@ -229,21 +230,6 @@ def draw_rows(ctx, model: Model, size, repeat: int, say) -> tuple[list[dict], di
     wire = wire_agreement(single, overdraw, Style().wire_color)
     by["quad_wire (single pass)"].update(baseline="list + line-overdraw wire", **wire)
     return rows, images
-
-
-def wire_agreement(single: np.ndarray, overdraw: np.ndarray, wire_color) -> dict:
-    """How the single-pass wire pixels agree with the line-overdraw wire pixels: recall (overdraw
-    pixels with a single-pass pixel within one pixel), precision (the converse), counts."""
-    from skimage.morphology import dilation, footprint_rectangle
-
-    colour = np.round(np.asarray(wire_color) * 255).astype(np.uint8)
-    a = (single[..., :3] == colour).all(axis=-1)
-    b = (overdraw[..., :3] == colour).all(axis=-1)
-    near = footprint_rectangle((3, 3))
-    return dict(wire_pixels=int(a.sum()), overdraw_wire_pixels=int(b.sum()),
-                wire_recall_1px=float((b & dilation(a, near)).sum() / max(b.sum(), 1)),
-                wire_precision_1px=float((a & dilation(b, near)).sum() / max(a.sum(), 1)),
-                wire_exact_overlap=float((a & b).sum() / max((a | b).sum(), 1)))
 
 
 @experiment("table_quad_strips", "crash2000 Table 1: quad strips by bandification against "

@@ -14,7 +14,7 @@ from workbench.gl import Camera, Framebuffer, GLUnavailable, create_context
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from workbench.paths import PATHS, ColorScale, Style, colormap_lut, make_path, scale_for
+from workbench.paths import PATHS, ColorScale, MeshPath, Style, colormap_lut, make_path, scale_for
 from workbench.paths.fields import provoking_vertices
 from workbench.scene.mesh import FEMesh
 
@@ -23,6 +23,9 @@ BACKGROUND = np.array([255, 255, 255, 255], np.uint8)
 FIELD_PATHS = {"vertex_color": "x", "pixel_color": "x", "element_color": "cell"}
 # quad_wire draws its own wire frame in the fill pass and refuses the line-overdraw one
 LINE_WIRE = {name: name != "quad_wire" for name in PATHS}
+# the paths that draw any FE mesh directly (the fe2003 texture paths draw a preprocessed surface
+# of one configuration and are tested in test_fetexture_paths)
+MESH_PATHS = sorted(name for name, cls in PATHS.items() if issubclass(cls, MeshPath))
 
 
 @pytest.fixture(scope="module")
@@ -81,7 +84,10 @@ def colors(image, mask):
 # --------------------------------------------------------------------------- registry, errors
 def test_registry_and_bad_names():
     assert set(PATHS) == {"position", "flat", "gouraud", "vertex_color", "pixel_color",
-                          "element_color", "quad_wire"}
+                          "element_color", "quad_wire", "fe_wire_texture", "fe_normal_map",
+                          "fe_normal_wire"}
+    assert MESH_PATHS == sorted(set(PATHS) - {"fe_wire_texture", "fe_normal_map",
+                                              "fe_normal_wire"})
     with pytest.raises(ValueError, match="known paths"):
         make_path("phong")
     for name, cls in PATHS.items():
@@ -142,7 +148,7 @@ def test_scale_for_defaults_to_field_range():
 
 
 # --------------------------------------------------------------------------- coverage
-@pytest.mark.parametrize("name", sorted(PATHS))
+@pytest.mark.parametrize("name", MESH_PATHS)
 def test_quad_covers_known_pixels_only(ctx, name):
     # the quad [-0.5, 0.5]² covers pixels 16..47 in rows and columns; nothing else is touched
     image, path = render(ctx, name, grid(), camera(), field=FIELD_PATHS.get(name))
@@ -455,7 +461,7 @@ def two_step_mesh():
                   element_fields={"cell": np.array([[0.0], [1.0]])})
 
 
-@pytest.mark.parametrize("name", sorted(PATHS))
+@pytest.mark.parametrize("name", MESH_PATHS)
 def test_magnification_moves_by_multiple_of_displacement(ctx, name):
     mesh = two_step_mesh()
     for magnification, cols in ((1.0, (20, 52)), (2.0, (24, 56)), (0.0, (16, 48))):
@@ -465,7 +471,7 @@ def test_magnification_moves_by_multiple_of_displacement(ctx, name):
         assert (c.min(), c.max() + 1) == cols, magnification
 
 
-@pytest.mark.parametrize("name", sorted(PATHS))
+@pytest.mark.parametrize("name", MESH_PATHS)
 def test_set_step_uploads_coordinates_only(ctx, name, monkeypatch):
     mesh = two_step_mesh()
     fb = Framebuffer(ctx, (SIZE, SIZE))
@@ -560,7 +566,7 @@ def curved_mesh(offset=(0.0, 0.0, 0.0)):
     return mesh
 
 
-@pytest.mark.parametrize("name", sorted(PATHS))
+@pytest.mark.parametrize("name", MESH_PATHS)
 def test_far_translation_renders_same_image(ctx, name):
     near, far = curved_mesh(), curved_mesh((1e6, 1e6, 1e6))
     images = []
@@ -576,7 +582,7 @@ def test_far_translation_renders_same_image(ctx, name):
     assert differ.mean() <= 0.005
 
 
-@pytest.mark.parametrize("name", sorted(PATHS))
+@pytest.mark.parametrize("name", MESH_PATHS)
 def test_repeated_draws_are_byte_identical(ctx, name):
     mesh = curved_mesh()
     fb = Framebuffer(ctx, (SIZE, SIZE))

@@ -123,3 +123,32 @@ def coverage(image, background=(1.0, 1.0, 1.0, 1.0), tolerance: int = 0) -> np.n
         raise ValueError("an RGBA background needs an RGBA image")
     diff = np.abs(image[..., :channels].astype(np.int16) - bg)
     return (diff > tolerance).any(axis=2)
+
+
+def wire_pixels(image, wire_color) -> np.ndarray:
+    """(H, W) bool: pixels of exactly ``wire_color`` (RGB in [0, 1]), the wire frame's pixels."""
+    colour = np.round(np.asarray(wire_color, np.float64) * 255).astype(np.uint8)
+    return (_check_image(image, "image")[..., :3] == colour).all(axis=-1)
+
+
+def wire_agreement(image, reference, wire_color) -> dict:
+    """How the wire pixels of ``image`` agree with those of ``reference`` (a line-overdraw
+    image), with a tolerance of one pixel (3 × 3 dilation, scikit-image):
+
+    * ``wire_recall_1px``: reference wire pixels with an image wire pixel within one pixel;
+    * ``wire_precision_1px``: the converse;
+    * ``wire_iou_1px``: ``1 / (1/precision + 1/recall − 1)``, the intersection over union when
+      matched pixels are counted once on each side (0 when either is 0);
+    * ``wire_exact_overlap``: intersection over union without tolerance;
+    * the two pixel counts.
+    """
+    from skimage.morphology import dilation, footprint_rectangle
+
+    a, b = wire_pixels(image, wire_color), wire_pixels(reference, wire_color)
+    near = footprint_rectangle((3, 3))
+    recall = float((b & dilation(a, near)).sum() / max(b.sum(), 1))
+    precision = float((a & dilation(b, near)).sum() / max(a.sum(), 1))
+    iou = 0.0 if min(recall, precision) == 0 else 1.0 / (1.0 / precision + 1.0 / recall - 1.0)
+    return dict(wire_pixels=int(a.sum()), overdraw_wire_pixels=int(b.sum()),
+                wire_recall_1px=recall, wire_precision_1px=precision, wire_iou_1px=iou,
+                wire_exact_overlap=float((a & b).sum() / max((a | b).sum(), 1)))

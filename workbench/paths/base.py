@@ -77,6 +77,8 @@ class Style:
     strips by bandification, quads shorter than ``strip_cutoff`` drawn one by one).
     quad_diagonal: how quads are split, "shorter" (the shorter diagonal), "strip" (the diagonal
     of the quad's strip) or "auto" ("strip" for quad strips, else "shorter").
+    fepatch: the fe2003 parameter set of the texture paths, "A" or "B" (their Table 1), or
+    "alpha_g1,d,l_outer,l_inner" in degrees and model units.
 
     Refused with ValueError: more than 4 clip planes, a plane that is not 4 finite numbers with a
     non-zero normal, a negative step, a non-finite magnification, a crease angle outside
@@ -100,6 +102,7 @@ class Style:
     strips: str = "none"
     strip_cutoff: int = 1
     quad_diagonal: str = "auto"
+    fepatch: str = "A"
 
     def __post_init__(self) -> None:
         planes = np.asarray(self.clip_planes, np.float64).reshape(-1, 4) if len(self.clip_planes) \
@@ -551,4 +554,4 @@ class MeshPath(RenderPath):
 
 
 # the path modules register themselves in PATHS on import
-from . import fields, surface, wire  # noqa: E402,F401
+from . import fetexture, fields, surface, wire  # noqa: E402,F401
