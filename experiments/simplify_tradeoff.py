@@ -61,16 +61,6 @@ def _from_mesh(label: str, mesh: FEMesh) -> Model:
     return Model(label, mesh.nodes, tri.triangles.astype(np.int64), mesh.parts[tri.element_of])
 
 
-def displaced(mesh: FEMesh, amplitude: float, wavelength: float) -> FEMesh:
-    """``mesh`` with a smooth bump field added along z: amplitude·sin(2πx/λ)·cos(2πy/λ), so
-    that flat regions become curved and a simplifier has something to lose (model units)."""
-    x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
-    nodes = mesh.nodes.copy()
-    nodes[:, 2] += amplitude * np.sin(2 * np.pi * x / wavelength) * np.cos(2 * np.pi * y / wavelength)
-    return FEMesh(nodes, mesh.elements, parts=mesh.parts, name=f"{mesh.name} displaced",
-                  part_names=dict(mesh.part_names))
-
-
 def smooth_closed_mesh() -> Model | None:
     """The Stanford bunny that pymeshlab ships with its tests (closed, 56 k triangles)."""
     import pymeshlab
@@ -92,7 +82,7 @@ def models(quick: bool, say):
         yield _from_mesh("car (per part)", car)
         refined = generators.refine(car, 2 if quick else 4)
         yield _from_mesh(f"car {2 if quick else 4}x{2 if quick else 4} displaced",
-                         displaced(refined, amplitude=10.0, wavelength=1200.0))
+                         generators.displaced(refined, amplitude=10.0, wavelength=1200.0))
     yield _from_mesh("stamped panels", generators.stamped_panels(2_215 if quick else 26_284))
     if shared_file(D3PLOT) is None:
         say(f"d3plot skipped: {D3PLOT} not found")

@@ -726,6 +726,18 @@ class _Refinement:
         return np.moveaxis(out.reshape((self.n_new,) + rest), 0, axis)
 
 
+def displaced(mesh: FEMesh, amplitude: float = 10.0, wavelength: float = 1200.0) -> FEMesh:
+    """``mesh`` with a smooth bump field added along z, amplitude·sin(2πx/λ)·cos(2πy/λ) (model
+    units), so that flat regions become curved: a simplifier then has something to lose."""
+    amplitude = float(amplitude)
+    wavelength = _positive_float(wavelength, "wavelength")
+    x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
+    nodes = mesh.nodes.copy()
+    nodes[:, 2] += amplitude * np.sin(2 * np.pi * x / wavelength) * np.cos(2 * np.pi * y / wavelength)
+    return FEMesh(nodes, mesh.elements, parts=mesh.parts, name=f"{mesh.name} displaced",
+                  part_names=dict(mesh.part_names))
+
+
 def refine(mesh: FEMesh, k: int) -> FEMesh:
     """Conforming k×k refinement: every quad into k² quads (bilinear), every triangle into k² triangles.
 

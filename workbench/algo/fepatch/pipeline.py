@@ -456,8 +456,6 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
     labels = sorted(atlas.uv)
     # vertices: one per (subpatch, node) of the atlas
     vnodes = [atlas.uv[s][0] for s in labels]
-    offsets = np.cumsum([0] + [len(v) for v in vnodes])
-    start = dict(zip(labels, offsets[:-1]))
     node_of = np.concatenate(vnodes)
     uv = np.concatenate([atlas.uv[s][1] for s in labels])
     label_of = np.repeat(labels, [len(v) for v in vnodes])
@@ -465,13 +463,12 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
     axis_of_label = dropped_axis(plane_n)
     normal_axis = axis_of_label[label_of]
 
+    # vertices are sorted by (subpatch, node): a (subpatch, node) pair is found by bisection
+    vertex_key = label_of.astype(np.int64) * len(c) + node_of
+
     def vertex(s_arr, n_arr):
         """Vertex ids of (subpatch, node) pairs."""
-        out = np.empty(n_arr.shape, np.int64)
-        for s in np.unique(s_arr):
-            sel = s_arr == s
-            out[sel] = start[int(s)] + np.searchsorted(vnodes[labels.index(int(s))], n_arr[sel])
-        return out
+        return np.searchsorted(vertex_key, np.asarray(s_arr, np.int64) * len(c) + n_arr)
 
     corner_vertex = vertex(np.repeat(sub, 4).reshape(-1, 4), e)
     corners_uv = uv[corner_vertex]

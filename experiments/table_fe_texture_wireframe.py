@@ -1,0 +1,312 @@
+"""fe2003 Tables 1-3: simplified FE meshes with a normal map and a wire-frame texture against the
+original mesh with line overdraw, run time against error.
+
+For every mesh of the suite (the car refined to the paper's size with a smooth displacement, the
+car itself, generated stamped panels) and each of the paper's parameter sets A and B
+(:data:`workbench.algo.fepatch.pipeline.PARAMETER_SETS`):
+
+* ``params`` (Table 1): the parameter sets;
+* ``preprocessing`` (Table 2): seconds per stage -- features + subpatches + lines,
+  retriangulation, textures -- with patch, subpatch and line counts;
+* ``table3`` (Table 3; every column in ``table``): per render path, triangles, GPU and wall time per frame, the speed factor
+  against original + line overdraw, texture memory in RGBA texels (4 bytes) per element, and
+  the errors the paper does not give: the certified one-sided Hausdorff distance original →
+  simplified (upper end of a bracket of width 1e-4 of the bounding-box diagonal, model units
+  and % of the diagonal, beside ``d``), wire-frame fidelity against the line-overdraw image
+  (precision, recall and IoU of wire pixels with a one-pixel tolerance,
+  :func:`workbench.experiment.compare.wire_agreement`), and SSIM of the image against the
+  original's (shaded paths against "original, shaded", wire paths against the overdraw);
+* ``sweep``: on the car refined 2×2 and displaced, the parameters scaled around sets A and B
+  and the atlas resolution (texels across the smallest element) varied: speed factor against wire IoU and Hausdorff
+  error (``sweep.png``);
+* ``crops.png``: the same crop of original + line overdraw and simplified A + normal map + wire
+  texture.
+
+Lighting follows the workbench's two-sided headlight; the original is Gouraud-shaded with the
+crease angle of set A, the simplified surfaces shade per pixel from the normal map.
+
+Run: ``workbench run table_fe_texture_wireframe [--quick]`` or
+``python experiments/table_fe_texture_wireframe.py [--quick]``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from workbench.algo.fepatch.pipeline import PARAMETER_SETS, STAGES, FEPatchParams, build_model
+from workbench.algo.hausdorff import hausdorff
+from workbench.data import CAR_DECK, shared_file
+from workbench.experiment.compare import compare_images, wire_agreement
+from workbench.experiment.figures import save_image_grid
+from workbench.experiment.registry import experiment, main
+from workbench.experiment.tables import atomic_open, write_table
+from workbench.experiment.timing import time_draw
+from workbench.gl import Camera, Framebuffer, create_context, renderer
+from workbench.paths import Style, make_path
+from workbench.scene import generators
+from workbench.scene.builtin import builtin_scene
+from workbench.scene.mesh import FEMesh
+
+VIEW = dict(azimuth=-35.0, elevation=25.0, up="z")
+WIRE = (0.0, 0.0, 0.0)
+OVERDRAW = "original + line overdraw"
+SHADED = "original, shaded"
+BRACKET_REL = 1e-4
+TABLE3 = ("renderer", "mesh", "size", "path", "triangles", "line_edges", "gpu_ms", "wall_ms",
+          "speed_vs_overdraw", "rgba_texels_per_element", "hausdorff_mm", "d_mm",
+          "wire_precision_1px", "wire_recall_1px", "wire_iou_1px", "ssim")
+
+
+@dataclass
+class Case:
+    label: str
+    mesh: FEMesh
+
+
+def cases(quick: bool, say):
+    if shared_file(CAR_DECK) is None:
+        say(f"car skipped: {CAR_DECK} not found (set WORKBENCH_DATA to the shared data folder)")
+    else:
+        car = builtin_scene("car")
+        k = 2 if quick else 8
+        yield Case(f"car {k}x{k} displaced", generators.displaced(generators.refine(car, k)))
+        yield Case("car", car)
+    yield Case("stamped panels", generators.stamped_panels(2_215 if quick else 26_284))
+
+
+def params_rows() -> list[dict]:
+    return [dict(set=name, alpha_g1_deg=p.alpha_g1_deg, d_mm=p.d, l_outer_mm=p.l_outer,
+                 l_inner_mm=p.l_inner) for name, p in PARAMETER_SETS.items()]
+
+
+def preprocessing_row(case: Case, model) -> dict:
+    row = dict(mesh=case.label, set=model.params.label, elements=model.n_elements,
+               patches=model.n_patches, subpatches=model.n_subpatches,
+               g0_edges=model.features["G0"], g1_edges=model.features["G1"],
+               closing_edges=model.features["closing"], line_nodes=model.line_nodes,
+               line_nodes_kept=model.line_nodes_kept, fallback_subpatches=len(model.fallback),
+               original_triangles=len(model.original.triangles),
+               simplified_triangles=len(model.simplified.triangles),
+               atlas=f"{model.atlas_size[0]}x{model.atlas_size[1]}")
+    for stage in STAGES:
+        row[f"{stage} s"] = model.seconds[stage]
+    row["total s"] = sum(model.seconds.values())
+    return row
+
+
+def simplification_error(case: Case, model) -> dict:
+    """Certified one-sided Hausdorff distance original → simplified surface."""
+    orig, simp = model.original, model.simplified
+    lo, hi = case.mesh.bounds()
+    diag = float(np.linalg.norm(hi - lo))
+    h = hausdorff(orig.positions, orig.triangles, simp.positions, simp.triangles,
+                  one_sided=True, tol=BRACKET_REL * diag)
+    return dict(hausdorff_mm=h.upper, hausdorff_lower_mm=h.lower,
+                hausdorff_pct_diag=100.0 * h.upper / diag, hausdorff_s=h.seconds,
+                within_d=bool(h.upper <= model.params.d))
+
+
+class Drawer:
+    """Draws paths of one mesh with one camera and frame buffer, timing each."""
+
+    def __init__(self, ctx, mesh: FEMesh, size, repeat: int):
+        self.ctx, self.mesh, self.size, self.repeat = ctx, mesh, size, repeat
+        lo, hi = mesh.bounds()
+        self.camera = Camera.fit_box(lo, hi, aspect=size[0] / size[1], **VIEW)
+        self.fb = Framebuffer(ctx, size)
+
+    def draw(self, name: str, style: Style, surface=None):
+        path = make_path(name, style)
+        if surface is not None:
+            path.surface = surface
+        path.prepare(self.ctx, self.mesh, self.camera)
+        try:
+            timing = time_draw(self.ctx, self.fb, path.draw, repeat=self.repeat)
+            self.fb.clear()
+            path.draw()
+            image = self.fb.read()
+            info = dict(triangles=path.triangles, line_edges=path.edges)
+        finally:
+            path.release()
+        return image, timing, info
+
+    def release(self) -> None:
+        self.fb.release()
+
+
+def table_rows(case: Case, models: dict, drawer: Drawer, gl_renderer: str, say):
+    """Table 3 rows of one mesh, and the images by path label."""
+    crease = PARAMETER_SETS["A"].alpha_g1_deg
+    configs = [(SHADED, "gouraud", None, Style(crease_deg=crease)),
+               (OVERDRAW, "gouraud", None, Style(crease_deg=crease, wireframe=True,
+                                                 wire_color=WIRE)),
+               ("original + wire texture", "fe_wire_texture", "A", None)]
+    for name in models:
+        configs += [(f"simplified {name} + normal map", "fe_normal_map", name, None),
+                    (f"simplified {name} + normal map + wire texture", "fe_normal_wire", name,
+                     None)]
+    rows, images = [], {}
+    for label, path_name, set_name, style in configs:
+        model = models.get(set_name) if set_name else None
+        if model is not None:
+            style = Style(fepatch=set_name, crease_deg=model.params.alpha_g1_deg, wire_color=WIRE)
+            surface = model.original if path_name == "fe_wire_texture" else model.simplified
+        else:
+            surface = None
+        image, timing, info = drawer.draw(path_name, style, surface)
+        images[label] = image
+        row = dict(renderer=gl_renderer, mesh=case.label, size=f"{drawer.size[0]}x{drawer.size[1]}",
+                   path=label, set=set_name or "", triangles=info["triangles"],
+                   line_edges=info["line_edges"], **timing.as_row())
+        if model is not None:
+            row.update(rgba_texels_per_element=model.rgba_texels_per_element,
+                       texture_mb=surface.texture_bytes / 2**20)
+        rows.append(row)
+        say(f"  {case.label} {label}: {info['triangles']} triangles, wall {timing.wall_ms:.1f} ms")
+    by = {r["path"]: r for r in rows}
+    base = by[OVERDRAW]
+    for r in rows:
+        r["speed_vs_overdraw"] = base["wall_ms"] / r["wall_ms"]
+        if r["gpu_ms"] and base["gpu_ms"]:
+            r["gpu_speed_vs_overdraw"] = base["gpu_ms"] / r["gpu_ms"]
+        wire = "wire" in r["path"] or r["path"] == OVERDRAW
+        reference = OVERDRAW if wire else SHADED
+        if r["path"] != reference:
+            r["ssim"] = compare_images(images[reference], images[r["path"]]).ssim
+            r["ssim_against"] = reference
+        if wire and r["path"] != OVERDRAW:
+            r.update(wire_agreement(images[r["path"]], images[OVERDRAW], WIRE))
+    for name, model in models.items():
+        error = simplification_error(case, model)
+        for label in (f"simplified {name} + normal map",
+                      f"simplified {name} + normal map + wire texture"):
+            by[label].update(d_mm=model.params.d, **error)
+        say(f"  {case.label} set {name}: one-sided Hausdorff <= {error['hausdorff_mm']:.3f} mm "
+            f"(d = {model.params.d} mm)")
+    return rows, images
+
+
+def sweep_configs(quick: bool) -> list[tuple[str, FEPatchParams, float]]:
+    a, b = PARAMETER_SETS["A"], PARAMETER_SETS["B"]
+
+    def scaled(p: FEPatchParams, f: float) -> FEPatchParams:
+        return FEPatchParams(p.alpha_g1_deg, p.d * f, p.l_outer * f, p.l_inner * f,
+                             f"{p.name}x{f:g}")
+
+    configs = [("A", a, 3.0), ("B", b, 3.0), ("A/2", scaled(a, 0.5), 3.0),
+               ("Bx2", scaled(b, 2.0), 3.0), ("A, 2 texels", a, 2.0), ("A, 4 texels", a, 4.0)]
+    if not quick:
+        configs += [("Ax2", scaled(a, 2.0), 3.0), ("A/4", scaled(a, 0.25), 3.0)]
+    return configs
+
+
+def sweep_rows(case: Case, drawer: Drawer, quick: bool, say) -> list[dict]:
+    overdraw_image, overdraw_timing, _ = drawer.draw(
+        "gouraud", Style(crease_deg=PARAMETER_SETS["A"].alpha_g1_deg, wireframe=True,
+                         wire_color=WIRE))
+    rows = []
+    for label, params, texels in sweep_configs(quick):
+        model = build_model(case.mesh.elements, case.mesh.nodes, params, texels_per_edge=texels)
+        style = Style(crease_deg=params.alpha_g1_deg, wire_color=WIRE)
+        image, timing, info = drawer.draw("fe_normal_wire", style, model.simplified)
+        row = dict(mesh=case.label, config=label, alpha_g1_deg=params.alpha_g1_deg, d_mm=params.d,
+                   l_outer_mm=params.l_outer, l_inner_mm=params.l_inner,
+                   texels_per_edge=texels, triangles=info["triangles"],
+                   line_edges=info["line_edges"], preprocessing_s=sum(model.seconds.values()),
+                   wall_ms=timing.wall_ms, speed_vs_overdraw=overdraw_timing.wall_ms / timing.wall_ms,
+                   rgba_texels_per_element=model.rgba_texels_per_element,
+                   **wire_agreement(image, overdraw_image, WIRE),
+                   **simplification_error(case, model))
+        rows.append(row)
+        say(f"  sweep {label}: {info['triangles']} triangles, speed x{row['speed_vs_overdraw']:.2f}, "
+            f"wire IoU {row['wire_iou_1px']:.3f}, Hausdorff {row['hausdorff_mm']:.3f} mm")
+    return rows
+
+
+def save_sweep_figure(path: Path, rows: list[dict], title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    speed = [r["speed_vs_overdraw"] for r in rows]
+    for ax, key, xlabel in ((axes[0], "wire_iou_1px", "wire IoU against line overdraw (1 px)"),
+                            (axes[1], "hausdorff_mm", "one-sided Hausdorff original → simplified [mm]")):
+        x = [r[key] for r in rows]
+        sc = ax.scatter(x, speed, c=[r["rgba_texels_per_element"] for r in rows], cmap="viridis")
+        for r, xi, yi in zip(rows, x, speed):
+            ax.annotate(r["config"], (xi, yi), textcoords="offset points", xytext=(4, 4),
+                        fontsize=8)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel("speed factor against original + line overdraw")
+        ax.grid(True, alpha=0.3)
+    fig.colorbar(sc, ax=axes, label="texture memory [RGBA texels per element]")
+    fig.suptitle(title)
+    with atomic_open(path, "wb") as handle:
+        fig.savefig(handle, format="png", dpi=100)
+    plt.close(fig)
+
+
+def crop(image: np.ndarray, box) -> np.ndarray:
+    y0, y1, x0, x1 = box
+    return image[y0:y1, x0:x1]
+
+
+@experiment("table_fe_texture_wireframe", "fe2003 Tables 1-3: simplified FE meshes with normal "
+                                          "maps and a wire-frame texture against line overdraw")
+def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
+    say = progress or (lambda msg: None)
+    size = (500, 375) if quick else (1000, 750)
+    repeat = 5 if quick else 9
+    ctx = create_context()
+    gl_renderer = renderer(ctx)
+    write_table(params_rows(), out_dir, "params", title="fe2003 Table 1: parameter sets")
+    pre, rows, sweep = [], [], []
+    first = True
+    for case in cases(quick, say):
+        say(f"{case.label}: {case.mesh.n_elements} elements")
+        models = {}
+        for name, params in PARAMETER_SETS.items():
+            models[name] = build_model(case.mesh.elements, case.mesh.nodes, params)
+            pre.append(preprocessing_row(case, models[name]))
+            say(f"  set {name}: preprocessing {pre[-1]['total s']:.1f} s, "
+                f"{pre[-1]['simplified_triangles']} of {pre[-1]['original_triangles']} triangles")
+        drawer = Drawer(ctx, case.mesh, size, repeat)
+        try:
+            mesh_rows, images = table_rows(case, models, drawer, gl_renderer, say)
+            rows += mesh_rows
+            if first:
+                h, w = size[1], size[0]
+                box = (h // 3, h // 3 + h // 3, w // 3, w // 3 + w // 3)
+                save_image_grid(out_dir / "crops.png",
+                                [crop(images[OVERDRAW], box),
+                                 crop(images["simplified A + normal map + wire texture"], box)],
+                                [f"{case.label}: original + line overdraw",
+                                 "simplified A + normal map + wire texture"])
+                first = False
+        finally:
+            drawer.release()
+    sweep_case = next((c for c in cases(True, say) if c.label.startswith("car")), None)
+    if sweep_case is not None:
+        say(f"sweep on {sweep_case.label}")
+        drawer = Drawer(ctx, sweep_case.mesh, size, repeat)
+        try:
+            sweep = sweep_rows(sweep_case, drawer, quick, say)
+        finally:
+            drawer.release()
+    write_table(pre, out_dir, "preprocessing", title="fe2003 Table 2: preprocessing seconds")
+    write_table(rows, out_dir, "table3", columns=TABLE3,
+                title="fe2003 Table 3: time per frame against error (all columns: table.md)")
+    if sweep:
+        write_table(sweep, out_dir, "sweep", title="Parameter sweep: speed against error")
+        save_sweep_figure(out_dir / "sweep.png", sweep,
+                          f"{sweep[0]['mesh']}: simplified + wire texture, speed against error")
+    return rows
+
+
+if __name__ == "__main__":
+    raise SystemExit(main("table_fe_texture_wireframe", __doc__.splitlines()[0]))

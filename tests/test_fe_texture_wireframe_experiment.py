@@ -1,0 +1,63 @@
+"""The table_fe_texture_wireframe experiment end to end in its quick form: what its tables show."""
+
+import pytest
+
+from workbench.algo.fepatch.pipeline import PARAMETER_SETS
+from workbench.experiment.registry import discover, run_experiment
+from workbench.experiment.tables import read_table
+
+
+@pytest.fixture(scope="module")
+def result(tmp_path_factory):
+    discover()
+    root = tmp_path_factory.mktemp("figures")
+    rows, out_dir = run_experiment("table_fe_texture_wireframe", figures_root=root, quick=True)
+    return rows, out_dir
+
+
+def test_every_table_and_figure_is_written(result):
+    _, out_dir = result
+    for name in ("table", "table3", "params", "preprocessing"):
+        assert (out_dir / f"{name}.csv").is_file() and (out_dir / f"{name}.md").is_file()
+    assert (out_dir / "crops.png").stat().st_size > 1000
+    params = read_table(out_dir / "params.csv")
+    assert [(r["set"], r["alpha_g1_deg"], r["d_mm"], r["l_outer_mm"], r["l_inner_mm"])
+            for r in params] == [("A", 12, 1, 0.5, 8), ("B", 18, 3, 2.5, 15)]
+
+
+def test_simplified_paths_draw_fewer_triangles_and_report_their_errors(result):
+    rows, _ = result
+    meshes = {r["mesh"] for r in rows}
+    assert "stamped panels" in meshes
+    for mesh in meshes:
+        by = {r["path"]: r for r in rows if r["mesh"] == mesh}
+        assert by["original + line overdraw"]["speed_vs_overdraw"] == 1.0
+        assert by["original + line overdraw"]["line_edges"] > 0
+        original = by["original, shaded"]["triangles"]
+        for name, params in PARAMETER_SETS.items():
+            for label in (f"simplified {name} + normal map",
+                          f"simplified {name} + normal map + wire texture"):
+                r = by[label]
+                assert r["triangles"] < original
+                assert r["d_mm"] == params.d
+                assert 0 < r["hausdorff_lower_mm"] <= r["hausdorff_mm"]
+                assert r["within_d"] == (r["hausdorff_mm"] <= params.d)
+                assert 0 < r["ssim"] <= 1
+                assert r["rgba_texels_per_element"] > 1
+            wire = by[f"simplified {name} + normal map + wire texture"]
+            # the outlines come through: most overdraw wire pixels are found within a pixel
+            assert 0.8 < wire["wire_recall_1px"] <= 1 and 0.8 < wire["wire_precision_1px"] <= 1
+            assert wire["wire_iou_1px"] <= min(wire["wire_recall_1px"],
+                                               wire["wire_precision_1px"]) + 1e-12
+
+
+def test_preprocessing_times_every_stage(result):
+    _, out_dir = result
+    pre = read_table(out_dir / "preprocessing.csv")
+    assert {r["set"] for r in pre} == {"A", "B"}
+    for r in pre:
+        stages = [r["features, subpatches, lines s"], r["retriangulation s"], r["textures s"]]
+        assert all(s > 0 for s in stages)
+        assert r["total s"] == pytest.approx(sum(stages))
+        assert r["simplified_triangles"] < r["original_triangles"]
+        assert r["line_nodes_kept"] <= r["line_nodes"]
