@@ -23,7 +23,7 @@ uniform vec3 wire_color;
 // other is not below minus half a pixel (w: the distance's change per pixel along the minor
 // axis of its iso-line, like an aliased one-pixel GL line)
 bool on_outline(float c1, float c2, float w1, float w2) {
-    return (abs(c1) < 0.5 * w1 && c2 > -0.5 * w2) || (abs(c2) < 0.5 * w2 && c1 > -0.5 * w1);
+    return (abs(c1) <= 0.5 * w1 && c2 >= -0.5 * w2) || (abs(c2) <= 0.5 * w2 && c1 >= -0.5 * w1);
 }
 #endif
 

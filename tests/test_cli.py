@@ -55,6 +55,44 @@ def test_render_draws_the_same_plate_with_quad_strips(deck, tmp_path, capsys):
     assert "6 vertices sent" in printed and "4 vertices sent, 1 strip," in printed
 
 
+def grid_deck(n: int, cell: float) -> str:
+    """A flat n × n quad plate as a fixed-format keyword deck."""
+    nodes = [f"{1 + i + (n + 1) * j:8d}{i * cell:16.1f}{j * cell:16.1f}{0.0:16.1f}"
+             for j in range(n + 1) for i in range(n + 1)]
+    elements = []
+    for j in range(n):
+        for i in range(n):
+            a = 1 + i + (n + 1) * j
+            elements.append(f"{len(elements) + 1:8d}{1:8d}{a:8d}{a + 1:8d}{a + n + 2:8d}"
+                            f"{a + n + 1:8d}")
+    return "\n".join(["*KEYWORD", "*NODE", *nodes, "*ELEMENT_SHELL", *elements, "*END", ""])
+
+
+def test_render_the_plate_simplified_with_a_wire_texture(tmp_path):
+    # a flat 4 x 4 plate simplifies to two triangles; the texture still outlines its elements,
+    # so the image has wire lines inside the plate, not only along its border
+    deck = tmp_path / "grid.k"
+    deck.write_text(grid_deck(4, 25.0))
+    out = tmp_path / "plate_fe.png"
+    assert main(["render", str(deck), "--view", "0,0", "--up", "y", "--size", "170x130",
+                 "--path", "fe_normal_wire", "--fepatch", "B", "-o", str(out)]) == 0
+    image = np.asarray(Image.open(out))[..., :3].astype(int)
+    wire = (image == 0).all(axis=2)
+    drawn = (image != 255).any(axis=2)
+    rows, cols = np.flatnonzero(drawn.any(axis=1)), np.flatnonzero(drawn.any(axis=0))
+    r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+    # the three inner element lines each way are there, within a pixel, along the whole plate
+    for k in (1, 2, 3):
+        x = round(c0 + k * (c1 - c0) / 4 - 0.5)
+        y = round(r0 + k * (r1 - r0) / 4 - 0.5)
+        assert wire[r0:r1, x - 1:x + 2].any(axis=1).mean() > 0.95
+        assert wire[y - 1:y + 2, c0:c1].any(axis=0).mean() > 0.95
+    # and little else: 4 + 4 lines of one or, where a line falls on a pixel boundary, two pixels
+    assert wire.sum() <= 8 * 2 * max(r1 - r0, c1 - c0)
+    assert main(["render", str(deck), "--path", "fe_normal_wire", "--fepatch", "C",
+                 "-o", str(tmp_path / "bad.png")]) != 0
+
+
 def test_render_car_with_field_writes_a_colour_bar_figure(tmp_path):
     if shared_file(CAR_DECK) is None:
         pytest.skip("shared car deck not found (set WORKBENCH_DATA)")

@@ -71,7 +71,8 @@ def cmd_render(args) -> int:
         else:
             path_name = "element_color" if args.field in mesh.element_fields else "pixel_color"
     style = Style(field=args.field, step=args.step, colormap=args.colormap, bands=args.bands,
-                  wireframe=args.wireframe, crease_deg=args.crease, strips=args.strips)
+                  wireframe=args.wireframe, crease_deg=args.crease, strips=args.strips,
+                  fepatch=args.fepatch)
     ctx = create_context()
     width, height = args.size
     camera = Camera.fit_box(*mesh.bounds(all_steps=True), azimuth=args.view[0], elevation=args.view[1],
@@ -210,6 +211,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--wireframe", action="store_true", help="overdraw element edges")
     p.add_argument("--strips", choices=("none", "triangle", "quad"), default="none",
                    help="draw a triangle list (default), meshoptimizer triangle strips or quad strips")
+    p.add_argument("--fepatch", default="A", metavar="SET",
+                   help="fe2003 parameters of the fe_* texture paths: A, B or "
+                        "'alpha_g1,d,l_outer,l_inner' in degrees and mm (default A)")
     p.add_argument("--view", type=lambda s: _pair(s, ","), default=(30.0, 25.0), metavar="AZ,EL",
                    help="azimuth and elevation in degrees (default 30,25)")
     p.add_argument("--up", choices=("y", "z"), default="z",

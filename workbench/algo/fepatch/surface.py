@@ -20,8 +20,9 @@ Texture conventions (shared with the shaders):
   edges 1 and 3 (a triangle (a, b, c, c): its edges ab and ca, element edges 0 and 3, in the
   first, bc alone in the second). Where elements of one pair overlap, a texel inside one keeps
   that element's channels, a texel outside all of them the smallest value per channel; texels
-  no element writes hold −wire_range (byte 0). A fragment is on an outline when, in either pair, one channel is within half a
-  pixel of zero while the other is not below minus half a pixel.
+  no element writes hold −wire_range (byte 0). A fragment is on an outline when, in either
+  pair, one channel is within half a pixel of zero (inclusive) while the other is not below
+  minus half a pixel.
 * ``line_edges`` are element edges the texture cannot show -- two neighbours of the same colour,
   and the outer boundary, which the texture would draw on its inner half only: they are drawn
   as lines in the same frame.

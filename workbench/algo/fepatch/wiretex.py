@@ -272,11 +272,12 @@ def decode_wire(texture, points, wire_range: float = WIRE_RANGE) -> np.ndarray:
 
 def on_outline(texture, points, h: float, wire_range: float = WIRE_RANGE) -> np.ndarray:
     """(P,) bool: whether ``points`` (P, 2) in texel units lie on an outline, the fragment
-    shader's test: in either pair one channel is within ``h`` texels of zero (|d| < h) while the
-    other is above −h. ``h`` is half the line width in texels (> 0)."""
+    shader's test: in either pair one channel is within ``h`` texels of zero (|d| ≤ h, a tie on a
+    pixel boundary draws both pixels rather than neither) while the other is at least −h. ``h``
+    is half the line width in texels (> 0)."""
     if not h > 0:
         raise ValueError(f"h must be positive, got {h}")
     d = decode_wire(texture, points, wire_range)
     a, b = d[:, :, 0], d[:, :, 1]
-    hit = ((np.abs(a) < h) & (b > -h)) | ((np.abs(b) < h) & (a > -h))
+    hit = ((np.abs(a) <= h) & (b >= -h)) | ((np.abs(b) <= h) & (a >= -h))
     return hit.any(axis=1)
