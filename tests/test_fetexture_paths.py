@@ -16,7 +16,7 @@ import pytest
 import workbench.paths.fetexture  # noqa: F401  (registers the paths)
 from workbench.algo.fepatch.normalmap import decode_normals, encode_normals
 from workbench.algo.fepatch.surface import TexturedSurface
-from workbench.gl import Camera, Framebuffer, GLUnavailable, create_context
+from workbench.gl import Camera, Framebuffer
 from workbench.paths import PATHS, Style, make_path
 from workbench.scene.mesh import FEMesh
 
@@ -27,14 +27,6 @@ FAR = np.array([1.0e5, 0.0, 0.0])
 WIRE = (1.0, 0.0, 0.0)
 WIRE_RGB = np.array([255, 0, 0], np.uint8)
 NAMES = ("fe_wire_texture", "fe_normal_map", "fe_normal_wire")
-
-
-@pytest.fixture(scope="module")
-def ctx():
-    try:
-        return create_context()
-    except GLUnavailable as exc:
-        pytest.skip(str(exc))
 
 
 # --------------------------------------------------------------------------- synthetic surface

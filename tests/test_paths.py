@@ -10,7 +10,7 @@ import moderngl
 import numpy as np
 import pytest
 
-from workbench.gl import Camera, Framebuffer, GLUnavailable, create_context
+from workbench.gl import Camera, Framebuffer
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -26,14 +26,6 @@ LINE_WIRE = {name: name != "quad_wire" for name in PATHS}
 # the paths that draw any FE mesh directly (the fe2003 texture paths draw a preprocessed surface
 # of one configuration and are tested in test_fetexture_paths)
 MESH_PATHS = sorted(name for name, cls in PATHS.items() if issubclass(cls, MeshPath))
-
-
-@pytest.fixture(scope="module")
-def ctx():
-    try:
-        return create_context()
-    except GLUnavailable as exc:
-        pytest.skip(str(exc))
 
 
 def grid(nx=1, ny=1, x0=-0.5, x1=0.5, y0=-0.5, y1=0.5, offset=(0.0, 0.0, 0.0), z=None):

@@ -9,8 +9,7 @@ import pytest
 from skimage.morphology import dilation, footprint_rectangle
 
 from workbench.algo.strips import quad_strips
-from workbench.gl import (Camera, Framebuffer, GLUnavailable, VertexShaderInvocations,
-                          create_context)
+from workbench.gl import Camera, Framebuffer, VertexShaderInvocations
 from workbench.paths import Style, make_path
 from workbench.scene.mesh import FEMesh
 
@@ -19,14 +18,6 @@ from test_paths import render
 BACKGROUND = np.array([255, 255, 255, 255], np.uint8)
 SHADED = {"position": None, "flat": None, "gouraud": None, "pixel_color": "h",
           "vertex_color": "h"}
-
-
-@pytest.fixture(scope="module")
-def ctx():
-    try:
-        return create_context()
-    except GLUnavailable as exc:
-        pytest.skip(str(exc))
 
 
 def scene_with_defects():

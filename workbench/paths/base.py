@@ -237,7 +237,99 @@ def field_kind(mesh, name: str) -> str:
                    f"element fields: {sorted(mesh.element_fields)}")
 
 
-class MeshPath(RenderPath):
+class GLPath(RenderPath):
+    """GL-object bookkeeping and per-frame state shared by the paths: objects kept for
+    ``release``, the fill program ``_program`` and VAO ``_vao``, an optional pass of lines
+    (``_line_program``/``_line_vao``, drawn after the fill, which gets polygon offset), clip
+    planes and camera uniforms for both programs, and the draw itself."""
+
+    def __init__(self, style: Style | None = None) -> None:
+        super().__init__(style)
+        self.ctx = None
+        self._objects: list = []
+        self._program = self._line_program = self._line_vao = None
+        self._textures: list = []  # (texture, unit) bound before each draw
+
+    def _keep(self, obj):
+        self._objects.append(obj)
+        return obj
+
+    def _programs(self) -> list:
+        return [p for p in (self._program, self._line_program) if p is not None]
+
+    @staticmethod
+    def _uniforms(program) -> set[str]:
+        return {name for name in program if isinstance(program[name], moderngl.Uniform)}
+
+    def _line_pass(self, ctx: moderngl.Context, positions, edges: np.ndarray) -> int:
+        """Build the pass drawing ``edges`` (K, 2) vertex pairs of ``positions`` as GL_LINES in
+        ``Style.wire_color``; returns the bytes uploaded."""
+        edges = np.ascontiguousarray(edges, dtype=np.int32)
+        self._line_program = self._keep(load_program(
+            ctx, "position.vert.glsl", "position.frag.glsl",
+            defines={"NUM_CLIP": len(self.style.clip_planes)}))
+        self._line_program["base_color"].value = self.style.wire_color
+        index = self._keep(ctx.buffer(edges.tobytes()))
+        self._line_vao = self._keep(ctx.vertex_array(
+            self._line_program, [(positions, "3f", "position")], index, index_element_size=4))
+        self.edges = len(edges)
+        return edges.nbytes
+
+    def _set_clip_planes(self) -> None:
+        planes = np.array(self.style.clip_planes, np.float64).reshape(-1, 4)
+        if not len(planes):
+            return
+        shifted = planes.copy()
+        shifted[:, 3] += planes[:, :3] @ self.origin  # float64, before the float32 cast
+        data = shifted.astype(np.float32).tobytes()
+        for program in self._programs():
+            program["clip_planes"].write(data)
+
+    def set_camera(self, camera) -> None:
+        if self.ctx is None:
+            raise RuntimeError(f"path {self.name!r} is not prepared")
+        if not np.array_equal(np.asarray(camera.origin, np.float64), self.origin):
+            raise ValueError(f"camera origin {camera.origin} differs from the prepared origin "
+                             f"{self.origin}: prepare the path again for a new origin")
+        mvp, view = camera.mvp_bytes(), camera.view_bytes()
+        perspective = 1.0 if camera.projection == "perspective" else 0.0
+        for program in self._programs():
+            names = self._uniforms(program)
+            program["mvp"].write(mvp)
+            if "view" in names:
+                program["view"].write(view)
+            if "perspective" in names:
+                program["perspective"].value = perspective
+
+    def _render(self, mode: int) -> None:
+        """Draw the fill VAO with ``mode`` and then the line pass, in the style's GL state."""
+        ctx, style = self.ctx, self.style
+        ctx.enable_only(moderngl.DEPTH_TEST | (moderngl.CULL_FACE if style.cull_back else 0))
+        if style.cull_back:
+            ctx.front_face, ctx.cull_face = "ccw", "back"
+        for i in range(len(style.clip_planes)):
+            ctx.enable_direct(GL_CLIP_DISTANCE0 + i)
+        for texture, unit in self._textures:
+            texture.use(unit)
+        if self._line_vao is not None:
+            ctx.polygon_offset = POLYGON_OFFSET
+            self._vao.render(mode)
+            ctx.polygon_offset = (0.0, 0.0)
+            self._line_vao.render(moderngl.LINES)
+        else:
+            self._vao.render(mode)
+        for i in range(len(style.clip_planes)):
+            ctx.disable_direct(GL_CLIP_DISTANCE0 + i)
+
+    def release(self) -> None:
+        for obj in reversed(self._objects):
+            obj.release()
+        self._objects.clear()
+        self._textures = []
+        self.ctx = None
+
+
+class MeshPath(GLPath):
     """The shared implementation: one indexed triangle VAO, optionally a wire-frame VAO.
 
     Subclasses choose shaders and two switches: ``split`` (vertices are the crease-split
@@ -251,11 +343,6 @@ class MeshPath(RenderPath):
     fragment_shader: ClassVar[str]
     split: ClassVar[bool] = False
     field_per: ClassVar[str | None] = None
-
-    def __init__(self, style: Style | None = None) -> None:
-        super().__init__(style)
-        self.ctx = None
-        self._objects: list = []
 
     # ------------------------------------------------------------------ prepare
     def prepare(self, ctx: moderngl.Context, mesh, camera) -> None:
@@ -377,6 +464,7 @@ class MeshPath(RenderPath):
         if self.scale is not None:
             texels = self.scale.texture_data()
             self._colormap = self._keep(ctx.texture((len(texels), 1), 4, texels.tobytes()))
+            self._textures = [(self._colormap, 0)]
             filt = moderngl.LINEAR if self.scale.linear else moderngl.NEAREST
             self._colormap.filter = (filt, filt)
             self._colormap.repeat_x = self._colormap.repeat_y = False
@@ -389,20 +477,9 @@ class MeshPath(RenderPath):
         if "base_color" in self._uniforms(self._program):
             self._program["base_color"].value = style.base_color
 
-        self._wire_program = self._wire_vao = None
+        self._line_program = self._line_vao = None
         if style.wireframe:
-            edges = self._vertex_of_node()[mesh.edges]
-            edges = np.ascontiguousarray(edges, dtype=np.int32)
-            self._wire_program = self._keep(load_program(
-                ctx, "position.vert.glsl", "position.frag.glsl",
-                defines={"NUM_CLIP": len(style.clip_planes)}))
-            self._wire_program["base_color"].value = style.wire_color
-            self._edges = self._keep(ctx.buffer(edges.tobytes()))
-            uploaded += edges.nbytes
-            self._wire_vao = self._keep(ctx.vertex_array(
-                self._wire_program, [(self._positions, "3f", "position")], self._edges,
-                index_element_size=4))
-            self.edges = len(edges)
+            uploaded += self._line_pass(ctx, self._positions, self._vertex_of_node()[mesh.edges])
 
         self._static_values = False
         if self.field_per is not None and self._field_values().ndim == 1:
@@ -412,14 +489,6 @@ class MeshPath(RenderPath):
         self.set_camera(camera)
         self.bytes_per_step = self.set_step(style.step)
         self.bytes_uploaded = uploaded + self.bytes_per_step
-
-    def _keep(self, obj):
-        self._objects.append(obj)
-        return obj
-
-    @staticmethod
-    def _uniforms(program) -> set[str]:
-        return {name for name in program if isinstance(program[name], moderngl.Uniform)}
 
     def _check_field(self, mesh) -> None:
         name = self.style.field
@@ -446,36 +515,7 @@ class MeshPath(RenderPath):
         first[self._vertex_node[::-1]] = np.arange(len(self._vertex_node))[::-1]
         return first
 
-    def _set_clip_planes(self) -> None:
-        planes = np.array(self.style.clip_planes, np.float64).reshape(-1, 4)
-        if not len(planes):
-            return
-        shifted = planes.copy()
-        shifted[:, 3] += planes[:, :3] @ self.origin  # float64, before the float32 cast
-        data = shifted.astype(np.float32).tobytes()
-        for program in (self._program, self._wire_program):
-            if program is not None:
-                program["clip_planes"].write(data)
-
     # ------------------------------------------------------------------ per frame / per step
-    def set_camera(self, camera) -> None:
-        if self.ctx is None:
-            raise RuntimeError(f"path {self.name!r} is not prepared")
-        if not np.array_equal(np.asarray(camera.origin, np.float64), self.origin):
-            raise ValueError(f"camera origin {camera.origin} differs from the prepared origin "
-                             f"{self.origin}: prepare the path again for a new origin")
-        mvp, view = camera.mvp_bytes(), camera.view_bytes()
-        perspective = 1.0 if camera.projection == "perspective" else 0.0
-        for program in (self._program, self._wire_program):
-            if program is None:
-                continue
-            names = self._uniforms(program)
-            program["mvp"].write(mvp)
-            if "view" in names:
-                program["view"].write(view)
-            if "perspective" in names:
-                program["perspective"].value = perspective
-
     def shown_coordinates(self, step: int) -> np.ndarray:
         """(N, 3) float64 node positions drawn for ``step`` (deformation plot applied)."""
         mesh, style = self.mesh, self.style
@@ -527,30 +567,8 @@ class MeshPath(RenderPath):
         return t if self._vertex_node is None else t[self._vertex_node]
 
     def draw(self) -> None:
-        ctx, style = self.ctx, self.style
-        ctx.enable_only(moderngl.DEPTH_TEST | (moderngl.CULL_FACE if style.cull_back else 0))
-        ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
-        if style.cull_back:
-            ctx.front_face, ctx.cull_face = "ccw", "back"
-        for i in range(len(style.clip_planes)):
-            ctx.enable_direct(GL_CLIP_DISTANCE0 + i)
-        if self._colormap is not None:
-            self._colormap.use(0)
-        if self._wire_vao is not None:
-            ctx.polygon_offset = POLYGON_OFFSET
-            self._vao.render(self.mode)
-            ctx.polygon_offset = (0.0, 0.0)
-            self._wire_vao.render(moderngl.LINES)
-        else:
-            self._vao.render(self.mode)
-        for i in range(len(style.clip_planes)):
-            ctx.disable_direct(GL_CLIP_DISTANCE0 + i)
-
-    def release(self) -> None:
-        for obj in reversed(self._objects):
-            obj.release()
-        self._objects.clear()
-        self.ctx = None
+        self.ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
+        self._render(self.mode)
 
 
 # the path modules register themselves in PATHS on import

@@ -40,7 +40,7 @@ import moderngl
 import numpy as np
 
 from ..gl import load_program
-from .base import GL_CLIP_DISTANCE0, POLYGON_OFFSET, RenderPath
+from .base import GLPath
 
 __all__ = ["FETexturePath", "FEWireTexturePath", "FENormalMapPath", "FENormalWirePath",
            "fepatch_model"]
@@ -60,7 +60,7 @@ def fepatch_model(mesh, fepatch: str):
     return by_parameters[fepatch]
 
 
-class FETexturePath(RenderPath):
+class FETexturePath(GLPath):
     """The shared implementation of the fe2003 texture paths (see the module docstring).
 
     Class switches: ``model_surface`` ("original" or "simplified": which surface of the model
@@ -78,8 +78,6 @@ class FETexturePath(RenderPath):
     def __init__(self, style=None) -> None:
         super().__init__(style)
         self.surface = None
-        self.ctx = None
-        self._objects: list = []
 
     # ------------------------------------------------------------------ prepare
     def _check_style(self, mesh) -> None:
@@ -173,7 +171,6 @@ class FETexturePath(RenderPath):
         self._vao = self._keep(ctx.vertex_array(self._program, content, self._index,
                                                 index_element_size=4))
 
-        self._textures: list = []
         if self.normal_map:
             uploaded += self._texture(ctx, surface.normal_map, 0, "normal_map")
         if self.wire_texture:
@@ -181,63 +178,20 @@ class FETexturePath(RenderPath):
             self._program["wire_range"].value = float(surface.wire_range)
             self._program["wire_color"].value = style.wire_color
 
-        self._line_program = self._line_vao = None
-        edges = np.ascontiguousarray(surface.line_edges, np.int32)
+        edges = surface.line_edges
         if len(edges):
             if edges.min() < 0 or edges.max() >= n:
                 raise ValueError(f"line_edges index outside 0..{n - 1}")
-            self._line_program = self._keep(load_program(
-                ctx, "position.vert.glsl", "position.frag.glsl",
-                defines={"NUM_CLIP": len(style.clip_planes)}))
-            self._line_program["base_color"].value = style.wire_color
-            self._edges = self._keep(ctx.buffer(edges.tobytes()))
-            uploaded += edges.nbytes
-            self._line_vao = self._keep(ctx.vertex_array(
-                self._line_program, [(self._positions, "3f", "position")], self._edges,
-                index_element_size=4))
+            uploaded += self._line_pass(ctx, self._positions, edges)
 
-        self.triangles, self.vertices, self.edges = len(index), n, len(edges)
+        self.triangles, self.vertices = len(index), n
         self.vertices_sent, self.strips = index.size, 0
         self._set_clip_planes()
         self.set_camera(camera)
         self.bytes_per_step = self.set_step(0)
         self.bytes_uploaded = uploaded + self.bytes_per_step
 
-    def _keep(self, obj):
-        self._objects.append(obj)
-        return obj
-
-    def _programs(self):
-        return [p for p in (self._program, self._line_program) if p is not None]
-
-    def _set_clip_planes(self) -> None:
-        planes = np.array(self.style.clip_planes, np.float64).reshape(-1, 4)
-        if not len(planes):
-            return
-        shifted = planes.copy()
-        shifted[:, 3] += planes[:, :3] @ self.origin  # float64, before the float32 cast
-        data = shifted.astype(np.float32).tobytes()
-        for program in self._programs():
-            program["clip_planes"].write(data)
-
     # ------------------------------------------------------------------ per frame / per step
-    def set_camera(self, camera) -> None:
-        if self.ctx is None:
-            raise RuntimeError(f"path {self.name!r} is not prepared")
-        if not np.array_equal(np.asarray(camera.origin, np.float64), self.origin):
-            raise ValueError(f"camera origin {camera.origin} differs from the prepared origin "
-                             f"{self.origin}: prepare the path again for a new origin")
-        mvp, view = camera.mvp_bytes(), camera.view_bytes()
-        perspective = 1.0 if camera.projection == "perspective" else 0.0
-        for program in self._programs():
-            program["mvp"].write(mvp)
-            for name, value in (("view", view), ("perspective", perspective)):
-                if name in program and isinstance(program[name], moderngl.Uniform):
-                    if isinstance(value, bytes):
-                        program[name].write(value)
-                    else:
-                        program[name].value = value
-
     def set_step(self, step: int) -> int:
         """Upload the surface's positions (float32 relative to the origin); only step 0, the
         configuration the surface was built for, is accepted."""
@@ -252,29 +206,7 @@ class FETexturePath(RenderPath):
         return data.nbytes
 
     def draw(self) -> None:
-        ctx, style = self.ctx, self.style
-        ctx.enable_only(moderngl.DEPTH_TEST | (moderngl.CULL_FACE if style.cull_back else 0))
-        if style.cull_back:
-            ctx.front_face, ctx.cull_face = "ccw", "back"
-        for i in range(len(style.clip_planes)):
-            ctx.enable_direct(GL_CLIP_DISTANCE0 + i)
-        for tex, unit in self._textures:
-            tex.use(unit)
-        if self._line_vao is not None:
-            ctx.polygon_offset = POLYGON_OFFSET
-            self._vao.render(moderngl.TRIANGLES)
-            ctx.polygon_offset = (0.0, 0.0)
-            self._line_vao.render(moderngl.LINES)
-        else:
-            self._vao.render(moderngl.TRIANGLES)
-        for i in range(len(style.clip_planes)):
-            ctx.disable_direct(GL_CLIP_DISTANCE0 + i)
-
-    def release(self) -> None:
-        for obj in reversed(self._objects):
-            obj.release()
-        self._objects.clear()
-        self.ctx = None
+        self._render(moderngl.TRIANGLES)
 
 
 class FEWireTexturePath(FETexturePath):

@@ -203,7 +203,6 @@ def border_network(elements, labels, n_nodes: int) -> BorderNetwork:
     e1, e2 = eid_s[first[two]], eid_s[first[two] + 1]
     fixed[two[(sig[e1] != sig[e2]).any(axis=1)]] = True
     # walk the lines
-    deg_first = first
     visited = np.zeros(len(ukey), bool)
     lines = []
 
@@ -218,14 +217,14 @@ def border_network(elements, labels, n_nodes: int) -> BorderNetwork:
             nodes.append(node)
             if fixed[node]:
                 return nodes
-            f = deg_first[node]
+            f = first[node]
             nxt = eid_s[f] if eid_s[f] != edge else eid_s[f + 1]
             if visited[nxt]:
                 return nodes  # closed line back at its start
             edge = int(nxt)
 
     for node in np.flatnonzero(fixed):
-        f = deg_first[node]
+        f = first[node]
         for k in range(degree[node]):
             edge = int(eid_s[f + k])
             if not visited[edge]:
@@ -348,10 +347,13 @@ def _triangulate_subpatch(loops, removed, coords, frame) -> np.ndarray | None:
 
 
 def simplified_triangles(elements, coords, labels, network: BorderNetwork,
-                         removed: np.ndarray, frames) -> tuple[dict, np.ndarray, np.ndarray]:
+                         removed: np.ndarray, frames,
+                         triangulation=None) -> tuple[dict, np.ndarray, np.ndarray]:
     """({label: (K, 3) node triangles}, fallback labels, final ``removed``): every subpatch
     retriangulated from its simplified border loops; those that fail keep their original
-    element triangles and restore their border nodes, which re-triangulates the neighbours."""
+    element triangles and restore their border nodes, which re-triangulates the neighbours.
+    ``triangulation``: the elements' :func:`triangulate`, computed when not given.
+    """
     e = np.asarray(elements, np.int64)
     lab = np.asarray(labels, np.int64)
     removed = removed.copy()
@@ -397,7 +399,7 @@ def simplified_triangles(elements, coords, labels, network: BorderNetwork,
             todo |= {int(s) for s in touched if s not in failed}
     fallback = np.array(sorted(failed), np.int64)
     if len(fallback):
-        tri = triangulate(e, coords)
+        tri = triangulation if triangulation is not None else triangulate(e, coords)
         of = lab[tri.element_of]
         for s in fallback:
             result[int(s)] = tri.triangles[of == s].astype(np.int64)
@@ -406,10 +408,10 @@ def simplified_triangles(elements, coords, labels, network: BorderNetwork,
 
 # --------------------------------------------------------------------------- textures
 def _corner_normals(e: np.ndarray, coords: np.ndarray, crease_deg: float,
-                    plane_normal: np.ndarray) -> np.ndarray:
+                    plane_normal: np.ndarray, triangulation) -> np.ndarray:
     """(M, 4, 3) unit normals at the element corners, smooth across edges flatter than
     ``crease_deg``; a zero normal (degenerate element) takes its subpatch's plane normal."""
-    split = gouraud_split(e, [coords], crease_deg, triangulate(e, coords))
+    split = gouraud_split(e, [coords], crease_deg, triangulation)
     n = split.normals(coords)[split.elements]
     zero = np.linalg.norm(n, axis=2) < 0.5
     if zero.any():
@@ -436,6 +438,8 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
     c = _as_coords(coords, e)
     if len(e) == 0:
         raise ValueError("the mesh has no elements")
+    # the original's own triangles (drawn as they are; not part of the preprocessing stages)
+    orig_tri = triangulate(e, c)
     seconds = {}
     t0 = time.perf_counter()
     fe = feature_edges(e, c, p.alpha_g1_deg)
@@ -447,7 +451,8 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
     seconds[STAGES[0]] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    tris, fallback, removed = simplified_triangles(e, c, sub, network, removed, frames)
+    tris, fallback, removed = simplified_triangles(e, c, sub, network, removed, frames,
+                                                   orig_tri)
     seconds[STAGES[1]] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
@@ -472,7 +477,7 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
 
     corner_vertex = vertex(np.repeat(sub, 4).reshape(-1, 4), e)
     corners_uv = uv[corner_vertex]
-    corner_n = _corner_normals(e, c, p.alpha_g1_deg, plane_n[sub])
+    corner_n = _corner_normals(e, c, p.alpha_g1_deg, plane_n[sub], orig_tri)
     vertex_normals = np.zeros((len(node_of), 3))
     vertex_normals[corner_vertex.ravel()] = corner_n.reshape(-1, 3)
     size = atlas.size
@@ -486,7 +491,6 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
     line_nodes = np.concatenate([np.asarray(line_nodes, np.int64).reshape(-1, 2),
                                  fe.of_kind(G0).astype(np.int64)])
     line_edges = _edge_vertices(e, corner_vertex, line_nodes, len(c))
-    orig_tri = triangulate(e, c)
     original = TexturedSurface(
         positions=c[node_of], triangles=_element_triangles(corner_vertex, orig_tri),
         uv=uv, normal_axis=normal_axis, normals=vertex_normals, normal_map=nmap,
