@@ -1,0 +1,104 @@
+"""Pixel-centre location in slice polygons, and the float64 shading model of st2005."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from workbench.algo.spacetime.raster import PixelGrid, locate_pixels
+from workbench.algo.spacetime.shading import (LIGHT, height_normal, log_scale, phong, ramp_color,
+                                              shade)
+
+
+def _grid_polygons(n, offset, seed):
+    """An n×n grid of unit cells, each split into a quad or two triangles, jittered inside."""
+    rng = np.random.default_rng(seed)
+    pts = np.stack(np.meshgrid(np.arange(n + 1.0), np.arange(n + 1.0), indexing="ij"), -1)
+    inner = (slice(1, n), slice(1, n))
+    pts[inner] += rng.uniform(-0.3, 0.3, pts[inner].shape)
+    pts += offset
+    polys = []
+    for i in range(n):
+        for j in range(n):
+            a, b, c, d = pts[i, j], pts[i + 1, j], pts[i + 1, j + 1], pts[i, j + 1]
+            if rng.random() < 0.5:
+                polys.append([a, b, c, d])
+            else:
+                polys += [[a, b, c, c], [a, c, d, d]]
+    return np.array(polys), pts
+
+
+def _brute(corners, xs, ys):
+    """Reference: every polygon tested against every pixel centre (inside or on an edge)."""
+    X, Y = np.meshgrid(xs, ys)
+    out = np.full(X.shape, -1)
+    for p, poly in enumerate(corners):
+        inside = np.ones(X.shape, bool)
+        for k in range(4):
+            a, b = poly[k], poly[(k + 1) % 4]
+            inside &= (b[0] - a[0]) * (Y - a[1]) - (b[1] - a[1]) * (X - a[0]) >= 0
+        out[inside] = p
+    return out
+
+
+@settings(max_examples=25, deadline=None)
+@given(n=st.integers(1, 6), seed=st.integers(0, 10_000), width=st.integers(5, 60),
+       far=st.booleans())
+def test_locate_matches_brute_force_and_covers_the_domain(n, seed, width, far):
+    offset = np.array([3.0e5, -7.0e5]) if far else np.zeros(2)
+    corners, _ = _grid_polygons(n, offset, seed)
+    grid = PixelGrid.fit(offset, offset + n, width, margin=0.1)
+    loc = locate_pixels(corners, grid)
+    xs, ys = grid.centres()
+    assert np.array_equal(loc, _brute(corners, xs, ys))
+    X, Y = np.meshgrid(xs, ys)
+    inside = (X > offset[0]) & (X < offset[0] + n) & (Y > offset[1]) & (Y < offset[1] + n)
+    outside = (X < offset[0]) | (X > offset[0] + n) | (Y < offset[1]) | (Y > offset[1] + n)
+    assert (loc[inside] >= 0).all()  # the polygons tile the square: no hole
+    assert (loc[outside] == -1).all()
+
+
+def test_pixel_grid_fit_and_refusals():
+    g = PixelGrid.fit((0, 0), (2, 1), 200, margin=0.0)
+    assert (g.width, g.height) == (200, 100) and g.dx == pytest.approx(0.01)
+    xs, ys = g.centres()
+    assert xs[0] == pytest.approx(0.005) and ys[0] == pytest.approx(0.995)
+    with pytest.raises(ValueError):
+        PixelGrid(0, 0, 0.0, 1, 4, 4)
+    with pytest.raises(ValueError):
+        PixelGrid.fit((0, 0), (0, 1), 10)
+    with pytest.raises(ValueError):
+        locate_pixels(np.zeros((3, 3, 2)), g)
+
+
+def test_log_scale_and_ramp():
+    U = np.array([0.0, 9.0, 99.0, 1e6, -1.0])
+    s = log_scale(U, 99.0)
+    assert s == pytest.approx([0.0, 0.5, 1.0, 1.0, 0.0])
+    table = np.array([[0, 0, 0, 255], [255, 0, 0, 255], [255, 255, 255, 255]], np.uint8)
+    assert ramp_color([0.0, 0.25, 0.5, 1.0], table) == pytest.approx(
+        np.array([[0, 0, 0], [0.5, 0, 0], [1, 0, 0], [1, 1, 1]]))
+    with pytest.raises(ValueError):
+        log_scale(U, 0.0)
+
+
+def test_height_normal_is_exact_and_never_nan():
+    n = height_normal(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, -2.0]]), 3.0)
+    assert n[0] == pytest.approx([0, 0, 1])
+    assert n[1] == pytest.approx(np.array([-3.0, 0, 1]) / np.sqrt(10))
+    assert n[2] == pytest.approx(np.array([0, 6.0, 1]) / np.sqrt(37))
+    assert np.isfinite(height_normal(np.zeros((4, 2)), 1e9)).all()
+
+
+def test_phong_lights_facing_surfaces_more_and_stays_in_range():
+    color = np.full((3, 3), 0.8)
+    facing = LIGHT[None, :]
+    away = np.array([[-LIGHT[0], -LIGHT[1], 0.0]]) / np.hypot(LIGHT[0], LIGHT[1])
+    up = np.array([[0.0, 0.0, 1.0]])
+    lit = phong(color[:3], np.concatenate([facing, up, away]))
+    assert lit[0, 0] > lit[1, 0] > lit[2, 0]
+    assert lit[2] == pytest.approx(0.8 * 0.3)  # ambient only: the light grazes it
+    assert (lit >= 0).all() and (lit <= 1).all()
+    flat = shade(np.array([9.0]), np.zeros((1, 2)), U_max=99.0,
+                 table=np.array([[0, 0, 0, 255], [255, 255, 255, 255]], np.uint8), height_scale=1.0)
+    assert np.isfinite(flat).all()
