@@ -6,8 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from workbench.algo.spacetime.raster import PixelGrid, locate_pixels
-from workbench.algo.spacetime.shading import (LIGHT, height_normal, log_scale, phong, ramp_color,
-                                              shade)
+from workbench.algo.spacetime.shading import LIGHT, log_scale, phong, ramp_color, shade
 
 
 def _grid_polygons(n, offset, seed):
@@ -80,14 +79,6 @@ def test_log_scale_and_ramp():
         np.array([[0, 0, 0], [0.5, 0, 0], [1, 0, 0], [1, 1, 1]]))
     with pytest.raises(ValueError):
         log_scale(U, 0.0)
-
-
-def test_height_normal_is_exact_and_never_nan():
-    n = height_normal(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, -2.0]]), 3.0)
-    assert n[0] == pytest.approx([0, 0, 1])
-    assert n[1] == pytest.approx(np.array([-3.0, 0, 1]) / np.sqrt(10))
-    assert n[2] == pytest.approx(np.array([0, 6.0, 1]) / np.sqrt(37))
-    assert np.isfinite(height_normal(np.zeros((4, 2)), 1e9)).all()
 
 
 def test_phong_lights_facing_surfaces_more_and_stays_in_range():

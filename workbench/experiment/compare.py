@@ -152,3 +152,17 @@ def wire_agreement(image, reference, wire_color) -> dict:
     return dict(wire_pixels=int(a.sum()), overdraw_wire_pixels=int(b.sum()),
                 wire_recall_1px=recall, wire_precision_1px=precision, wire_iou_1px=iou,
                 wire_exact_overlap=float((a & b).sum() / max((a | b).sum(), 1)))
+
+
+def crack_pixels(image, background=(1.0, 1.0, 1.0, 1.0)) -> np.ndarray:
+    """(H, W) bool: background pixels enclosed by drawn ones — cracks seen through a surface
+    that should be closed (st2005 §4.3), e.g. between elements whose heights disagree.
+
+    A crack that reaches the image border or the outline is not enclosed and is not counted;
+    for a height field over a simply connected domain seen from above, every crack between
+    elements is enclosed. ``background`` as in :func:`coverage`.
+    """
+    from scipy.ndimage import binary_fill_holes
+
+    covered = coverage(image, background)
+    return binary_fill_holes(covered) & ~covered

@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .poly import height_normal
+
 AMBIENT, DIFFUSE, SPECULAR, SHININESS = 0.3, 0.6, 0.25, 16.0
 LIGHT = np.array([-0.35, 0.45, 1.0]) / np.linalg.norm([-0.35, 0.45, 1.0])
 TOP_EYE = np.array([0.0, 0.0, 1.0])
@@ -52,16 +54,6 @@ def ramp_color(s, table) -> np.ndarray:
     i = np.minimum(np.floor(x).astype(np.int64), len(rgb) - 2)
     f = (x - i)[..., None]
     return rgb[i] * (1.0 - f) + rgb[i + 1] * f
-
-
-def height_normal(grad_speed, height_scale: float) -> np.ndarray:
-    """(K, 3) unit normals of z = height_scale·|v| from the spatial gradient of |v| (K, 2).
-
-    A zero gradient (flat field, or zero velocity) gives exactly (0, 0, 1); never NaN.
-    """
-    g = np.asarray(grad_speed, np.float64) * float(height_scale)
-    n = np.concatenate([-g, np.ones(g.shape[:-1] + (1,))], axis=-1)
-    return n / np.linalg.norm(n, axis=-1, keepdims=True)
 
 
 def phong(color, normal, eye=TOP_EYE, light=LIGHT) -> np.ndarray:

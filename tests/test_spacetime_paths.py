@@ -1,0 +1,180 @@
+"""The st2005 render paths against the exact float64 image of the same solution."""
+
+import numpy as np
+import pytest
+
+from workbench.algo.spacetime.exact import colour_error, element_boundary, exact_image
+from workbench.algo.spacetime.fields import BAR, STEEL
+from workbench.algo.spacetime.poly import evaluate
+from workbench.algo.spacetime.raster import PixelGrid
+from workbench.experiment.compare import crack_pixels
+from workbench.gl import Camera, Framebuffer
+from workbench.paths.colormap import colormap_lut
+from workbench.paths.spacetime import SpacetimePath, SpacetimeScene, SpacetimeStyle, top_camera
+
+U_MAX = 300.0
+SIZE = 96
+CELL = 5.0  # mm
+
+
+def _polygons(n, offset, seed):
+    """n×n cells of CELL mm, each a quad or two triangles, jittered: a tiling of a square."""
+    rng = np.random.default_rng(seed)
+    pts = np.stack(np.meshgrid(np.arange(n + 1.0), np.arange(n + 1.0), indexing="ij"), -1)
+    pts[1:n, 1:n] += rng.uniform(-0.25, 0.25, (n - 1, n - 1, 2))
+    pts = pts * CELL + offset
+    polys = []
+    for i in range(n):
+        for j in range(n):
+            a, b, c, d = pts[i, j], pts[i + 1, j], pts[i + 1, j + 1], pts[i, j + 1]
+            polys += [[a, b, c, d]] if rng.random() < 0.5 else [[a, b, c, c], [a, c, d, d]]
+    return np.array(polys)
+
+
+def _scene(n=4, offset=(0.0, 0.0), seed=0, t=3.0, moving=True, scale=1.0):
+    """One element per polygon with random cubic coefficients: strains ~1e-3, U up to ~U_MAX."""
+    corners = _polygons(n, np.asarray(offset, np.float64), seed)
+    P = len(corners)
+    rng = np.random.default_rng(seed + 1)
+    centre = np.c_[corners.mean(axis=1), np.full(P, t + 0.4)]
+    extent = np.c_[np.ptp(corners, axis=1) * 1.1, np.full(P, 2.0)]
+    coeffs = rng.normal(scale=3e-3 * scale, size=(P, 20, 2))
+    if not moving:  # no monomial with t: zero velocity, a flat height field
+        from workbench.algo.spacetime.poly import EXPONENTS
+        coeffs[:, EXPONENTS[:, 2] > 0] = 0.0
+    return SpacetimeScene(corners, np.arange(P), coeffs, centre, extent, STEEL.lam, STEEL.mu, t=t)
+
+
+def _render(ctx, scene, style, camera, size, background=(1.0, 1.0, 1.0, 1.0)):
+    path = SpacetimePath(style)
+    fb = Framebuffer(ctx, size)
+    try:
+        path.prepare(ctx, scene, camera)
+        fb.use()
+        fb.clear(background)
+        path.draw()
+        return fb.read()
+    finally:
+        path.release()
+        fb.release()
+
+
+def _exact(scene, grid, lighting=True, height_scale=20.0):
+    return exact_image(scene.corners, scene.element, scene.coeffs, scene.centre, scene.extent,
+                       STEEL if scene.t is not None else BAR, grid, t=scene.t, U_max=U_MAX,
+                       table=colormap_lut("inferno"), height_scale=height_scale, lighting=lighting)
+
+
+def _top(ctx, scene, shading, *, origin=None, lighting=True, height_scale=20.0, overdraw=False):
+    grid = PixelGrid.fit(*scene.bounds(), SIZE)
+    o = None if origin is None else np.asarray(origin, np.float64)
+    camera = top_camera(grid, (-1.0, 50.0), origin=o)
+    style = SpacetimeStyle(shading=shading, U_max=U_MAX, height_scale=height_scale,
+                           lighting=lighting, edge_overdraw=overdraw)
+    return _render(ctx, scene, style, camera, (grid.width, grid.height)), grid
+
+
+def _inner_error(image, exact):
+    """colour_error away from element boundaries (where either element may be shown)."""
+    labels = np.where(exact.polygon >= 0, exact.polygon, -1)
+    keep = exact.covered & ~element_boundary(labels)
+    err = np.abs(image[..., :3].astype(float) - 255 * exact.rgb).max(axis=2)
+    return err[keep]
+
+
+@pytest.mark.parametrize("lighting", [True, False])
+def test_per_pixel_matches_the_exact_image(ctx, lighting):
+    scene = _scene()
+    image, grid = _top(ctx, scene, "per_pixel", lighting=lighting)
+    exact = _exact(scene, grid, lighting=lighting)
+    inner = _inner_error(image, exact)
+    assert inner.max() <= 1.0 + 1e-9  # within 1/255 everywhere off element boundaries
+    stats = colour_error(image, exact)
+    assert stats["uncovered"] == 0
+    assert stats["share_over_1"] <= 0.05  # only boundary pixels may pick the neighbour
+
+
+def test_per_vertex_is_visibly_wrong_on_the_same_solution(ctx):
+    scene = _scene()
+    image, grid = _top(ctx, scene, "per_vertex")
+    exact = _exact(scene, grid)
+    inner = _inner_error(image, exact)
+    assert inner.max() > 8.0  # cubic fields are not linear: interpolation misses them
+    assert (inner > 1.0).mean() > 0.2
+
+
+def test_far_from_origin_relative_upload_keeps_the_bound_global_does_not(ctx):
+    offset = np.array([5.0e4, -5.0e4])  # 10^4 element sizes away
+    scene = _scene(offset=offset)
+    near_image, _ = _top(ctx, _scene(), "per_pixel")
+    image, grid = _top(ctx, scene, "per_pixel")
+    exact = _exact(scene, grid)
+    assert _inner_error(image, exact).max() <= 1.0 + 1e-9
+    assert np.array_equal(image, near_image)  # relative upload: the same float32 numbers
+    global_image, _ = _top(ctx, scene, "per_pixel", origin=(0.0, 0.0, 0.0))
+    # global float32 coordinates round positions to 4 µm here (local coordinates to ~1e-3):
+    # the bound breaks
+    assert _inner_error(global_image, exact).max() > 1.2
+
+
+def test_zero_velocity_and_zero_strain_give_finite_exact_colours(ctx):
+    for scene in (_scene(moving=False), _scene(scale=0.0)):
+        image, grid = _top(ctx, scene, "per_pixel")
+        exact = _exact(scene, grid)
+        assert np.isfinite(exact.rgb).all()
+        assert _inner_error(image, exact).max() <= 1.0 + 1e-9
+        vertex, _ = _top(ctx, scene, "per_vertex")
+        assert colour_error(vertex, exact)["uncovered"] == 0
+
+
+def test_bar_spacetime_triangles(ctx):
+    scene = _scene(t=3.0)
+    # reuse the polygons as (x, t) triangles of a bar: centre/extent in (x, 0, t)
+    corners = scene.corners
+    centre = np.c_[scene.centre[:, 0], np.zeros(len(corners)), scene.centre[:, 1]]
+    extent = np.c_[scene.extent[:, 0], np.ones(len(corners)), scene.extent[:, 1]]
+    bar = SpacetimeScene(corners, scene.element, scene.coeffs, centre, extent, BAR.lam, BAR.mu, t=None)
+    for shading in ("per_pixel", "per_vertex"):
+        image, grid = _top(ctx, bar, shading)
+        exact = _exact(bar, grid, lighting=False)
+        inner = _inner_error(image, exact)
+        if shading == "per_pixel":
+            assert inner.max() <= 1.0 + 1e-9
+        else:
+            assert inner.max() > 4.0
+
+
+def test_edge_overdraw_closes_the_cracks_between_discontinuous_elements(ctx):
+    scene = _scene(n=6, seed=3)
+    lo, hi = scene.bounds()
+    speed = evaluate(scene.coeffs, scene.centre, scene.extent, np.repeat(scene.element, 4),
+                     scene.corners[..., 0].ravel(), scene.corners[..., 1].ravel(), scene.t)["speed"]
+    top = 40.0 * speed.max()
+    camera = Camera.fit_box(np.r_[lo, 0.0], np.r_[hi, top], azimuth=20, elevation=35,
+                            projection="perspective", up="z")
+    size = (160, 120)
+    background = (0.0, 1.0, 0.0, 1.0)
+    counts = {}
+    for overdraw in (False, True):
+        style = SpacetimeStyle(shading="per_pixel", U_max=U_MAX, height_scale=40.0,
+                               edge_overdraw=overdraw)
+        image = _render(ctx, scene, style, camera, size, background)
+        counts[overdraw] = int(crack_pixels(image, background).sum())
+    assert counts[False] > 20  # independent per-element heights tear the surface apart
+    assert counts[True] == 0
+
+
+def test_scene_and_style_refusals():
+    scene = _scene()
+    with pytest.raises(ValueError):
+        SpacetimeStyle(shading="per_face")
+    with pytest.raises(ValueError):
+        SpacetimeStyle(U_max=0.0)
+    bad = SpacetimeScene(scene.corners[:0], scene.element[:0], scene.coeffs, scene.centre,
+                         scene.extent, STEEL.lam, STEEL.mu, t=1.0)
+    with pytest.raises(ValueError, match="no polygons"):
+        bad.check()
+    bad = SpacetimeScene(scene.corners, scene.element + 1000, scene.coeffs, scene.centre,
+                         scene.extent, STEEL.lam, STEEL.mu, t=1.0)
+    with pytest.raises(ValueError):
+        bad.check()

@@ -1,0 +1,288 @@
+"""st2005 render paths: time slices of spacetime FE solutions, per vertex or per pixel.
+
+Both paths draw the same polygons (slice polygons of tetrahedra, or the spacetime triangles of
+a 1-D bar) with the height ``height_scale·|v|`` evaluated per vertex from the element's cubic
+polynomial (the paper's vertex program). They differ in colour and lighting:
+
+* ``per_vertex`` — strain energy density, colour and Phong lighting at the polygon vertices,
+  the lit colour interpolated across the polygon (Gouraud);
+* ``per_pixel`` — the element's coefficients are fetched per fragment and the strain energy
+  density, its colour and the exact normal of the height field are evaluated at every pixel
+  (the paper's fragment program).
+
+Element data go to the GPU once per slice in a float RGBA texture, 12 texels per element used
+by the slice (centre, 1/extent, 20 coefficient vectors), rows never breaking an element — the
+paper's texture rectangle. Positions and element centres are float32 relative to a float64
+origin, so a domain far from the coordinate origin is evaluated like one at it; ``origin=0``
+uploads global coordinates instead, to show what that costs.
+
+Options: ``edge_overdraw`` draws every polygon edge as a line with the same program after the
+fill (st2005 §4.3, against cracks between elements whose heights differ); quadrisection is done
+on the polygons before they reach the path (:func:`workbench.algo.spacetime.slicing.quadrisect`).
+
+The shading model is :mod:`workbench.algo.spacetime.shading`; with a top view its float64
+evaluation at pixel centres is the exact image the paths are measured against.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from ..algo.spacetime.shading import LIGHT
+from ..gl import load_program
+from ..gl.camera import Camera
+from .colormap import colormap_lut
+
+SHADINGS = ("per_vertex", "per_pixel")
+ELEMENT_TEXELS = 12
+ELEMENTS_PER_ROW = 341  # 4092 texels per row
+GL_MAX_TEXTURE_SIZE = 0x0D33
+
+
+@dataclass
+class SpacetimeStyle:
+    """How a spacetime path draws.
+
+    shading: "per_vertex" or "per_pixel". edge_overdraw: draw the polygon edges as lines over
+    the fill. lighting: Phong with the height-field normal (off: the ramp colour alone).
+    height_scale: mm of height per mm/µs of speed. U_max: the top of the log colour scale in
+    kJ/m³. colormap: a matplotlib colormap name for the ramp.
+    Refused with ValueError: an unknown shading, a U_max that is not positive and finite, a
+    height scale that is negative or not finite.
+    """
+
+    shading: str = "per_pixel"
+    edge_overdraw: bool = False
+    lighting: bool = True
+    height_scale: float = 1.0
+    U_max: float = 100.0
+    colormap: str = "inferno"
+
+    def __post_init__(self) -> None:
+        if self.shading not in SHADINGS:
+            raise ValueError(f"shading must be one of {SHADINGS}, got {self.shading!r}")
+        if not (np.isfinite(self.U_max) and self.U_max > 0):
+            raise ValueError(f"U_max must be positive and finite, got {self.U_max}")
+        if not (np.isfinite(self.height_scale) and self.height_scale >= 0):
+            raise ValueError(f"height_scale must be non-negative and finite, got {self.height_scale}")
+
+
+@dataclass
+class SpacetimeScene:
+    """What a spacetime path draws: polygons, each with the element whose solution it shows.
+
+    corners: (P, 4, 2) float64 convex polygons, a triangle repeating its third corner — (x, y)
+    in mm of a slice at time ``t`` (µs), or (x, t) spacetime triangles of a 1-D bar with
+    ``t=None``. element: (P,) indices into the solution arrays: ``coeffs`` (M, 20, 2)
+    displacement coefficients in element-local coordinates, ``centre`` and ``extent`` (M, 3)
+    float64 local frames in (x, y, t), and ``lam``/``mu`` the Lamé constants in GPa.
+    """
+
+    corners: np.ndarray
+    element: np.ndarray
+    coeffs: np.ndarray
+    centre: np.ndarray
+    extent: np.ndarray
+    lam: float
+    mu: float
+    t: float | None = None
+
+    @property
+    def is_bar(self) -> bool:
+        return self.t is None
+
+    def check(self) -> None:
+        """ValueError for inconsistent shapes, an empty scene or non-finite data."""
+        P = len(self.corners)
+        if self.corners.shape != (P, 4, 2) or self.element.shape != (P,):
+            raise ValueError(f"corners must be (P, 4, 2) and element (P,), got "
+                             f"{self.corners.shape} and {self.element.shape}")
+        if P == 0:
+            raise ValueError("nothing to draw: the scene has no polygons")
+        M = len(self.coeffs)
+        if self.coeffs.shape != (M, 20, 2) or self.centre.shape != (M, 3) or self.extent.shape != (M, 3):
+            raise ValueError("coeffs must be (M, 20, 2), centre and extent (M, 3)")
+        if self.element.min() < 0 or self.element.max() >= M:
+            raise ValueError(f"element indices must lie in [0, {M})")
+        if not np.isfinite(self.corners).all():
+            raise ValueError("polygon corners must be finite")
+        if (self.extent[np.unique(self.element)] <= 0).any():
+            raise ValueError("element extents must be positive")
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi) of the polygons in the drawing plane, float64."""
+        flat = self.corners.reshape(-1, 2)
+        return flat.min(axis=0), flat.max(axis=0)
+
+
+def top_camera(grid, z_range: tuple[float, float] = (-1.0, 1.0), origin=None) -> Camera:
+    """An orthographic camera looking down −z whose pixels are exactly those of ``grid``
+    (a :class:`workbench.algo.spacetime.raster.PixelGrid`): pixel centres of the image read
+    back are the grid's centres, so the exact image and the rendered one match pixel for pixel.
+    ``z_range`` (mm) must enclose the heights drawn; ``origin`` (3,) defaults to the grid centre
+    at z = 0."""
+    centre = np.array([grid.left + grid.dx * grid.width / 2, grid.top - grid.dy * grid.height / 2, 0.0])
+    origin = centre.copy() if origin is None else np.asarray(origin, np.float64)
+    lo, hi = float(z_range[0]), float(z_range[1])
+    depth = max(hi - lo, 1e-6)
+    eye = centre - origin + np.array([0.0, 0.0, hi + depth])
+    return Camera(origin=origin, eye=eye, target=eye - np.array([0.0, 0.0, 1.0]), up=np.array([0.0, 1.0, 0.0]),
+                  projection="orthographic", half_height=grid.dy * grid.height / 2,
+                  aspect=(grid.dx * grid.width) / (grid.dy * grid.height),
+                  near=0.5 * depth, far=2.5 * depth)
+
+
+class SpacetimePath:
+    """One spacetime render path (``per_vertex`` or ``per_pixel``), prepared for one scene.
+
+    After :meth:`prepare`: ``polygons``, ``triangles`` and ``lines`` drawn, ``elements`` (rows of
+    the element texture), ``bytes_uploaded``.
+    """
+
+    def __init__(self, style: SpacetimeStyle | None = None) -> None:
+        self.style = style if style is not None else SpacetimeStyle()
+        self.ctx = None
+        self._objects: list = []
+        self.polygons = self.triangles = self.lines = self.elements = self.bytes_uploaded = 0
+
+    @property
+    def name(self) -> str:
+        return self.style.shading + ("+overdraw" if self.style.edge_overdraw else "")
+
+    def _keep(self, obj):
+        self._objects.append(obj)
+        return obj
+
+    def prepare(self, ctx: moderngl.Context, scene: SpacetimeScene, camera: Camera) -> None:
+        """Upload ``scene`` (polygons, element texture, ramp) relative to ``camera.origin``."""
+        if self.ctx is not None:
+            self.release()
+        scene.check()
+        self.ctx, self.origin, self.scene = ctx, np.asarray(camera.origin, np.float64), scene
+        try:
+            self._build(ctx, scene)
+            self.set_camera(camera)
+        except BaseException:
+            self.release()
+            raise
+
+    def _build(self, ctx, scene: SpacetimeScene) -> None:
+        style = self.style
+        defines = {}
+        if style.shading == "per_vertex":
+            defines["PER_VERTEX"] = 1
+        if scene.is_bar:
+            defines["BAR"] = 1
+        program = self._program = self._keep(load_program(
+            ctx, "spacetime.vert.glsl", "spacetime.frag.glsl", defines=defines))
+
+        used, slot = np.unique(scene.element, return_inverse=True)
+        self.elements = len(used)
+        texture = self._element_texture(ctx, scene, used)
+        ramp = self._keep(ctx.texture((256, 1), 4, colormap_lut(style.colormap).tobytes()))
+        ramp.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        ramp.repeat_x = ramp.repeat_y = False
+        self._textures = [(texture, 0), (ramp, 1)]
+        program["elements"].value = 0
+        program["ramp"].value = 1
+
+        P = len(scene.corners)
+        positions = (scene.corners - self.origin[:2]).astype(np.float32).reshape(-1, 2)
+        slots = np.repeat(slot.astype(np.int32), 4)
+        vbo = self._keep(ctx.buffer(positions.tobytes()))
+        sbo = self._keep(ctx.buffer(slots.tobytes()))
+        quad = self._is_quad(scene.corners)
+        base = (np.arange(P, dtype=np.int64) * 4)[:, None]
+        tris = np.concatenate([base + [0, 1, 2], (base + [0, 2, 3])[quad]]).astype(np.int32)
+        self.polygons, self.triangles = P, len(tris)
+        ibo = self._keep(ctx.buffer(tris.tobytes()))
+        layout = [(vbo, "2f", "position"), (sbo, "1i", "slot")]
+        self._vao = self._keep(ctx.vertex_array(program, layout, ibo, index_element_size=4))
+        self._line_vao = None
+        nbytes = positions.nbytes + slots.nbytes + tris.nbytes + texture.width * texture.height * 16
+        if style.edge_overdraw:
+            tri_edges = base + np.array([[0, 1], [1, 2], [2, 0]]).reshape(1, -1)
+            quad_edges = base + np.array([[0, 1], [1, 2], [2, 3], [3, 0]]).reshape(1, -1)
+            edges = np.concatenate([tri_edges[~quad].reshape(-1, 2),
+                                    quad_edges[quad].reshape(-1, 2)]).astype(np.int32)
+            lbo = self._keep(ctx.buffer(edges.tobytes()))
+            self._line_vao = self._keep(ctx.vertex_array(program, layout, lbo, index_element_size=4))
+            self.lines = len(edges)
+            nbytes += edges.nbytes
+        self.bytes_uploaded = nbytes
+
+        lam_k, mu_k = scene.lam * 1e6, scene.mu * 1e6  # GPa → kJ/m³ per unit strain²
+        program["lam_k"].value = lam_k
+        program["mu_k"].value = mu_k
+        program["log_denominator"].value = float(np.log1p(style.U_max))
+        program["height_scale"].value = 0.0 if scene.is_bar else float(style.height_scale)
+        program["light"].value = tuple(float(v) for v in LIGHT)
+        program["lighting"].value = 1.0 if (style.lighting and not scene.is_bar) else 0.0
+        if "t_slice" in program:
+            program["t_slice"].value = 0.0 if scene.is_bar else float(scene.t)
+
+    def _spacetime_origin(self) -> np.ndarray:
+        """The float64 point subtracted from spacetime points (x, y, t) before the float32
+        upload: the drawing plane's origin is (x, y) for a slice, (x, t) for the bar."""
+        o = self.origin
+        return np.array([o[0], 0.0, o[1]]) if self.scene.is_bar else np.array([o[0], o[1], 0.0])
+
+    @staticmethod
+    def _is_quad(corners: np.ndarray) -> bool:
+        return ~np.all(corners[:, 3] == corners[:, 2], axis=1)
+
+    def _element_texture(self, ctx, scene: SpacetimeScene, used: np.ndarray):
+        """The element texture: 12 RGBA32F texels per used element, rows of 341 elements."""
+        n = len(used)
+        rows = -(-n // ELEMENTS_PER_ROW)
+        max_size = int(ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
+        if rows > max_size:
+            raise ValueError(f"{n} elements need {rows} texture rows; this renderer allows {max_size}")
+        data = np.zeros((rows * ELEMENTS_PER_ROW, ELEMENT_TEXELS, 4), np.float32)
+        data[:n, 0, :3] = scene.centre[used] - self._spacetime_origin()  # float64, then cast
+        data[:n, 1, :3] = 1.0 / scene.extent[used]
+        data[:n, 2:, :] = scene.coeffs[used].reshape(n, 10, 4)
+        width = ELEMENTS_PER_ROW * ELEMENT_TEXELS
+        texture = self._keep(ctx.texture((width, rows), 4, data.reshape(rows, width, 4).tobytes(),
+                                         dtype="f4"))
+        texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        return texture
+
+    def set_camera(self, camera: Camera) -> None:
+        """Camera uniforms; ``camera.origin`` must be the one given to ``prepare``."""
+        if self.ctx is None:
+            raise RuntimeError("spacetime path is not prepared")
+        if not np.array_equal(np.asarray(camera.origin, np.float64), self.origin):
+            raise ValueError("camera origin differs from the prepared origin: prepare again")
+        program = self._program
+        program["mvp"].write(camera.mvp_bytes())
+        eye = np.asarray(camera.eye, np.float64)
+        axis = eye - np.asarray(camera.target, np.float64)
+        axis /= np.linalg.norm(axis)
+        for name, value in (("eye_position", eye), ("eye_axis", axis)):
+            if name in program:
+                program[name].value = tuple(float(v) for v in value)
+        if "perspective" in program:
+            program["perspective"].value = 1.0 if camera.projection == "perspective" else 0.0
+
+    def draw(self) -> None:
+        """Draw into the bound framebuffer: the fill, then the edge lines if asked for."""
+        ctx = self.ctx
+        ctx.enable_only(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<="
+        for texture, unit in self._textures:
+            texture.use(unit)
+        self._vao.render(moderngl.TRIANGLES)
+        if self._line_vao is not None:
+            self._line_vao.render(moderngl.LINES)
+        ctx.depth_func = "<"
+
+    def release(self) -> None:
+        for obj in reversed(self._objects):
+            obj.release()
+        self._objects.clear()
+        self._textures = []
+        self.ctx = None
