@@ -93,3 +93,12 @@ def test_phong_lights_facing_surfaces_more_and_stays_in_range():
     flat = shade(np.array([9.0]), np.zeros((1, 2)), U_max=99.0,
                  table=np.array([[0, 0, 0, 255], [255, 255, 255, 255]], np.uint8), height_scale=1.0)
     assert np.isfinite(flat).all()
+
+
+def test_degenerate_polygons_cover_nothing():
+    grid = PixelGrid.fit((0, 0), (4, 4), 40, margin=0.0)
+    point = np.full((1, 4, 2), 2.0)
+    segment = np.array([[[1.0, 1.0], [3.0, 3.0], [3.0, 3.0], [1.0, 1.0]]])
+    square = np.array([[[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]]])
+    loc = locate_pixels(np.concatenate([square, point, segment]), grid)
+    assert (loc == 0).all()  # the slice through a vertex or a flat front leaves no trace

@@ -67,6 +67,13 @@ class PixelGrid:
 @numba.njit(cache=True)
 def _locate(corners, left, top, dx, dy, width, height, out):
     for p in range(corners.shape[0]):
+        twice_area = 0.0
+        for k in range(4):
+            ax, ay = corners[p, k, 0] - left, corners[p, k, 1] - top
+            bx, by = corners[p, (k + 1) % 4, 0] - left, corners[p, (k + 1) % 4, 1] - top
+            twice_area += ax * by - bx * ay
+        if not twice_area > 0.0:
+            continue  # degenerate (a slice through a vertex or a flat front): covers nothing
         xmin = xmax = corners[p, 0, 0] - left
         ymin = ymax = top - corners[p, 0, 1]  # y measured downwards from the top
         for k in range(1, 4):
@@ -97,7 +104,8 @@ def locate_pixels(corners, grid: PixelGrid) -> np.ndarray:
     """(H, W) int64: the polygon containing each pixel centre, −1 where none does.
 
     ``corners`` (P, 4, 2) float64 are convex counter-clockwise polygons, a triangle repeating
-    its third corner. A centre on an edge shared by two polygons goes to the later one. The
+    its third corner; polygons of zero area (degenerate slices) contain nothing. A centre on an
+    edge shared by two polygons goes to the later one. The
     test runs in float64 on coordinates relative to the grid, so far-from-origin polygons are
     located as exactly as ones at the origin.
     """
