@@ -277,8 +277,8 @@ def test_materials():
     assert STEEL.p_wave_speed == pytest.approx(math.sqrt(210 * 0.7 / (1.3 * 0.4) / 7.85), rel=1e-12)
     assert BAR.lam == 0.0 and BAR.mu == pytest.approx(105.0)
     assert BAR.p_wave_speed == pytest.approx(math.sqrt(210.0 / 7.85), rel=1e-12)  # ≈ 5.17 mm/µs = km/s
-    for bad in (dict(E=0.0, nu=0.3, rho=1.0), dict(E=1.0, nu=0.5, rho=1.0), dict(E=1.0, nu=-1.0, rho=1.0),
-                dict(E=1.0, nu=0.2, rho=0.0), dict(E=float("nan"), nu=0.2, rho=1.0)):  # fmt: skip
+    for bad in ({"E": 0.0, "nu": 0.3, "rho": 1.0}, {"E": 1.0, "nu": 0.5, "rho": 1.0}, {"E": 1.0, "nu": -1.0, "rho": 1.0},
+                {"E": 1.0, "nu": 0.2, "rho": 0.0}, {"E": float("nan"), "nu": 0.2, "rho": 1.0}):  # fmt: skip
         with pytest.raises(ValueError):
             Material.from_young(**bad)
     with pytest.raises(ValueError):

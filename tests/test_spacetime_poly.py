@@ -14,7 +14,14 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from workbench.algo.spacetime.fields import BAR, STEEL, PlaneWave, RadialPulse, ReflectingWave, strain_energy_density
+from workbench.algo.spacetime.fields import (
+    BAR,
+    STEEL,
+    PlaneWave,
+    RadialPulse,
+    ReflectingWave,
+    strain_energy_density,
+)
 from workbench.algo.spacetime.poly import (
     EXPONENTS,
     evaluate,
