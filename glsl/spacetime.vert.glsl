@@ -36,4 +36,9 @@ void main() {
     v_color = shade(s, eye_dir);
 #endif
     gl_Position = mvp * vec4(world, 1.0);
+#ifdef DEPTH_HALF
+    // edge overdraw behind the fill: polygons (DEPTH_HALF -1) in the near half of the depth
+    // range, lines (+1) in the far half, so lines fill only what no polygon covers
+    gl_Position.z = 0.5 * gl_Position.z + 0.5 * float(DEPTH_HALF) * gl_Position.w;
+#endif
 }

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from scipy.ndimage import binary_dilation
 
 from workbench.algo.spacetime.exact import colour_error, element_boundary, exact_image
 from workbench.algo.spacetime.fields import BAR, STEEL
@@ -65,7 +66,7 @@ def _exact(scene, grid, lighting=True, height_scale=20.0):
                        table=colormap_lut("inferno"), height_scale=height_scale, lighting=lighting)
 
 
-def _top(ctx, scene, shading, *, origin=None, lighting=True, height_scale=20.0, overdraw=False):
+def _top(ctx, scene, shading, *, origin=None, lighting=True, height_scale=20.0, overdraw="none"):
     grid = PixelGrid.fit(*scene.bounds(), SIZE)
     o = None if origin is None else np.asarray(origin, np.float64)
     camera = top_camera(grid, (-1.0, 50.0), origin=o)
@@ -155,19 +156,40 @@ def test_edge_overdraw_closes_the_cracks_between_discontinuous_elements(ctx):
     size = (160, 120)
     background = (0.0, 1.0, 0.0, 1.0)
     counts = {}
-    for overdraw in (False, True):
+    for overdraw in ("none", "over", "behind"):
         style = SpacetimeStyle(shading="per_pixel", U_max=U_MAX, height_scale=40.0,
                                edge_overdraw=overdraw)
         image = _render(ctx, scene, style, camera, size, background)
         counts[overdraw] = int(crack_pixels(image, background).sum())
-    assert counts[False] > 20  # independent per-element heights tear the surface apart
-    assert counts[True] == 0
+    assert counts["none"] > 20  # independent per-element heights tear the surface apart
+    assert counts["over"] == 0
+    assert counts["behind"] == 0
+
+
+def test_overdraw_behind_the_fill_leaves_the_polygons_pixels_exact(ctx):
+    scene = _scene(n=6, seed=3)
+    images = {mode: _top(ctx, scene, "per_pixel", overdraw=mode)[0]
+              for mode in ("none", "over", "behind")}
+    grid = PixelGrid.fit(*scene.bounds(), SIZE)
+    exact = _exact(scene, grid)
+    share = {mode: colour_error(image, exact)["share_over_1"] for mode, image in images.items()}
+    # lines on top paint half a pixel of the neighbour with their own element's colour
+    assert share["over"] > share["none"] + 0.01
+    # lines behind the fill show only where no polygon covers the pixel: in the top view the
+    # polygons tile the square, so inside it the image is the one without lines; outside,
+    # the boundary lines reach at most a pixel beyond the outline
+    covered = exact.covered
+    assert np.array_equal(images["behind"][covered], images["none"][covered])
+    outside = (images["behind"] != images["none"]).any(axis=2) & ~covered
+    assert not (outside & ~binary_dilation(covered, iterations=1)).any()
 
 
 def test_scene_and_style_refusals():
     scene = _scene()
     with pytest.raises(ValueError):
         SpacetimeStyle(shading="per_face")
+    with pytest.raises(ValueError):
+        SpacetimeStyle(edge_overdraw=True)
     with pytest.raises(ValueError):
         SpacetimeStyle(U_max=0.0)
     bad = SpacetimeScene(scene.corners[:0], scene.element[:0], scene.coeffs, scene.centre,

@@ -16,9 +16,14 @@ paper's texture rectangle. Positions and element centres are float32 relative to
 origin, so a domain far from the coordinate origin is evaluated like one at it; ``origin=0``
 uploads global coordinates instead, to show what that costs.
 
-Options: ``edge_overdraw`` draws every polygon edge as a line with the same program after the
-fill (st2005 §4.3, against cracks between elements whose heights differ); quadrisection is done
-on the polygons before they reach the path (:func:`workbench.algo.spacetime.slicing.quadrisect`).
+Options: ``edge_overdraw`` draws every polygon edge as a one-pixel line with the same shading
+after the fill, against the cracks that open between elements whose heights differ (st2005
+§4.3): ``"over"`` depth-tests the lines like the polygons (the paper's overdraw: a line also
+covers up to half a pixel of the neighbouring polygon, which then shows the line's element),
+``"behind"`` draws the polygons in the near half of the depth range and the lines in the far
+half (each keeping its own depth order), so a line shows only where no polygon covers the pixel
+— the gaps — and every pixel a polygon covers keeps that polygon's exact shading. Quadrisection is done on the polygons before they reach the path
+(:func:`workbench.algo.spacetime.slicing.quadrisect`).
 
 The shading model is :mod:`workbench.algo.spacetime.shading`; with a top view its float64
 evaluation at pixel centres is the exact image the paths are measured against.
@@ -37,6 +42,7 @@ from ..gl.camera import Camera
 from .colormap import colormap_lut
 
 SHADINGS = ("per_vertex", "per_pixel")
+OVERDRAWS = ("none", "over", "behind")
 ELEMENT_TEXELS = 12
 ELEMENTS_PER_ROW = 341  # 4092 texels per row
 GL_MAX_TEXTURE_SIZE = 0x0D33
@@ -46,16 +52,16 @@ GL_MAX_TEXTURE_SIZE = 0x0D33
 class SpacetimeStyle:
     """How a spacetime path draws.
 
-    shading: "per_vertex" or "per_pixel". edge_overdraw: draw the polygon edges as lines over
-    the fill. lighting: Phong with the height-field normal (off: the ramp colour alone).
+    shading: "per_vertex" or "per_pixel". edge_overdraw: "none", "over" (polygon edges drawn as
+    lines over the fill) or "behind" (lines that only fill gaps). lighting: Phong with the height-field normal (off: the ramp colour alone).
     height_scale: mm of height per mm/µs of speed. U_max: the top of the log colour scale in
     kJ/m³. colormap: a matplotlib colormap name for the ramp.
-    Refused with ValueError: an unknown shading, a U_max that is not positive and finite, a
+    Refused with ValueError: an unknown shading or overdraw, a U_max that is not positive and finite, a
     height scale that is negative or not finite.
     """
 
     shading: str = "per_pixel"
-    edge_overdraw: bool = False
+    edge_overdraw: str = "none"
     lighting: bool = True
     height_scale: float = 1.0
     U_max: float = 100.0
@@ -64,6 +70,8 @@ class SpacetimeStyle:
     def __post_init__(self) -> None:
         if self.shading not in SHADINGS:
             raise ValueError(f"shading must be one of {SHADINGS}, got {self.shading!r}")
+        if self.edge_overdraw not in OVERDRAWS:
+            raise ValueError(f"edge_overdraw must be one of {OVERDRAWS}, got {self.edge_overdraw!r}")
         if not (np.isfinite(self.U_max) and self.U_max > 0):
             raise ValueError(f"U_max must be positive and finite, got {self.U_max}")
         if not (np.isfinite(self.height_scale) and self.height_scale >= 0):
@@ -150,7 +158,8 @@ class SpacetimePath:
 
     @property
     def name(self) -> str:
-        return self.style.shading + ("+overdraw" if self.style.edge_overdraw else "")
+        overdraw = self.style.edge_overdraw
+        return self.style.shading + ("" if overdraw == "none" else f"+overdraw {overdraw}")
 
     def _keep(self, obj):
         self._objects.append(obj)
@@ -176,8 +185,15 @@ class SpacetimePath:
             defines["PER_VERTEX"] = 1
         if scene.is_bar:
             defines["BAR"] = 1
+        behind = style.edge_overdraw == "behind"
         program = self._program = self._keep(load_program(
-            ctx, "spacetime.vert.glsl", "spacetime.frag.glsl", defines=defines))
+            ctx, "spacetime.vert.glsl", "spacetime.frag.glsl",
+            defines=dict(defines, **({"DEPTH_HALF": -1} if behind else {}))))
+        self._line_program = None
+        if style.edge_overdraw != "none":
+            self._line_program = self._keep(load_program(
+                ctx, "spacetime.vert.glsl", "spacetime.frag.glsl",
+                defines=dict(defines, **({"DEPTH_HALF": 1} if behind else {}))))
 
         used, slot = np.unique(scene.element, return_inverse=True)
         self.elements = len(used)
@@ -186,8 +202,6 @@ class SpacetimePath:
         ramp.filter = (moderngl.LINEAR, moderngl.LINEAR)
         ramp.repeat_x = ramp.repeat_y = False
         self._textures = [(texture, 0), (ramp, 1)]
-        program["elements"].value = 0
-        program["ramp"].value = 1
 
         P = len(scene.corners)
         positions = (scene.corners - self.origin[:2]).astype(np.float32).reshape(-1, 2)
@@ -203,26 +217,36 @@ class SpacetimePath:
         self._vao = self._keep(ctx.vertex_array(program, layout, ibo, index_element_size=4))
         self._line_vao = None
         nbytes = positions.nbytes + slots.nbytes + tris.nbytes + texture.width * texture.height * 16
-        if style.edge_overdraw:
+        if self._line_program is not None:
             tri_edges = base + np.array([[0, 1], [1, 2], [2, 0]]).reshape(1, -1)
             quad_edges = base + np.array([[0, 1], [1, 2], [2, 3], [3, 0]]).reshape(1, -1)
             edges = np.concatenate([tri_edges[~quad].reshape(-1, 2),
                                     quad_edges[quad].reshape(-1, 2)]).astype(np.int32)
             lbo = self._keep(ctx.buffer(edges.tobytes()))
-            self._line_vao = self._keep(ctx.vertex_array(program, layout, lbo, index_element_size=4))
+            self._line_vao = self._keep(ctx.vertex_array(self._line_program, layout, lbo,
+                                                         index_element_size=4))
             self.lines = len(edges)
             nbytes += edges.nbytes
         self.bytes_uploaded = nbytes
 
-        lam_k, mu_k = scene.lam * 1e6, scene.mu * 1e6  # GPa → kJ/m³ per unit strain²
-        program["lam_k"].value = lam_k
-        program["mu_k"].value = mu_k
-        program["log_denominator"].value = float(np.log1p(style.U_max))
-        program["height_scale"].value = 0.0 if scene.is_bar else float(style.height_scale)
-        program["light"].value = tuple(float(v) for v in LIGHT)
-        program["lighting"].value = 1.0 if (style.lighting and not scene.is_bar) else 0.0
-        if "t_slice" in program:
-            program["t_slice"].value = 0.0 if scene.is_bar else float(scene.t)
+        for program in self._programs():
+            self._set_uniforms(program, scene)
+
+    def _programs(self) -> list:
+        return [p for p in (self._program, self._line_program) if p is not None]
+
+    def _set_uniforms(self, program, scene: SpacetimeScene) -> None:
+        style = self.style
+        values = {"elements": 0, "ramp": 1,
+                  "lam_k": scene.lam * 1e6, "mu_k": scene.mu * 1e6,  # GPa → kJ/m³ per strain²
+                  "log_denominator": float(np.log1p(style.U_max)),
+                  "height_scale": 0.0 if scene.is_bar else float(style.height_scale),
+                  "light": tuple(float(v) for v in LIGHT),
+                  "lighting": 1.0 if (style.lighting and not scene.is_bar) else 0.0,
+                  "t_slice": 0.0 if scene.is_bar else float(scene.t)}
+        for name, value in values.items():
+            if name in program:
+                program[name].value = value
 
     def _spacetime_origin(self) -> np.ndarray:
         """The float64 point subtracted from spacetime points (x, y, t) before the float32
@@ -257,16 +281,16 @@ class SpacetimePath:
             raise RuntimeError("spacetime path is not prepared")
         if not np.array_equal(np.asarray(camera.origin, np.float64), self.origin):
             raise ValueError("camera origin differs from the prepared origin: prepare again")
-        program = self._program
-        program["mvp"].write(camera.mvp_bytes())
         eye = np.asarray(camera.eye, np.float64)
         axis = eye - np.asarray(camera.target, np.float64)
         axis /= np.linalg.norm(axis)
-        for name, value in (("eye_position", eye), ("eye_axis", axis)):
-            if name in program:
-                program[name].value = tuple(float(v) for v in value)
-        if "perspective" in program:
-            program["perspective"].value = 1.0 if camera.projection == "perspective" else 0.0
+        for program in self._programs():
+            program["mvp"].write(camera.mvp_bytes())
+            for name, value in (("eye_position", eye), ("eye_axis", axis)):
+                if name in program:
+                    program[name].value = tuple(float(v) for v in value)
+            if "perspective" in program:
+                program["perspective"].value = 1.0 if camera.projection == "perspective" else 0.0
 
     def draw(self) -> None:
         """Draw into the bound framebuffer: the fill, then the edge lines if asked for."""
