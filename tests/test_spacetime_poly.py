@@ -39,7 +39,7 @@ NO_Y = np.flatnonzero(EXPONENTS[:, 1] == 0)
 WITH_Y = np.flatnonzero(EXPONENTS[:, 1] != 0)
 
 
-# --------------------------------------------------------------------------- helpers
+# --------------------------------------------------------------------------- meshes and cubics
 def kuhn_grid(n: int, size, offset) -> tuple[np.ndarray, np.ndarray]:
     """n³ boxes of ``size`` (x, y, t) / n from ``offset``, each cut into the 6 Kuhn tetrahedra."""
     size = np.asarray(size, float)

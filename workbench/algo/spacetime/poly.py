@@ -241,7 +241,8 @@ def fit_cubic(points, simplices, displacement, *, lattice: int = 4, chunk: int =
     (P, 2) (x, t) with (M, 3) triangles (then the callable gets y = 0 and only the 10 monomials
     without y are fitted; the other coefficients are 0). Returns ``coeffs`` (M, 20, 2) float64 in
     the element-local coordinates of ``local_frames``, ``coeffs[e, α, i]`` multiplying m^α for
-    component u_i. Samples are drawn ``chunk`` elements at a time.
+    component u_i. Samples are drawn ``chunk`` elements at a time: the callable gets x, y, t of
+    shape (lattice points, elements in the chunk) and must return that shape plus (2,).
 
     Refused: bad shapes, ``lattice`` < 3 (fewer samples than monomials), ``chunk`` < 1, flat or
     sliver simplices (local volume below ``MIN_LOCAL_VOLUME``), a callable returning the wrong
