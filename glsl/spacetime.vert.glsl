@@ -38,7 +38,10 @@ void main() {
     gl_Position = mvp * vec4(world, 1.0);
 #ifdef DEPTH_HALF
     // edge overdraw behind the fill: polygons (DEPTH_HALF -1) in the near half of the depth
-    // range, lines (+1) in the far half, so lines fill only what no polygon covers
+    // range, lines (+1) in the far half, so lines fill only what no polygon covers; the near
+    // and far planes then clip through clip distances, as the squeezed depth no longer does
+    gl_ClipDistance[0] = gl_Position.w + gl_Position.z;
+    gl_ClipDistance[1] = gl_Position.w - gl_Position.z;
     gl_Position.z = 0.5 * gl_Position.z + 0.5 * float(DEPTH_HALF) * gl_Position.w;
 #endif
 }

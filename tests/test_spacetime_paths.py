@@ -200,3 +200,21 @@ def test_scene_and_style_refusals():
                          scene.extent, STEEL.lam, STEEL.mu, t=1.0)
     with pytest.raises(ValueError):
         bad.check()
+
+
+def test_overdraw_behind_keeps_the_near_and_far_planes(ctx):
+    """The squeezed depth of 'behind' must not let geometry outside near/far through."""
+    scene = _scene(n=6, seed=3)
+    lo, hi = scene.bounds()
+    mid = (lo + hi) / 2
+    camera = Camera.fit_box(np.r_[mid - 4.0, 0.0], np.r_[mid + 4.0, 1.0], azimuth=20,
+                            elevation=35, projection="perspective", up="z", margin=0.9)
+    background = (0.0, 1.0, 0.0, 1.0)
+    covered = {}
+    for overdraw in ("none", "over", "behind"):
+        style = SpacetimeStyle(shading="per_pixel", U_max=U_MAX, height_scale=40.0,
+                               edge_overdraw=overdraw)
+        image = _render(ctx, scene, style, camera, (120, 90), background)
+        covered[overdraw] = (image[..., :3] != (0, 255, 0)).any(axis=2)
+    assert 0.05 < covered["none"].mean() < 0.95  # near/far planes cut the plate
+    assert np.array_equal(covered["behind"], covered["over"])

@@ -45,7 +45,7 @@ SHADINGS = ("per_vertex", "per_pixel")
 OVERDRAWS = ("none", "over", "behind")
 ELEMENT_TEXELS = 12
 ELEMENTS_PER_ROW = 341  # 4092 texels per row
-GL_MAX_TEXTURE_SIZE = 0x0D33
+GL_CLIP_DISTANCE0 = 0x3000
 
 
 @dataclass
@@ -297,11 +297,18 @@ class SpacetimePath:
         ctx = self.ctx
         ctx.enable_only(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="
+        behind = self.style.edge_overdraw == "behind"
+        if behind:  # the near and far planes, clipped by distance
+            ctx.enable_direct(GL_CLIP_DISTANCE0)
+            ctx.enable_direct(GL_CLIP_DISTANCE0 + 1)
         for texture, unit in self._textures:
             texture.use(unit)
         self._vao.render(moderngl.TRIANGLES)
         if self._line_vao is not None:
             self._line_vao.render(moderngl.LINES)
+        if behind:
+            ctx.disable_direct(GL_CLIP_DISTANCE0)
+            ctx.disable_direct(GL_CLIP_DISTANCE0 + 1)
         ctx.depth_func = "<"
 
     def release(self) -> None:
