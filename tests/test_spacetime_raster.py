@@ -102,3 +102,13 @@ def test_degenerate_polygons_cover_nothing():
     square = np.array([[[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]]])
     loc = locate_pixels(np.concatenate([square, point, segment]), grid)
     assert (loc == 0).all()  # the slice through a vertex or a flat front leaves no trace
+
+
+def test_edge_distance_to_the_polygon_boundary():
+    from workbench.algo.spacetime.exact import edge_distance
+    square = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+    triangle = [[0.0, 0.0], [2.0, 0.0], [0.0, 2.0], [0.0, 2.0]]
+    corners = np.array([square, triangle]) + 1e6
+    d = edge_distance(corners, np.array([0, 0, 1, 1]), np.array([0.5, 0.1, 0.5, 1.0]) + 1e6,
+                      np.array([0.5, 0.7, 0.5, 1.0]) + 1e6)
+    assert d == pytest.approx([0.5, 0.1, 0.5, 0.0], abs=1e-9)

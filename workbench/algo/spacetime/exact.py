@@ -101,3 +101,17 @@ def element_boundary(labels: np.ndarray) -> np.ndarray:
     centre = p[1:-1, 1:-1]
     return ((p[:-2, 1:-1] != centre) | (p[2:, 1:-1] != centre)
             | (p[1:-1, :-2] != centre) | (p[1:-1, 2:] != centre))
+
+
+def edge_distance(corners, polygon, x, y) -> np.ndarray:
+    """Distance (model units) from points (x, y) to the boundary of their polygons
+    ``corners[polygon]`` — how close a pixel centre lies to an element edge, where a rasteriser
+    with finite sub-pixel precision may hand it to the neighbour. float64; (K,)."""
+    c = np.asarray(corners, np.float64)[np.asarray(polygon)]
+    p = np.stack([np.asarray(x, np.float64), np.asarray(y, np.float64)], axis=-1)[:, None, :]
+    a, b = c, np.roll(c, -1, axis=1)
+    ab = b - a
+    length2 = (ab ** 2).sum(axis=2)
+    u = np.where(length2 > 0, ((p - a) * ab).sum(axis=2) / np.where(length2 > 0, length2, 1.0), 0.0)
+    closest = a + np.clip(u, 0.0, 1.0)[..., None] * ab
+    return np.sqrt(((p - closest) ** 2).sum(axis=2)).min(axis=1)
