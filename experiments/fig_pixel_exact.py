@@ -11,10 +11,13 @@ Outputs in ``figures/fig_pixel_exact/``:
 
 * ``table.md`` — per slice size (10³ … 10⁶ polygons; 10³ … 10⁵ with ``--quick``): tetrahedra,
   polygons, per-frame slicing time, then for each path (per vertex, per pixel) without edge
-  overdraw, with the paper's overdraw ("over") and with lines behind the fill ("behind"): GPU
-  and wall ms per frame, max and mean colour error against the exact image
-  (1/255), the share of covered pixels over 1/255 (all, and off element boundaries), and crack
-  pixels (background enclosed by the surface) in an oblique perspective view;
+  overdraw, with the paper's overdraw ("over") and with lines behind the fill ("behind"): the
+  time to upload the slice (``prepare_ms``, program linking included), GPU and wall ms per
+  frame, max and mean colour error against the exact image (1/255), the share of covered pixels
+  over 1/255 — all of them, and those whose centre is more than 0.01 px from an element edge
+  (closer, the rasteriser's sub-pixel precision may pick the neighbouring element) with their
+  max error — and crack pixels (background enclosed by the surface) in an oblique perspective
+  view;
 * ``slicing.md`` — incremental slicing of a spacetime mesh of ~10⁶ tetrahedra (10⁵ quick) as t
   advances, against slicing every tetrahedron from scratch;
 * ``sweep.md``, ``sweep.png`` — error and time against the quadrisection threshold and the mesh
@@ -24,9 +27,10 @@ Outputs in ``figures/fig_pixel_exact/``:
   slices through a flat front and through a vertex;
 * ``fig3_bar.png`` (the 1-D bar fixed at one end, its whole (x, t) spacetime),
   ``fig5_slice.png`` (a slice: per vertex, per pixel, exact, both error maps),
-  ``fig5_colorbar.png`` (the per-pixel slice with its colour bar),
-  ``fig4_cracks.png`` and ``fig8_height.png`` (oblique views: raw polygons, the two edge
-  overdraws, overdraw with quadrisection; per vertex against per pixel).
+  ``fig5_crop.png`` (a closer look at a quarter of it), ``fig5_colorbar.png`` (the per-pixel
+  slice with its colour bar), ``fig4_cracks.png`` (oblique views of slices of 10⁴ and 10⁵
+  polygons: raw polygons, the two edge overdraws, overdraw with quadrisection) and
+  ``fig8_height.png`` (the height field, per vertex against per pixel).
 
 Run: ``workbench run fig_pixel_exact [--quick]`` or ``python experiments/fig_pixel_exact.py``.
 """
@@ -61,7 +65,7 @@ PULSE = dict(centre=(30.0, 35.0), a=2.0, t0=2.0)
 T_SLICE = 5.0  # µs: the ring is ~40 mm out
 U_MAX = 100.0  # kJ/m³, top of the log colour scale
 HEIGHT_SCALE = 800.0  # mm of height per mm/µs (peak speeds ~1e-2 mm/µs)
-COLORMAP = "inferno"
+COLORMAP = "plasma"  # its dark end is blue, not black, so lighting shows everywhere
 BACKGROUND = (1.0, 1.0, 1.0, 1.0)
 CRACK_BACKGROUND = (0.0, 1.0, 0.0, 1.0)  # a colour the ramp never produces
 EDGE_PX = 0.01  # pixel centres this close to an element edge may go to either element
@@ -139,7 +143,9 @@ def bar_scene(n: int = 24, t_end: float = 16.0):
 
 class Renderer:
     """One GL context and framebuffer; draws scenes in the top view (against the exact
-    image) and in an oblique perspective view (cracks)."""
+    image) and in an oblique perspective view (cracks). ``last_prepare_ms`` and ``last_bytes``:
+    what preparing the last path took (uploading the slice and its element texture, and
+    linking the programs) and uploaded."""
 
     def __init__(self, width: int, repeat: int) -> None:
         self.ctx = create_context()
@@ -176,11 +182,9 @@ class Renderer:
         return self._draw(scene, style, camera, (grid.width, grid.height), BACKGROUND,
                           time_it) + (grid,)
 
-    def oblique(self, scene, style, *, size=None, time_it=False, crop=None):
-        """(image, timing or None) of a perspective view from 30° above the plate."""
+    def oblique(self, scene, style, *, size=None, time_it=False):
+        """(image, timing or None) of a perspective view from 35° above the plate."""
         lo, hi = scene.bounds()
-        if crop is not None:
-            lo, hi = crop
         top = self.heights(scene)
         camera = Camera.fit_box(np.r_[lo, 0.0], np.r_[hi, top], azimuth=25, elevation=35,
                                 projection="perspective", up="z", margin=0.9,
@@ -192,7 +196,11 @@ class Renderer:
         path = SpacetimePath(style)
         fb = self.fb(size)
         try:
+            start = time.perf_counter()
             path.prepare(self.ctx, scene, camera)
+            self.ctx.finish()
+            self.last_prepare_ms = 1e3 * (time.perf_counter() - start)
+            self.last_bytes = path.bytes_uploaded
             fb.use()
             fb.clear(background)
             path.draw()
@@ -275,6 +283,7 @@ def size_rows(r: Renderer, quick: bool, say) -> tuple[list[dict], dict]:
                            polygons=s.n_polygons, quads=int(s.is_quad.sum()),
                            slice_ms=float(np.median(slice_ms[1:])), path=shading,
                            edge_overdraw=overdraw, **timing.as_row(),
+                           prepare_ms=r.last_prepare_ms, upload_bytes=r.last_bytes,
                            **error_columns(image, exact, scene.corners, grid),
                            crack_pixels=int(crack_pixels(oblique, CRACK_BACKGROUND).sum()),
                            renderer=r.name, image=f"{grid.width}x{grid.height}")
@@ -284,8 +293,8 @@ def size_rows(r: Renderer, quick: bool, say) -> tuple[list[dict], dict]:
                     f">1/255 {100 * row['share_over_1']:.4f} % (off edges "
                     f"{100 * row['share_over_1_off_edges']:.4f} %, max "
                     f"{row['err_max_off_edges']:.2f}), cracks {row['crack_pixels']}")
-        if target == 10_000:
-            keep["sol"], keep["scene"], keep["slice"] = sol, scene, s
+        if target in (10_000, 100_000):
+            keep[target] = (sol, scene, s)
     # per-pixel / per-vertex cost ratio per size (no overdraw, wall time)
     by = {(row["target_polygons"], row["path"], row["edge_overdraw"]): row for row in rows}
     for row in rows:
@@ -297,7 +306,7 @@ def size_rows(r: Renderer, quick: bool, say) -> tuple[list[dict], dict]:
 # ---------------------------------------------------------------------------------- slicing
 def slicing_rows(quick: bool, say) -> list[dict]:
     """Incremental slicing while t advances through a mesh of ~10⁶ (10⁵ quick) tetrahedra."""
-    n, t_end = (25, 6.0) if quick else (50, 10.0)
+    n, t_end = (25, 6.0) if quick else (35, 10.0)
     field = RadialPulse(**PULSE)
     start = time.perf_counter()
     pts, tris = rect_triangulation(n, n, size=(DOMAIN, DOMAIN), jitter=0.25, seed=2)
@@ -330,7 +339,7 @@ def slicing_rows(quick: bool, say) -> list[dict]:
 # ------------------------------------------------------------------------------------ sweep
 def sweep_rows(r: Renderer, quick: bool, keep: dict, say) -> list[dict]:
     rows = []
-    sol, s = keep["sol"], keep["slice"]
+    sol, _, s = keep[10_000]
     area = polygon_areas(s)
     mean_area = float(area.mean())
     factors = (None, 1.0, 0.5, 0.25) if quick else (None, 2.0, 1.0, 0.5, 0.25, 0.125)
@@ -494,37 +503,51 @@ def figures(r: Renderer, out_dir: Path, keep: dict, say) -> None:
     say(f"  fig3: bar, {len(bar.corners)} spacetime triangles, per-vertex error max "
         f"{errors['per_vertex'].max():.0f}, per-pixel {errors['per_pixel'].max():.1f} (1/255)")
 
-    sol, scene = keep["sol"], keep["scene"]
+    sol, scene, s = keep[10_000]
     images = {}
     for shading in ("per_vertex", "per_pixel"):
         images[shading], _, grid = r.top(scene, r.style(shading))
     exact = r.exact(scene, sol.material, grid)
-    save_image_grid(out_dir / "fig5_slice.png",
-                    [images["per_vertex"], images["per_pixel"], exact.rgba8(),
-                     error_map(images["per_vertex"], exact), error_map(images["per_pixel"], exact)],
-                    ["(a) per vertex", "(b) per pixel", "(c) exact", "|a − c|", "|b − c|"],
-                    columns=3)
+    panels = [images["per_vertex"], images["per_pixel"], exact.rgba8(),
+              error_map(images["per_vertex"], exact), error_map(images["per_pixel"], exact)]
+    titles = ["(a) per vertex", "(b) per pixel", "(c) exact", "|a − c|", "|b − c|"]
+    save_image_grid(out_dir / "fig5_slice.png", panels, titles, columns=3)
+    # a quarter of the image around the ring's upper right part, for a closer look
+    h, w = grid.height, grid.width
+    box = (slice(h // 4, h // 2), slice(w // 2, w // 2 + w // 4))
+    save_image_grid(out_dir / "fig5_crop.png", [p[box] for p in panels], titles, columns=5)
     unlit, _, _ = r.top(scene, r.style("per_pixel", lighting=False))
     save_field_figure(out_dir / "fig5_colorbar.png", unlit,
                       value_range=(0.0, float(np.log1p(U_MAX))), colormap=COLORMAP,
                       label="ln(1 + U / (1 kJ/m³)), clamped at U_max", units="",
                       title=f"strain energy density at t = {scene.t:.2f} µs, per pixel, unlit")
 
-    s = keep["slice"]
-    quads = slice_scene(sol, quadrisect(s, 0.25 * float(polygon_areas(s).mean())))
-    lo = np.array([15.0, 15.0]) + sol.field.origin
-    crop = (lo, lo + 40.0)
     panels, titles = [], []
-    for label, sc, overdraw in (("(a) raw polygons", scene, "none"),
-                                ("(b) edge overdraw", scene, "over"),
-                                ("(c) overdraw behind the fill", scene, "behind"),
-                                ("(d) (c) + quadrisection", quads, "behind")):
-        image, _ = r.oblique(sc, r.style("per_pixel", overdraw), crop=crop)
-        panels.append(image)
-        titles.append(f"{label}: {int(crack_pixels(image, CRACK_BACKGROUND).sum())} crack px")
-    save_image_grid(out_dir / "fig4_cracks.png", panels, titles, columns=2)
+    for target in (10_000, 100_000):
+        sol_k, scene_k, s_k = keep[target]
+        quads = slice_scene(sol_k, quadrisect(s_k, 0.25 * float(polygon_areas(s_k).mean())))
+        row = []
+        for label, sc, overdraw in (("raw", scene_k, "none"), ("overdraw", scene_k, "over"),
+                                    ("overdraw behind", scene_k, "behind"),
+                                    ("behind + quadrisection", quads, "behind")):
+            image, _ = r.oblique(sc, r.style("per_pixel", overdraw))
+            row.append(image)
+            titles.append(f"{s_k.n_polygons} polygons, {label}: "
+                          f"{int(crack_pixels(image, CRACK_BACKGROUND).sum())} crack px")
+        panels += crop_to_cracks(row)
+    save_image_grid(out_dir / "fig4_cracks.png", panels, titles, columns=4)
     panels = [r.oblique(scene, r.style(sh, "behind"))[0] for sh in ("per_vertex", "per_pixel")]
     save_image_grid(out_dir / "fig8_height.png", panels, ["(a) per-vertex colour", "(b) per-pixel colour"])
+
+
+def crop_to_cracks(images: list) -> list:
+    """The same half-size window of every image, centred on the first image's cracks."""
+    h, w = images[0].shape[:2]
+    cracks = np.argwhere(crack_pixels(images[0], CRACK_BACKGROUND))
+    ci, cj = cracks.mean(axis=0).astype(int) if len(cracks) else (h // 2, w // 2)
+    i0 = int(np.clip(ci - h // 4, 0, h - h // 2))
+    j0 = int(np.clip(cj - w // 4, 0, w - w // 2))
+    return [im[i0:i0 + h // 2, j0:j0 + w // 2] for im in images]
 
 
 @experiment("fig_pixel_exact", "st2005: pixel-exact rendering of spacetime FE solutions, "

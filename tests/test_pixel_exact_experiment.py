@@ -18,7 +18,8 @@ def test_every_table_and_figure_is_written(result):
     _, out_dir = result
     for name in ("table", "slicing", "sweep", "stability"):
         assert (out_dir / f"{name}.csv").is_file() and (out_dir / f"{name}.md").is_file()
-    for name in ("fig3_bar", "fig5_slice", "fig5_colorbar", "fig4_cracks", "fig8_height", "sweep"):
+    for name in ("fig3_bar", "fig5_slice", "fig5_crop", "fig5_colorbar", "fig4_cracks",
+                 "fig8_height", "sweep"):
         assert (out_dir / f"{name}.png").stat().st_size > 10_000
 
 

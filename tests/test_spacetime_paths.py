@@ -200,6 +200,12 @@ def test_scene_and_style_refusals():
                          scene.extent, STEEL.lam, STEEL.mu, t=1.0)
     with pytest.raises(ValueError):
         bad.check()
+    coeffs = scene.coeffs.copy()
+    coeffs[3, 5, 1] = np.nan
+    bad = SpacetimeScene(scene.corners, scene.element, coeffs, scene.centre, scene.extent,
+                         STEEL.lam, STEEL.mu, t=1.0)
+    with pytest.raises(ValueError, match="finite"):
+        bad.check()
 
 
 def test_overdraw_behind_keeps_the_near_and_far_planes(ctx):

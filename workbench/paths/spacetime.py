@@ -103,7 +103,8 @@ class SpacetimeScene:
         return self.t is None
 
     def check(self) -> None:
-        """ValueError for inconsistent shapes, an empty scene or non-finite data."""
+        """ValueError for inconsistent shapes, an empty scene, element indices out of range,
+        non-positive extents or non-finite corners, coefficients or centres."""
         P = len(self.corners)
         if self.corners.shape != (P, 4, 2) or self.element.shape != (P,):
             raise ValueError(f"corners must be (P, 4, 2) and element (P,), got "
@@ -117,8 +118,11 @@ class SpacetimeScene:
             raise ValueError(f"element indices must lie in [0, {M})")
         if not np.isfinite(self.corners).all():
             raise ValueError("polygon corners must be finite")
-        if (self.extent[np.unique(self.element)] <= 0).any():
+        used = np.unique(self.element)
+        if (self.extent[used] <= 0).any():
             raise ValueError("element extents must be positive")
+        if not (np.isfinite(self.coeffs[used]).all() and np.isfinite(self.centre[used]).all()):
+            raise ValueError("element coefficients and centres must be finite")
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) of the polygons in the drawing plane, float64."""
@@ -255,7 +259,7 @@ class SpacetimePath:
         return np.array([o[0], 0.0, o[1]]) if self.scene.is_bar else np.array([o[0], o[1], 0.0])
 
     @staticmethod
-    def _is_quad(corners: np.ndarray) -> bool:
+    def _is_quad(corners: np.ndarray) -> np.ndarray:
         return ~np.all(corners[:, 3] == corners[:, 2], axis=1)
 
     def _element_texture(self, ctx, scene: SpacetimeScene, used: np.ndarray):
