@@ -243,6 +243,23 @@ def test_front_refined_is_non_conforming_on_band_boundaries():
     assert max_slope(m) <= 0.5 * (1 + 1e-9)
 
 
+@pytest.mark.parametrize("build", ["tent 2-D", "front refined 2-D", "tent 1-D"])
+def test_shared_facets_match_a_brute_force_count(build):
+    if build == "tent 1-D":
+        p, s = interval_mesh(7, jitter=0.2, seed=3)
+        m = tent_pitch(p, s, 0.0, 0.5, 1.0)
+    else:
+        p, s = rect_triangulation(5, 4, jitter=0.2, seed=3)
+        m = (tent_pitch(p, s, 0.0, 0.3, 1.0) if build == "tent 2-D" else
+             front_refined(p, s, 0.4, 1.0, front_distance=ring_front, bands=4, width=0.05, levels=2))
+    counts = face_counts(m)
+    k = m.simplices.shape[1]
+    expected = np.array([[counts[tuple(np.sort(np.delete(row, i)))] > 1 for i in range(k)]
+                         for row in m.simplices])
+    assert np.array_equal(m.shared_facets, expected)
+    assert 0 < (~expected).sum() < expected.size  # both kinds occur
+
+
 def test_front_refined_without_front_is_conforming():
     p, t = rect_triangulation(4, 3, jitter=0.1)
     m = front_refined(p, t, 0.3, 1.0, bands=3)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from workbench.algo.spacetime.mesh import (SpacetimeMesh, front_refined, interval_mesh,
@@ -159,15 +159,93 @@ def test_flat_front_gives_the_top_faces():
 @given(kind=mesh_kind, times=st.lists(slice_time, min_size=1, max_size=12))
 def test_time_slicer_matches_brute_force(kind, times):
     m = MESHES[kind]
-    slicer = TimeSlicer(m)
+    slicer = TimeSlicer(m, outer=True)
     sequence = sorted(times) + sorted(times, reverse=True) + times
     for t in sequence:
-        s, ref = slicer.slice(t), slice_at(m, t)
+        s, ref = slicer.slice(t), slice_at(m, t, outer=True)
         order = np.argsort(s.element)
         assert np.array_equal(s.element[order], ref.element)
         assert np.array_equal(s.corners[order], ref.corners)
         assert np.array_equal(s.is_quad[order], ref.is_quad)
+        assert np.array_equal(s.outer[order], ref.outer)
         assert np.array_equal(np.sort(slicer.active), ref.element)
+    assert TimeSlicer(m).slice(times[0]).outer is None  # derived only when asked for
+
+
+# --------------------------------------------------------------------------- outer edges
+def edge_lengths(s: Slice) -> np.ndarray:
+    return np.linalg.norm(np.roll(s.corners, -1, axis=1) - s.corners, axis=2)
+
+
+def on_square_boundary(s: Slice) -> np.ndarray:
+    """(P, 4) bool: polygon edges of non-zero length with both ends on one side of the unit
+    square — the reference for ``outer``, from geometry alone."""
+    a, b = s.corners, np.roll(s.corners, -1, axis=1)
+    on = np.zeros(a.shape[:2], bool)
+    for axis in (0, 1):
+        for side in (0.0, 1.0):
+            on |= (np.abs(a[..., axis] - side) < 1e-12) & (np.abs(b[..., axis] - side) < 1e-12)
+    return on & (edge_lengths(s) > 0)
+
+
+@PROPERTY
+@given(kind=mesh_kind, t=st.floats(1e-6, T_END - 1e-6),
+       max_area=st.one_of(st.none(), st.floats(2e-4, 0.05)))
+def test_outer_edges_are_the_domain_boundary(kind, t, max_area):
+    m = MESHES[kind]
+    # through a vertex an edge may run along a tetrahedron edge shared by a boundary face and
+    # an inner one; those times are tested below
+    assume(np.abs(m.points[:, -1] - t).min() > 1e-9)
+    s = slice_at(m, t, outer=True)
+    if max_area is not None:
+        s = quadrisect(s, max_area)
+    assert s.outer.shape == (s.n_polygons, 4) and s.outer.dtype == bool
+    assert not s.outer[~s.is_quad, 2].any()
+    assert np.array_equal(s.outer, on_square_boundary(s))
+    assert s.outer.any() and not s.outer.all()
+
+
+@pytest.mark.parametrize("kind", sorted(MESHES))
+def test_outer_edges_at_vertex_and_band_times_are_never_inner(kind):
+    m = MESHES[kind]
+    times = np.unique(m.points[:, -1])
+    rng = np.random.default_rng(1)
+    for t in list(rng.choice(times[1:], 15)) + list(np.linspace(0.0, T_END, BANDS + 1)[1:]):
+        s = slice_at(m, t, outer=True)
+        boundary = on_square_boundary(s)
+        real = s.outer & (edge_lengths(s) > 0)
+        # an inner edge is never taken for a boundary one (it would lose its overdraw); a
+        # boundary edge along a tetrahedron edge whose faces through it are inner is missed
+        assert not (real & ~boundary).any()
+
+
+def test_outer_edges_follow_the_flips_and_the_children():
+    """Hand-checked: a lone tetrahedron, all of whose faces are outer, cut clockwise and
+    counter-clockwise, and quadrisected: outer edges are the polygon's whole perimeter, the
+    children's inner edges are not outer."""
+    for pts in ([[0, 0, 0], [1, 0, 1], [0, 1, 1], [0, 0, 1]],    # one vertex below t = 0.5
+                [[0, 0, 0], [0, 1, 1], [1, 0, 1], [0, 0, 1]],    # the same, other orientation
+                [[0, 0, 0], [2, 0, 0], [0, 2, 1], [2, 3, 1]]):   # a quad
+        m = SpacetimeMesh(np.array(pts, float), np.array([[0, 1, 2, 3]]))
+        s = slice_at(m, 0.5, outer=True)
+        assert polygon_areas(s)[0] > 0
+        assert np.array_equal(s.outer, edge_lengths(s) > 0)
+        q = quadrisect(s, 0.2 * polygon_areas(s)[0])
+        assert q.n_polygons == 16
+        perimeter = (edge_lengths(s) * s.outer).sum()
+        assert np.isclose((edge_lengths(q) * q.outer).sum(), perimeter)
+        # an outer child edge lies on the parent's boundary: its midpoint is on a parent edge
+        a, b = q.corners, np.roll(q.corners, -1, axis=1)
+        mid = 0.5 * (a + b)[q.outer]
+        c, d = s.corners[0], np.roll(s.corners[0], -1, axis=0)
+        c, d = c[edge_lengths(s)[0] > 0], d[edge_lengths(s)[0] > 0]
+        e = d - c
+        cross = e[None, :, 0] * (mid[:, None, 1] - c[None, :, 1]) - e[None, :, 1] * (mid[:, None, 0] - c[None, :, 0])
+        assert np.all(np.abs(cross).min(axis=1) < 1e-12)
+        inner = ~q.outer & (edge_lengths(q) > 0)
+        mid = 0.5 * (a + b)[inner]
+        cross = e[None, :, 0] * (mid[:, None, 1] - c[None, :, 1]) - e[None, :, 1] * (mid[:, None, 0] - c[None, :, 0])
+        assert np.all(np.abs(cross).min(axis=1) > 1e-6)
 
 
 def test_slice_at_elements_subset():

@@ -95,6 +95,28 @@ class SpacetimeMesh:
         out.setflags(write=False)
         return out
 
+    @cached_property
+    def shared_facets(self) -> np.ndarray:
+        """(M, D+2) bool: whether the facet opposite vertex i of simplex m (its other D+1
+        vertices) is a facet of another simplex too. A facet no other simplex has lies on the
+        boundary of the spacetime domain (the spatial boundary, the first and last fronts) or
+        on a non-conforming interface."""
+        sim = self.simplices.astype(np.int64)
+        M, k = sim.shape
+        facets = np.sort(np.stack([np.delete(sim, i, axis=1) for i in range(k)], axis=1), axis=2)
+        flat = facets.reshape(-1, k - 1)
+        n = max(len(self.points), 1)
+        if float(n) ** (k - 1) < 2.0 ** 62:  # one int64 key per facet sorts fastest
+            key = flat[:, 0]
+            for j in range(1, k - 1):
+                key = key * n + flat[:, j]
+            _, inverse, counts = np.unique(key, return_inverse=True, return_counts=True)
+        else:
+            _, inverse, counts = np.unique(flat, axis=0, return_inverse=True, return_counts=True)
+        out = (counts[inverse.ravel()] > 1).reshape(M, k)
+        out.setflags(write=False)
+        return out
+
 
 def _signed_measure(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
     """Signed volume of d-simplices in d dimensions: det of the edge vectors / d!."""
