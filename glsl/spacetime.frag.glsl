@@ -1,6 +1,12 @@
 #version 330
 #include "spacetime_poly.glsl"
 #include "spacetime_shade.glsl"
+#ifdef SKIRT  // the inputs come from the skirt geometry shader
+#define v_slot g_slot
+#define v_st g_st
+#define v_world g_world
+#define v_color g_color
+#endif
 uniform vec3 eye_position;
 uniform vec3 eye_axis;
 uniform float perspective;

@@ -4,9 +4,9 @@
 // the fragment shader as the spacetime point and element slot (per pixel).
 #include "spacetime_poly.glsl"
 #include "spacetime_shade.glsl"
+#include "spacetime_place.glsl"
 in vec2 position;  // (x, y) or, for the bar, (x, t); relative to the upload origin
 in int slot;
-uniform mat4 mvp;
 uniform float t_slice;     // slice time, us (time is never shifted)
 uniform vec3 eye_position; // relative world position of the eye (perspective)
 uniform vec3 eye_axis;     // unit direction towards the eye (orthographic)
@@ -35,13 +35,5 @@ void main() {
     vec3 eye_dir = perspective > 0.5 ? normalize(eye_position - world) : eye_axis;
     v_color = shade(s, eye_dir);
 #endif
-    gl_Position = mvp * vec4(world, 1.0);
-#ifdef DEPTH_HALF
-    // edge overdraw behind the fill: polygons (DEPTH_HALF -1) in the near half of the depth
-    // range, lines (+1) in the far half, so lines fill only what no polygon covers; the near
-    // and far planes then clip through clip distances, as the squeezed depth no longer does
-    gl_ClipDistance[0] = gl_Position.w + gl_Position.z;
-    gl_ClipDistance[1] = gl_Position.w - gl_Position.z;
-    gl_Position.z = 0.5 * gl_Position.z + 0.5 * float(DEPTH_HALF) * gl_Position.w;
-#endif
+    gl_Position = place(world);
 }

@@ -1,12 +1,18 @@
 // st2005 per-element cubic displacement polynomials, evaluated in element-local coordinates.
-// Element data lives in a float RGBA texture, ELEMENT_TEXELS texels per element packed into
-// rows of ELEMENTS_PER_ROW elements (never broken across rows), like the paper's texture
-// rectangle: texel 0 = centre (x, y, t) relative to the upload origin, texel 1 = 1/extent,
-// texels 2..11 = the 20 coefficient vectors c_a = (u_x, u_y), two per texel, in the order
+// Element data: ELEMENT_TEXELS float RGBA texels per element, texel 0 = centre (x, y, t)
+// relative to the upload origin, texel 1 = 1/extent, texels 2..11 = the 20 coefficient vectors
+// c_a = (u_x, u_y), two per texel, in the order
 // 1, x, y, t, x2, xy, xt, y2, yt, t2, x3, x2y, x2t, xy2, xyt, xt2, y3, y2t, yt2, t3.
+// With ELEMENT_BUFFER they sit in a buffer texture indexed by slot (texel slot*12 + k);
+// otherwise in a 2-D texture, rows of ELEMENTS_PER_ROW elements never broken across rows,
+// like the paper's texture rectangle.
 #define ELEMENT_TEXELS 12
 #define ELEMENTS_PER_ROW 341
+#ifdef ELEMENT_BUFFER
+uniform samplerBuffer elements;
+#else
 uniform sampler2D elements;
+#endif
 uniform float lam_k;  // Lame constants in kJ/m3 per unit strain squared (GPa * 1e6)
 uniform float mu_k;
 
@@ -17,9 +23,13 @@ struct Solution {
 };
 
 vec4 element_texel(int slot, int k) {
+#ifdef ELEMENT_BUFFER
+    return texelFetch(elements, slot * ELEMENT_TEXELS + k);
+#else
     int row = slot / ELEMENTS_PER_ROW;
     int col = (slot - row * ELEMENTS_PER_ROW) * ELEMENT_TEXELS + k;
     return texelFetch(elements, ivec2(col, row), 0);
+#endif
 }
 
 Solution evaluate(int slot, vec3 st) {

@@ -192,6 +192,11 @@ def test_scene_and_style_refusals():
         SpacetimeStyle(edge_overdraw=True)
     with pytest.raises(ValueError):
         SpacetimeStyle(U_max=0.0)
+    with pytest.raises(ValueError, match="element_store"):
+        SpacetimeStyle(element_store="ssbo")
+    with pytest.raises(ValueError, match="outer"):
+        SpacetimeScene(scene.corners, scene.element, scene.coeffs, scene.centre, scene.extent,
+                       STEEL.lam, STEEL.mu, t=1.0, outer=np.zeros((3, 4), bool)).check()
     bad = SpacetimeScene(scene.corners[:0], scene.element[:0], scene.coeffs, scene.centre,
                          scene.extent, STEEL.lam, STEEL.mu, t=1.0)
     with pytest.raises(ValueError, match="no polygons"):
@@ -224,3 +229,98 @@ def test_overdraw_behind_keeps_the_near_and_far_planes(ctx):
         covered[overdraw] = (image[..., :3] != (0, 255, 0)).any(axis=2)
     assert 0.05 < covered["none"].mean() < 0.95  # near/far planes cut the plate
     assert np.array_equal(covered["behind"], covered["over"])
+
+
+def _square_outer(scene):
+    """(P, 4) bool: the polygon edges on the boundary of the tiled square, from geometry."""
+    lo, hi = scene.bounds()
+    a, b = scene.corners, np.roll(scene.corners, -1, axis=1)
+    on = np.zeros(a.shape[:2], bool)
+    for axis in (0, 1):
+        for side in (lo[axis], hi[axis]):
+            on |= (a[..., axis] == side) & (b[..., axis] == side)
+    return on & ~np.all(a == b, axis=2)
+
+
+def _oblique_cracks(ctx, scene, overdraw, shading="per_pixel", height_scale=40.0):
+    lo, hi = scene.bounds()
+    speed = evaluate(scene.coeffs, scene.centre, scene.extent, np.repeat(scene.element, 4),
+                     scene.corners[..., 0].ravel(), scene.corners[..., 1].ravel(), scene.t)["speed"]
+    camera = Camera.fit_box(np.r_[lo, 0.0], np.r_[hi, height_scale * speed.max()], azimuth=20,
+                            elevation=35, projection="perspective", up="z")
+    background = (0.0, 1.0, 0.0, 1.0)
+    style = SpacetimeStyle(shading=shading, U_max=U_MAX, height_scale=height_scale,
+                           edge_overdraw=overdraw)
+    image = _render(ctx, scene, style, camera, (160, 120), background)
+    return int(crack_pixels(image, background).sum())
+
+
+@pytest.mark.parametrize("shading", ["per_pixel", "per_vertex"])
+def test_skirts_close_gaps_wider_than_a_line(ctx, shading):
+    """Heights that jump by many pixels between elements: one-pixel lines leave most of each
+    gap open, skirts close every one of them."""
+    scene = _scene(n=6, seed=3)
+    scene.outer = _square_outer(scene)
+    counts = {mode: _oblique_cracks(ctx, scene, mode, shading, height_scale=400.0)
+              for mode in ("none", "behind", "skirts")}
+    assert counts["none"] > 200
+    assert counts["behind"] > 50  # the paper's lines are not enough here
+    assert counts["skirts"] == 0
+
+
+def test_skirts_leave_the_top_view_to_the_polygons(ctx):
+    scene = _scene(n=6, seed=3)
+    scene.outer = _square_outer(scene)
+    behind, grid = _top(ctx, scene, "per_pixel", overdraw="behind")
+    skirts, _ = _top(ctx, scene, "per_pixel", overdraw="skirts")
+    assert np.array_equal(skirts, behind)  # vertical quads cover no pixel from straight above
+    exact = _exact(scene, grid)
+    assert _inner_error(skirts, exact).max() <= 1.0 + 1e-9
+
+
+def test_edges_on_the_domain_boundary_are_not_overdrawn(ctx):
+    scene = _scene(n=6, seed=3)
+    none, grid = _top(ctx, scene, "per_pixel")
+    covered = _exact(scene, grid).covered
+    # every edge treated as shared: boundary lines reach beyond the outline
+    spill = (_top(ctx, scene, "per_pixel", overdraw="over")[0] != none).any(axis=2) & ~covered
+    assert spill.sum() > 10
+    scene.outer = _square_outer(scene)
+    assert scene.outer.sum() == 4 * 6
+    # the points where inner edges meet the boundary: the 4 × 5 grid nodes on the sides
+    lo, hi = scene.bounds()
+    a = scene.corners
+    inner_ends = {tuple(p) for p in a[~scene.outer].reshape(-1, 2).tolist()
+                  if p[0] in (lo[0], hi[0]) or p[1] in (lo[1], hi[1])}
+    assert len(inner_ends) >= 4 * 5
+    for mode in ("over", "behind", "skirts"):
+        image, _ = _top(ctx, scene, "per_pixel", overdraw=mode)
+        changed = (image != none).any(axis=2) & ~covered
+        # only the last pixel of an inner edge that ends on the boundary may lie beyond it
+        assert changed.sum() <= len(inner_ends) < spill.sum() / 10
+
+
+@pytest.mark.parametrize("shading", ["per_pixel", "per_vertex"])
+def test_buffer_and_texture_stores_draw_the_same_image(ctx, shading):
+    scene = _scene(n=5, seed=4)
+    grid = PixelGrid.fit(*scene.bounds(), SIZE)
+    camera = top_camera(grid, (-1.0, 50.0))
+    images = []
+    for store in ("buffer", "texture"):
+        style = SpacetimeStyle(shading=shading, U_max=U_MAX, height_scale=20.0, element_store=store)
+        images.append(_render(ctx, scene, style, camera, (grid.width, grid.height)))
+    assert np.array_equal(images[0], images[1])  # the same float32 records, fetched two ways
+    assert colour_error(images[0], _exact(scene, grid))["uncovered"] == 0
+
+
+def test_texture_buffer_refusals(ctx):
+    from workbench.gl.texbuffer import TextureBuffer
+
+    with pytest.raises(ValueError, match="float32"):
+        TextureBuffer(ctx, np.zeros((4, 4)))
+    with pytest.raises(ValueError, match="float32"):
+        TextureBuffer(ctx, np.zeros((4, 3), np.float32))
+    tb = TextureBuffer(ctx, np.zeros((4, 4), np.float32))
+    assert tb.nbytes == 64
+    tb.release()
+    tb.release()  # twice is harmless

@@ -10,19 +10,30 @@ polynomial (the paper's vertex program). They differ in colour and lighting:
   density, its colour and the exact normal of the height field are evaluated at every pixel
   (the paper's fragment program).
 
-Element data go to the GPU once per slice in a float RGBA texture, 12 texels per element used
-by the slice (centre, 1/extent, 20 coefficient vectors), rows never breaking an element — the
-paper's texture rectangle. Positions and element centres are float32 relative to a float64
-origin, so a domain far from the coordinate origin is evaluated like one at it; ``origin=0``
-uploads global coordinates instead, to show what that costs.
+Element data go to the GPU once per slice, 12 float RGBA texels per element used by the
+slice (centre, 1/extent, 20 coefficient vectors), indexed by the element's slot: in a buffer
+texture (``element_store="buffer"``, a ``samplerBuffer``) or in a 2-D texture whose rows never
+break an element (``"texture"``, the paper's texture rectangle). Positions and element centres
+are float32 relative to a float64 origin, so a domain far from the coordinate origin is
+evaluated like one at it; ``origin=0`` uploads global coordinates instead, to show what that
+costs.
 
-Options: ``edge_overdraw`` draws every polygon edge as a one-pixel line with the same shading
-after the fill, against the cracks that open between elements whose heights differ (st2005
-§4.3): ``"over"`` depth-tests the lines like the polygons (the paper's overdraw: a line also
-covers up to half a pixel of the neighbouring polygon, which then shows the line's element),
-``"behind"`` draws the polygons in the near half of the depth range and the lines in the far
-half (each keeping its own depth order), so a line shows only where no polygon covers the pixel
-— the gaps — and every pixel a polygon covers keeps that polygon's exact shading. Quadrisection is done on the polygons before they reach the path
+Options: ``edge_overdraw`` draws the edges shared between polygons (every edge but those the
+scene marks ``outer``, on the domain boundary) with the same shading after the fill, against the
+cracks that open between elements whose heights differ (st2005 §4.3):
+
+* ``"over"`` — one-pixel lines depth-tested like the polygons (the paper's overdraw: a line
+  also covers up to half a pixel of the neighbouring polygon, which then shows the line's
+  element);
+* ``"behind"`` — the polygons in the near half of the depth range and the lines in the far
+  half (each keeping its own depth order), so a line shows only where no polygon covers the
+  pixel — the gaps — and every pixel a polygon covers keeps that polygon's exact shading;
+* ``"skirts"`` — as ``"behind"``, plus a vertical quad hanging from every shared edge down
+  below the lowest height (a geometry shader makes it from the edge's line), also in the far
+  half: a line fills a gap only up to a pixel wide, a skirt closes a gap of any width. Skirts
+  are vertical, so a top view draws none of their pixels.
+
+Quadrisection is done on the polygons before they reach the path
 (:func:`workbench.algo.spacetime.slicing.quadrisect`).
 
 The shading model is :mod:`workbench.algo.spacetime.shading`; with a top view its float64
@@ -39,10 +50,12 @@ import numpy as np
 from ..algo.spacetime.shading import LIGHT
 from ..gl import load_program
 from ..gl.camera import Camera
+from ..gl.texbuffer import TextureBuffer
 from .colormap import colormap_lut
 
 SHADINGS = ("per_vertex", "per_pixel")
-OVERDRAWS = ("none", "over", "behind")
+OVERDRAWS = ("none", "over", "behind", "skirts")
+ELEMENT_STORES = ("buffer", "texture")
 ELEMENT_TEXELS = 12
 ELEMENTS_PER_ROW = 341  # 4092 texels per row
 GL_CLIP_DISTANCE0 = 0x3000
@@ -52,12 +65,14 @@ GL_CLIP_DISTANCE0 = 0x3000
 class SpacetimeStyle:
     """How a spacetime path draws.
 
-    shading: "per_vertex" or "per_pixel". edge_overdraw: "none", "over" (polygon edges drawn as
-    lines over the fill) or "behind" (lines that only fill gaps). lighting: Phong with the height-field normal (off: the ramp colour alone).
-    height_scale: mm of height per mm/µs of speed. U_max: the top of the log colour scale in
-    kJ/m³. colormap: a matplotlib colormap name for the ramp.
-    Refused with ValueError: an unknown shading or overdraw, a U_max that is not positive and finite, a
-    height scale that is negative or not finite.
+    shading: "per_vertex" or "per_pixel". edge_overdraw: "none", "over" (shared edges drawn as
+    lines over the fill), "behind" (lines that only fill gaps) or "skirts" (lines and vertical
+    skirts that only fill gaps). lighting: Phong with the height-field normal (off: the ramp
+    colour alone). height_scale: mm of height per mm/µs of speed. U_max: the top of the log
+    colour scale in kJ/m³. colormap: a matplotlib colormap name for the ramp. element_store:
+    "buffer" (a buffer texture) or "texture" (a 2-D texture of rows).
+    Refused with ValueError: an unknown shading, overdraw or store, a U_max that is not
+    positive and finite, a height scale that is negative or not finite.
     """
 
     shading: str = "per_pixel"
@@ -66,12 +81,15 @@ class SpacetimeStyle:
     height_scale: float = 1.0
     U_max: float = 100.0
     colormap: str = "inferno"
+    element_store: str = "buffer"
 
     def __post_init__(self) -> None:
         if self.shading not in SHADINGS:
             raise ValueError(f"shading must be one of {SHADINGS}, got {self.shading!r}")
         if self.edge_overdraw not in OVERDRAWS:
             raise ValueError(f"edge_overdraw must be one of {OVERDRAWS}, got {self.edge_overdraw!r}")
+        if self.element_store not in ELEMENT_STORES:
+            raise ValueError(f"element_store must be one of {ELEMENT_STORES}, got {self.element_store!r}")
         if not (np.isfinite(self.U_max) and self.U_max > 0):
             raise ValueError(f"U_max must be positive and finite, got {self.U_max}")
         if not (np.isfinite(self.height_scale) and self.height_scale >= 0):
@@ -86,7 +104,10 @@ class SpacetimeScene:
     in mm of a slice at time ``t`` (µs), or (x, t) spacetime triangles of a 1-D bar with
     ``t=None``. element: (P,) indices into the solution arrays: ``coeffs`` (M, 20, 2)
     displacement coefficients in element-local coordinates, ``centre`` and ``extent`` (M, 3)
-    float64 local frames in (x, y, t), and ``lam``/``mu`` the Lamé constants in GPa.
+    float64 local frames in (x, y, t), and ``lam``/``mu`` the Lamé constants in GPa. outer:
+    (P, 4) bool, edge k (corner k to k + 1) on the domain boundary, where edge overdraw draws
+    nothing (:attr:`workbench.algo.spacetime.slicing.Slice.outer`); None: every edge is
+    treated as shared.
     """
 
     corners: np.ndarray
@@ -97,6 +118,7 @@ class SpacetimeScene:
     lam: float
     mu: float
     t: float | None = None
+    outer: np.ndarray | None = None
 
     @property
     def is_bar(self) -> bool:
@@ -118,6 +140,8 @@ class SpacetimeScene:
             raise ValueError(f"element indices must lie in [0, {M})")
         if not np.isfinite(self.corners).all():
             raise ValueError("polygon corners must be finite")
+        if self.outer is not None and (np.shape(self.outer) != (P, 4) or np.asarray(self.outer).dtype != bool):
+            raise ValueError(f"outer must be (P, 4) bool, got {np.shape(self.outer)}")
         used = np.unique(self.element)
         if (self.extent[used] <= 0).any():
             raise ValueError("element extents must be positive")
@@ -150,27 +174,34 @@ def top_camera(grid, z_range: tuple[float, float] = (-1.0, 1.0), origin=None) ->
 class SpacetimePath:
     """One spacetime render path (``per_vertex`` or ``per_pixel``), prepared for one scene.
 
-    After :meth:`prepare`: ``polygons``, ``triangles`` and ``lines`` drawn, ``elements`` (rows of
-    the element texture), ``bytes_uploaded``.
+    After :meth:`prepare`: ``polygons``, ``triangles``, ``lines`` (shared edges overdrawn) and
+    ``skirts`` drawn, ``elements`` (element records uploaded), ``bytes_uploaded``.
     """
 
     def __init__(self, style: SpacetimeStyle | None = None) -> None:
         self.style = style if style is not None else SpacetimeStyle()
         self.ctx = None
         self._objects: list = []
-        self.polygons = self.triangles = self.lines = self.elements = self.bytes_uploaded = 0
+        self._textures: list = []
+        self.polygons = self.triangles = self.lines = self.skirts = 0
+        self.elements = self.bytes_uploaded = 0
 
     @property
     def name(self) -> str:
         overdraw = self.style.edge_overdraw
         return self.style.shading + ("" if overdraw == "none" else f"+overdraw {overdraw}")
 
+    @property
+    def _behind(self) -> bool:
+        """Whether the overdraw goes to the far half of the depth range, behind the fill."""
+        return self.style.edge_overdraw in ("behind", "skirts")
+
     def _keep(self, obj):
         self._objects.append(obj)
         return obj
 
     def prepare(self, ctx: moderngl.Context, scene: SpacetimeScene, camera: Camera) -> None:
-        """Upload ``scene`` (polygons, element texture, ramp) relative to ``camera.origin``."""
+        """Upload ``scene`` (polygons, element records, ramp) relative to ``camera.origin``."""
         if self.ctx is not None:
             self.release()
         scene.check()
@@ -182,6 +213,16 @@ class SpacetimePath:
             self.release()
             raise
 
+    def _load(self, ctx, defines: dict, depth_half: int | None, skirt: bool = False):
+        defines = dict(defines)
+        if depth_half is not None:
+            defines["DEPTH_HALF"] = depth_half
+        if skirt:
+            defines["SKIRT"] = 1
+        return self._keep(load_program(ctx, "spacetime.vert.glsl", "spacetime.frag.glsl",
+                                       geometry="spacetime_skirt.geom.glsl" if skirt else None,
+                                       defines=defines))
+
     def _build(self, ctx, scene: SpacetimeScene) -> None:
         style = self.style
         defines = {}
@@ -189,23 +230,29 @@ class SpacetimePath:
             defines["PER_VERTEX"] = 1
         if scene.is_bar:
             defines["BAR"] = 1
-        behind = style.edge_overdraw == "behind"
-        program = self._program = self._keep(load_program(
-            ctx, "spacetime.vert.glsl", "spacetime.frag.glsl",
-            defines=dict(defines, **({"DEPTH_HALF": -1} if behind else {}))))
-        self._line_program = None
+        if style.element_store == "buffer":
+            defines["ELEMENT_BUFFER"] = 1
+        behind = self._behind
+        self._program = self._load(ctx, defines, -1 if behind else None)
+        self._line_program = self._skirt_program = None
         if style.edge_overdraw != "none":
-            self._line_program = self._keep(load_program(
-                ctx, "spacetime.vert.glsl", "spacetime.frag.glsl",
-                defines=dict(defines, **({"DEPTH_HALF": 1} if behind else {}))))
+            self._line_program = self._load(ctx, defines, 1 if behind else None)
+        if style.edge_overdraw == "skirts":
+            self._skirt_program = self._load(ctx, defines, 1, skirt=True)
 
         used, slot = np.unique(scene.element, return_inverse=True)
         self.elements = len(used)
-        texture = self._element_texture(ctx, scene, used)
+        records = self._element_records(scene, used)
+        if style.element_store == "buffer":
+            store = self._keep(TextureBuffer(ctx, records.reshape(-1, 4)))
+            store_bytes = store.nbytes
+        else:
+            store = self._element_texture(ctx, records)
+            store_bytes = store.width * store.height * 16
         ramp = self._keep(ctx.texture((256, 1), 4, colormap_lut(style.colormap).tobytes()))
         ramp.filter = (moderngl.LINEAR, moderngl.LINEAR)
         ramp.repeat_x = ramp.repeat_y = False
-        self._textures = [(texture, 0), (ramp, 1)]
+        self._textures = [(store, 0), (ramp, 1)]
 
         P = len(scene.corners)
         positions = (scene.corners - self.origin[:2]).astype(np.float32).reshape(-1, 2)
@@ -218,36 +265,55 @@ class SpacetimePath:
         self.polygons, self.triangles = P, len(tris)
         ibo = self._keep(ctx.buffer(tris.tobytes()))
         layout = [(vbo, "2f", "position"), (sbo, "1i", "slot")]
-        self._vao = self._keep(ctx.vertex_array(program, layout, ibo, index_element_size=4))
-        self._line_vao = None
-        nbytes = positions.nbytes + slots.nbytes + tris.nbytes + texture.width * texture.height * 16
+        self._vao = self._keep(ctx.vertex_array(self._program, layout, ibo, index_element_size=4))
+        self._line_vao = self._skirt_vao = None
+        nbytes = positions.nbytes + slots.nbytes + tris.nbytes + store_bytes
         if self._line_program is not None:
-            tri_edges = base + np.array([[0, 1], [1, 2], [2, 0]]).reshape(1, -1)
-            quad_edges = base + np.array([[0, 1], [1, 2], [2, 3], [3, 0]]).reshape(1, -1)
-            edges = np.concatenate([tri_edges[~quad].reshape(-1, 2),
-                                    quad_edges[quad].reshape(-1, 2)]).astype(np.int32)
-            lbo = self._keep(ctx.buffer(edges.tobytes()))
-            self._line_vao = self._keep(ctx.vertex_array(self._line_program, layout, lbo,
-                                                         index_element_size=4))
+            edges = self._shared_edges(scene, quad)
             self.lines = len(edges)
+            if len(edges):
+                lbo = self._keep(ctx.buffer(edges.tobytes()))
+                self._line_vao = self._keep(ctx.vertex_array(self._line_program, layout, lbo,
+                                                             index_element_size=4))
+                if self._skirt_program is not None:
+                    self._skirt_vao = self._keep(ctx.vertex_array(self._skirt_program, layout, lbo,
+                                                                  index_element_size=4))
+                    self.skirts = len(edges)
             nbytes += edges.nbytes
         self.bytes_uploaded = nbytes
 
         for program in self._programs():
             self._set_uniforms(program, scene)
 
+    @staticmethod
+    def _shared_edges(scene: SpacetimeScene, quad: np.ndarray) -> np.ndarray:
+        """(E, 2) int32 vertex pairs of the polygon edges to overdraw: all but the zero-length
+        edge of a triangle and the edges the scene marks outer."""
+        P = len(quad)
+        keep = np.ones((P, 4), bool)
+        keep[~quad, 2] = False
+        if scene.outer is not None:
+            keep &= ~np.asarray(scene.outer)
+        k = np.arange(4)
+        pairs = (np.arange(P, dtype=np.int64) * 4)[:, None, None] + np.stack([k, (k + 1) % 4], -1)
+        return pairs[keep].astype(np.int32)
+
     def _programs(self) -> list:
-        return [p for p in (self._program, self._line_program) if p is not None]
+        return [p for p in (self._program, self._line_program, self._skirt_program) if p is not None]
 
     def _set_uniforms(self, program, scene: SpacetimeScene) -> None:
         style = self.style
+        lo, hi = scene.bounds()
         values = {"elements": 0, "ramp": 1,
                   "lam_k": scene.lam * 1e6, "mu_k": scene.mu * 1e6,  # GPa → kJ/m³ per strain²
                   "log_denominator": float(np.log1p(style.U_max)),
                   "height_scale": 0.0 if scene.is_bar else float(style.height_scale),
                   "light": tuple(float(v) for v in LIGHT),
                   "lighting": 1.0 if (style.lighting and not scene.is_bar) else 0.0,
-                  "t_slice": 0.0 if scene.is_bar else float(scene.t)}
+                  "t_slice": 0.0 if scene.is_bar else float(scene.t),
+                  # heights are >= 0: a floor a little below 0 keeps every skirt's bottom edge
+                  # under the lower neighbour instead of on it
+                  "skirt_floor": -1e-3 * float(max(np.max(hi - lo), 1e-9))}
         for name, value in values.items():
             if name in program:
                 program[name].value = value
@@ -262,17 +328,25 @@ class SpacetimePath:
     def _is_quad(corners: np.ndarray) -> np.ndarray:
         return ~np.all(corners[:, 3] == corners[:, 2], axis=1)
 
-    def _element_texture(self, ctx, scene: SpacetimeScene, used: np.ndarray):
-        """The element texture: 12 RGBA32F texels per used element, rows of 341 elements."""
+    def _element_records(self, scene: SpacetimeScene, used: np.ndarray) -> np.ndarray:
+        """(n, 12, 4) float32: per used element its centre relative to the upload origin (in
+        float64, then cast), 1/extent and the 20 coefficient vectors, two per texel."""
         n = len(used)
+        data = np.zeros((n, ELEMENT_TEXELS, 4), np.float32)
+        data[:, 0, :3] = scene.centre[used] - self._spacetime_origin()
+        data[:, 1, :3] = 1.0 / scene.extent[used]
+        data[:, 2:, :] = scene.coeffs[used].reshape(n, 10, 4)
+        return data
+
+    def _element_texture(self, ctx, records: np.ndarray):
+        """The records in a 2-D RGBA32F texture, rows of 341 elements (4092 texels)."""
+        n = len(records)
         rows = -(-n // ELEMENTS_PER_ROW)
         max_size = int(ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
         if rows > max_size:
             raise ValueError(f"{n} elements need {rows} texture rows; this renderer allows {max_size}")
         data = np.zeros((rows * ELEMENTS_PER_ROW, ELEMENT_TEXELS, 4), np.float32)
-        data[:n, 0, :3] = scene.centre[used] - self._spacetime_origin()  # float64, then cast
-        data[:n, 1, :3] = 1.0 / scene.extent[used]
-        data[:n, 2:, :] = scene.coeffs[used].reshape(n, 10, 4)
+        data[:n] = records
         width = ELEMENTS_PER_ROW * ELEMENT_TEXELS
         texture = self._keep(ctx.texture((width, rows), 4, data.reshape(rows, width, 4).tobytes(),
                                          dtype="f4"))
@@ -297,11 +371,11 @@ class SpacetimePath:
                 program["perspective"].value = 1.0 if camera.projection == "perspective" else 0.0
 
     def draw(self) -> None:
-        """Draw into the bound framebuffer: the fill, then the edge lines if asked for."""
+        """Draw into the bound framebuffer: the fill, then the edge lines and skirts if asked for."""
         ctx = self.ctx
         ctx.enable_only(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="
-        behind = self.style.edge_overdraw == "behind"
+        behind = self._behind
         if behind:  # the near and far planes, clipped by distance
             ctx.enable_direct(GL_CLIP_DISTANCE0)
             ctx.enable_direct(GL_CLIP_DISTANCE0 + 1)
@@ -310,6 +384,8 @@ class SpacetimePath:
         self._vao.render(moderngl.TRIANGLES)
         if self._line_vao is not None:
             self._line_vao.render(moderngl.LINES)
+        if self._skirt_vao is not None:
+            self._skirt_vao.render(moderngl.LINES)
         if behind:
             ctx.disable_direct(GL_CLIP_DISTANCE0)
             ctx.disable_direct(GL_CLIP_DISTANCE0 + 1)
