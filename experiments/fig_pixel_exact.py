@@ -11,25 +11,27 @@ Outputs in ``figures/fig_pixel_exact/``:
 
 * ``table.md`` — per slice size (10³ … 10⁶ polygons; 10³ … 10⁵ with ``--quick``): tetrahedra,
   polygons, per-frame slicing time, then for each path (per vertex, per pixel) without edge
-  overdraw, with the paper's overdraw ("over") and with lines behind the fill ("behind"): the
-  time to upload the slice (``prepare_ms``, program linking included), GPU and wall ms per
-  frame, max and mean colour error against the exact image (1/255), the share of covered pixels
-  over 1/255 — all of them, and those whose centre is more than 0.01 px from an element edge
-  (closer, the rasteriser's sub-pixel precision may pick the neighbouring element) with their
-  max error — and crack pixels (background enclosed by the surface) in an oblique perspective
-  view;
+  overdraw, with the paper's line overdraw ("over"), with lines behind the fill ("behind") and
+  with lines and skirts behind it ("skirts"), element records in a buffer texture, and once
+  more without overdraw from the paper's 2-D texture rectangle ("texture"): the time to upload
+  the slice (``prepare_ms``, program linking included), GPU and wall ms per frame, max and
+  mean colour error against the exact image (1/255), the share of covered pixels over 1/255 —
+  all of them, and those whose centre is more than 0.01 px from an element edge (closer, the
+  rasteriser's sub-pixel precision may pick the neighbouring element) with their max error —
+  and crack pixels (background enclosed by the surface) in an oblique perspective view;
 * ``slicing.md`` — incremental slicing of a spacetime mesh of ~10⁶ tetrahedra (10⁵ quick) as t
-  advances, against slicing every tetrahedron from scratch;
+  advances, with and without the domain-boundary edges, against slicing every tetrahedron from
+  scratch;
 * ``sweep.md``, ``sweep.png`` — error and time against the quadrisection threshold and the mesh
-  resolution (run time against error);
+  resolution (run time against error), with crack pixels for lines and for skirts;
 * ``stability.md`` — the domain 10⁴ element sizes from the origin (relative against global
   float32 coordinates, on the GPU and in a float32 emulation), zero velocity and zero strain,
   slices through a flat front and through a vertex;
 * ``fig3_bar.png`` (the 1-D bar fixed at one end, its whole (x, t) spacetime),
   ``fig5_slice.png`` (a slice: per vertex, per pixel, exact, both error maps),
   ``fig5_crop.png`` (a closer look at a quarter of it), ``fig5_colorbar.png`` (the per-pixel
-  slice with its colour bar), ``fig4_cracks.png`` (oblique views of slices of 10⁴ and 10⁵
-  polygons: raw polygons, the two edge overdraws, overdraw with quadrisection) and
+  slice with its colour bar), ``fig4_cracks.png`` (oblique views of slices of 10³, 10⁴ and 10⁵
+  polygons: raw polygons, lines over and behind the fill, lines with quadrisection, skirts) and
   ``fig8_height.png`` (the height field, per vertex against per pixel).
 
 Run: ``workbench run fig_pixel_exact [--quick]`` or ``python experiments/fig_pixel_exact.py``.
@@ -119,7 +121,8 @@ def window(n: int, layers: float = 1.0) -> tuple[float, float]:
 
 def slice_scene(sol: Solution, s) -> SpacetimeScene:
     m = sol.material
-    return SpacetimeScene(s.corners, s.element, sol.coeffs, sol.centre, sol.extent, m.lam, m.mu, t=s.t)
+    return SpacetimeScene(s.corners, s.element, sol.coeffs, sol.centre, sol.extent, m.lam, m.mu,
+                          t=s.t, outer=s.outer)
 
 
 def bar_scene(n: int = 24, t_end: float = 16.0):
@@ -159,9 +162,10 @@ class Renderer:
             self._fbs[size] = Framebuffer(self.ctx, size)
         return self._fbs[size]
 
-    def style(self, shading, overdraw="none", lighting=True) -> SpacetimeStyle:
+    def style(self, shading, overdraw="none", lighting=True, store="buffer") -> SpacetimeStyle:
         return SpacetimeStyle(shading=shading, edge_overdraw=overdraw, lighting=lighting,
-                              height_scale=HEIGHT_SCALE, U_max=U_MAX, colormap=COLORMAP)
+                              height_scale=HEIGHT_SCALE, U_max=U_MAX, colormap=COLORMAP,
+                              element_store=store)
 
     def grid(self, scene: SpacetimeScene) -> PixelGrid:
         return PixelGrid.fit(*scene.bounds(), self.width)
@@ -261,7 +265,7 @@ def size_rows(r: Renderer, quick: bool, say) -> tuple[list[dict], dict]:
         n = RESOLUTIONS[target]
         t_lo, t_hi = window(n)
         sol = plate_solution(n, t_lo, t_hi)
-        slicer = TimeSlicer(sol.mesh)
+        slicer = TimeSlicer(sol.mesh, outer=True)
         frames = np.linspace(t_lo + 0.05 * (t_hi - t_lo), T_SLICE, 9)
         slice_ms = []
         for t in frames:
@@ -272,9 +276,12 @@ def size_rows(r: Renderer, quick: bool, say) -> tuple[list[dict], dict]:
         say(f"  {target:>9} target: {sol.mesh.n_simplices} tets, {s.n_polygons} polygons, "
             f"mesh {sol.mesh_s:.1f} s, fit {sol.fit_s:.1f} s, slice {np.median(slice_ms[1:]):.1f} ms")
         exact = None
+        # every overdraw with the element records in a buffer texture, and the paper's 2-D
+        # texture rectangle for comparison
+        variants = [(overdraw, "buffer") for overdraw in OVERDRAWS] + [("none", "texture")]
         for shading in ("per_vertex", "per_pixel"):
-            for overdraw in OVERDRAWS:
-                style = r.style(shading, overdraw)
+            for overdraw, store in variants:
+                style = r.style(shading, overdraw, store=store)
                 image, timing, grid = r.top(scene, style, time_it=True)
                 if exact is None:
                     exact = r.exact(scene, sol.material, grid)
@@ -282,23 +289,24 @@ def size_rows(r: Renderer, quick: bool, say) -> tuple[list[dict], dict]:
                 row = dict(target_polygons=target, cells=f"{n}x{n}", tets=sol.mesh.n_simplices,
                            polygons=s.n_polygons, quads=int(s.is_quad.sum()),
                            slice_ms=float(np.median(slice_ms[1:])), path=shading,
-                           edge_overdraw=overdraw, **timing.as_row(),
+                           edge_overdraw=overdraw, element_store=store, **timing.as_row(),
                            prepare_ms=r.last_prepare_ms, upload_bytes=r.last_bytes,
                            **error_columns(image, exact, scene.corners, grid),
                            crack_pixels=int(crack_pixels(oblique, CRACK_BACKGROUND).sum()),
                            renderer=r.name, image=f"{grid.width}x{grid.height}")
                 rows.append(row)
-                say(f"    {shading:10} overdraw {overdraw:6} wall {row['wall_ms']:.1f} ms, "
+                say(f"    {shading:10} overdraw {overdraw:6} {store:7} wall {row['wall_ms']:.1f} ms, "
                     f"err max {row['err_max']:.1f} mean {row['err_mean']:.2f}, "
                     f">1/255 {100 * row['share_over_1']:.4f} % (off edges "
                     f"{100 * row['share_over_1_off_edges']:.4f} %, max "
                     f"{row['err_max_off_edges']:.2f}), cracks {row['crack_pixels']}")
-        if target in (10_000, 100_000):
+        if target <= 100_000:
             keep[target] = (sol, scene, s)
-    # per-pixel / per-vertex cost ratio per size (no overdraw, wall time)
-    by = {(row["target_polygons"], row["path"], row["edge_overdraw"]): row for row in rows}
+    # cost against the per-vertex path with the same overdraw and store (wall time)
+    by = {(row["target_polygons"], row["path"], row["edge_overdraw"], row["element_store"]): row
+          for row in rows}
     for row in rows:
-        base = by[(row["target_polygons"], "per_vertex", "none")]
+        base = by[(row["target_polygons"], "per_vertex", row["edge_overdraw"], row["element_store"])]
         row["wall_vs_per_vertex"] = row["wall_ms"] / base["wall_ms"]
     return rows, keep
 
@@ -314,7 +322,9 @@ def slicing_rows(quick: bool, say) -> list[dict]:
                          front_distance=field.front_distance, width=1.5 * DOMAIN / n)
     build_s = time.perf_counter() - start
     say(f"slicing: {mesh.n_simplices} tets built in {build_s:.1f} s")
+    start = time.perf_counter()
     slicer = TimeSlicer(mesh)
+    sort_s = time.perf_counter() - start
     times = np.linspace(0.05 * t_end, 0.95 * t_end, 10 if quick else 40)
     inc, polys = [], []
     for t in times:
@@ -322,16 +332,29 @@ def slicing_rows(quick: bool, say) -> list[dict]:
         s = slicer.slice(float(t))
         inc.append(1e3 * (time.perf_counter() - start))
         polys.append(s.n_polygons)
+    # the same frames with the domain-boundary edges the edge overdraw leaves out
+    start = time.perf_counter()
+    mesh.shared_facets  # derived once per mesh
+    facets_s = time.perf_counter() - start
+    outer_slicer = TimeSlicer(mesh, outer=True)
+    inc_outer = []
+    for t in times:
+        start = time.perf_counter()
+        outer_slicer.slice(float(t))
+        inc_outer.append(1e3 * (time.perf_counter() - start))
     brute = [time_call(lambda t=t: slice_at(mesh, float(t)), warmup=0, repeat=5).wall_ms
              for t in times[:: max(1, len(times) // 5)]]
     area = float(polygon_areas(s).sum())
-    row = dict(tets=mesh.n_simplices, build_s=build_s, frames=len(times),
+    row = dict(tets=mesh.n_simplices, build_s=build_s, sort_s=sort_s, frames=len(times),
                polygons_median=int(np.median(polys)), polygons_max=int(max(polys)),
                incremental_ms_median=float(np.median(inc[1:])), incremental_ms_max=float(max(inc[1:])),
-               first_frame_ms=inc[0], brute_force_ms_median=float(np.median(brute)),
+               first_frame_ms=inc[0], shared_facets_s=facets_s,
+               with_outer_ms_median=float(np.median(inc_outer[1:])),
+               brute_force_ms_median=float(np.median(brute)),
                speedup=float(np.median(brute) / np.median(inc[1:])),
                last_slice_area_error=abs(area - DOMAIN * DOMAIN) / (DOMAIN * DOMAIN))
-    say(f"  incremental {row['incremental_ms_median']:.1f} ms/frame (max {row['incremental_ms_max']:.1f}), "
+    say(f"  incremental {row['incremental_ms_median']:.1f} ms/frame (max {row['incremental_ms_max']:.1f}, "
+        f"{row['with_outer_ms_median']:.1f} with boundary edges), "
         f"brute force {row['brute_force_ms_median']:.1f} ms, {row['polygons_median']} polygons")
     return [row]
 
@@ -350,17 +373,20 @@ def sweep_rows(r: Renderer, quick: bool, keep: dict, say) -> list[dict]:
         qs = slice_scene(sol, q)
         for shading in ("per_vertex", "per_pixel"):
             image, timing, grid = r.top(qs, r.style(shading, "behind"), time_it=True)
-            if exact is None:
-                exact = r.exact(qs, sol.material, grid)
+            if exact is None:  # children show their parent's element: one exact image for all
+                exact = r.exact(slice_scene(sol, s), sol.material, grid)
             oblique, _ = r.oblique(qs, r.style(shading, "behind"))
+            skirted, _ = r.oblique(qs, r.style(shading, "skirts"))
             rows.append(dict(sweep="quadrisection", cells=sol.label,
                              threshold_mm2=None if factor is None else threshold,
                              threshold_vs_mean_area=factor, polygons=q.n_polygons, path=shading,
                              wall_ms=timing.wall_ms, gpu_ms=timing.gpu_ms,
-                             **error_columns(image, exact, qs.corners, grid),
+                             **error_columns(image, exact, s.corners, grid),
                              crack_pixels=int(crack_pixels(oblique, CRACK_BACKGROUND).sum()),
+                             crack_pixels_skirts=int(crack_pixels(skirted, CRACK_BACKGROUND).sum()),
                              renderer=r.name))
-        say(f"  quadrisection {factor}: {q.n_polygons} polygons")
+        say(f"  quadrisection {factor}: {q.n_polygons} polygons, {rows[-1]['crack_pixels']} crack "
+            f"pixels with lines behind, {rows[-1]['crack_pixels_skirts']} with skirts")
     for n in ((12, 24, 48) if quick else (12, 24, 48, 96, 192)):
         t_lo, t_hi = window(n)
         sol_n = plate_solution(n, t_lo, t_hi)
@@ -523,20 +549,21 @@ def figures(r: Renderer, out_dir: Path, keep: dict, say) -> None:
                       title=f"strain energy density at t = {scene.t:.2f} µs, per pixel, unlit")
 
     panels, titles = [], []
-    for target in (10_000, 100_000):
+    for target in (1_000, 10_000, 100_000):
         sol_k, scene_k, s_k = keep[target]
         quads = slice_scene(sol_k, quadrisect(s_k, 0.25 * float(polygon_areas(s_k).mean())))
         row = []
-        for label, sc, overdraw in (("raw", scene_k, "none"), ("overdraw", scene_k, "over"),
-                                    ("overdraw behind", scene_k, "behind"),
-                                    ("behind + quadrisection", quads, "behind")):
+        for label, sc, overdraw in (("raw", scene_k, "none"), ("lines over", scene_k, "over"),
+                                    ("lines behind", scene_k, "behind"),
+                                    ("behind + quadrisection", quads, "behind"),
+                                    ("skirts", scene_k, "skirts")):
             image, _ = r.oblique(sc, r.style("per_pixel", overdraw))
             row.append(image)
             titles.append(f"{s_k.n_polygons} polygons, {label}: "
                           f"{int(crack_pixels(image, CRACK_BACKGROUND).sum())} crack px")
         panels += crop_to_cracks(row)
-    save_image_grid(out_dir / "fig4_cracks.png", panels, titles, columns=4)
-    panels = [r.oblique(scene, r.style(sh, "behind"))[0] for sh in ("per_vertex", "per_pixel")]
+    save_image_grid(out_dir / "fig4_cracks.png", panels, titles, columns=5)
+    panels = [r.oblique(scene, r.style(sh, "skirts"))[0] for sh in ("per_vertex", "per_pixel")]
     save_image_grid(out_dir / "fig8_height.png", panels, ["(a) per-vertex colour", "(b) per-pixel colour"])
 
 

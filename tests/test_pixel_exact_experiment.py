@@ -28,9 +28,11 @@ def test_per_pixel_is_exact_off_element_boundaries_and_per_vertex_is_not(result)
     sizes = sorted({r["target_polygons"] for r in rows})
     assert sizes == [1_000, 10_000, 100_000]
     for size in sizes:
-        by = {(r["path"], r["edge_overdraw"]): r for r in rows if r["target_polygons"] == size}
-        assert 0.5 * size < by[("per_pixel", "none")]["polygons"] < 2 * size
-        pixel, vertex = by[("per_pixel", "none")], by[("per_vertex", "none")]
+        by = {(r["path"], r["edge_overdraw"], r["element_store"]): r
+              for r in rows if r["target_polygons"] == size}
+        assert len(by) == 2 * 5
+        assert 0.5 * size < by[("per_pixel", "none", "buffer")]["polygons"] < 2 * size
+        pixel, vertex = by[("per_pixel", "none", "buffer")], by[("per_vertex", "none", "buffer")]
         assert pixel["share_over_1"] <= 0.001  # the 99.9 % target
         # off element edges: within 1/255 up to float32 arithmetic
         assert pixel["err_max_off_edges"] < 1.1
@@ -38,11 +40,16 @@ def test_per_pixel_is_exact_off_element_boundaries_and_per_vertex_is_not(result)
         assert pixel["uncovered"] == 0
         assert vertex["share_over_1"] > 10 * pixel["share_over_1"]
         assert vertex["err_mean"] > pixel["err_mean"]
-        # lines behind the fill leave every polygon pixel as it was
-        assert by[("per_pixel", "behind")]["err_max"] == pixel["err_max"]
-        assert by[("per_pixel", "over")]["crack_pixels"] <= pixel["crack_pixels"]
-    largest = [r for r in rows if r["target_polygons"] == 100_000 and r["edge_overdraw"] != "none"]
-    assert all(r["crack_pixels"] == 0 for r in largest)
+        # lines and skirts behind the fill leave every polygon pixel as it was
+        for mode in ("behind", "skirts"):
+            assert by[("per_pixel", mode, "buffer")]["err_max"] == pixel["err_max"]
+        # the paper's texture rectangle holds the same numbers
+        assert by[("per_pixel", "none", "texture")]["err_max"] == pixel["err_max"]
+        assert by[("per_pixel", "over", "buffer")]["crack_pixels"] <= pixel["crack_pixels"]
+        # skirts close every crack, however coarse the slice and wide the jumps
+        assert pixel["crack_pixels"] > 0
+        assert by[("per_pixel", "skirts", "buffer")]["crack_pixels"] == 0
+        assert by[("per_vertex", "skirts", "buffer")]["crack_pixels"] == 0
 
 
 def test_slicing_sweep_and_stability_rows(result):
