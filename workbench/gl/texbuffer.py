@@ -25,10 +25,12 @@ class TextureBuffer:
     def __init__(self, ctx: moderngl.Context, data: np.ndarray) -> None:
         data = np.asarray(data)
         if data.ndim != 2 or data.shape[1] != 4 or data.dtype != np.float32:
-            raise ValueError(f"texture buffer data must be (N, 4) float32, got {data.shape} {data.dtype}")
+            raise ValueError(f"texture buffer data must be (N, 4) float32, "
+                             f"got {data.shape} {data.dtype}")
         limit = int(ctx.info.get("GL_MAX_TEXTURE_BUFFER_SIZE", 65536))
         if len(data) > limit:
-            raise ValueError(f"{len(data)} texels exceed this renderer's buffer texture limit of {limit}")
+            raise ValueError(f"{len(data)} texels exceed this renderer's buffer texture limit "
+                             f"of {limit}")
         self.ctx = ctx
         self.texels = len(data)
         self.buffer = ctx.buffer(np.ascontiguousarray(data).tobytes() or bytes(16))

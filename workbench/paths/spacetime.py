@@ -89,7 +89,8 @@ class SpacetimeStyle:
         if self.edge_overdraw not in OVERDRAWS:
             raise ValueError(f"edge_overdraw must be one of {OVERDRAWS}, got {self.edge_overdraw!r}")
         if self.element_store not in ELEMENT_STORES:
-            raise ValueError(f"element_store must be one of {ELEMENT_STORES}, got {self.element_store!r}")
+            raise ValueError(f"element_store must be one of {ELEMENT_STORES}, "
+                             f"got {self.element_store!r}")
         if not (np.isfinite(self.U_max) and self.U_max > 0):
             raise ValueError(f"U_max must be positive and finite, got {self.U_max}")
         if not (np.isfinite(self.height_scale) and self.height_scale >= 0):
@@ -140,7 +141,8 @@ class SpacetimeScene:
             raise ValueError(f"element indices must lie in [0, {M})")
         if not np.isfinite(self.corners).all():
             raise ValueError("polygon corners must be finite")
-        if self.outer is not None and (np.shape(self.outer) != (P, 4) or np.asarray(self.outer).dtype != bool):
+        outer = self.outer
+        if outer is not None and (np.shape(outer) != (P, 4) or np.asarray(outer).dtype != bool):
             raise ValueError(f"outer must be (P, 4) bool, got {np.shape(self.outer)}")
         used = np.unique(self.element)
         if (self.extent[used] <= 0).any():
