@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 from workbench.algo.spacetime.mesh import (SpacetimeMesh, front_refined, interval_mesh,
                                            rect_triangulation, tent_pitch)
 from workbench.algo.spacetime.slicing import (Slice, TimeSlicer, polygon_areas, quadrisect,
-                                              slice_at, slice_edges)
+                                              slice_at)
 
 PROPERTY = settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 T_END = 0.3
@@ -315,18 +315,3 @@ def test_quadrisect_one_level():
     area = polygon_areas(q)
     assert np.allclose(area[q.element == 7], 0.5) and np.allclose(area[q.element == 9], 1.0)
     assert (q.element == 7).sum() == 4 and (q.element == 9).sum() == 4
-
-
-# --------------------------------------------------------------------------- edges
-@pytest.mark.parametrize("kind", sorted(MESHES))
-def test_slice_edges(kind):
-    s = quadrisect(slice_at(MESHES[kind], 0.13), 0.01)
-    e = slice_edges(s)
-    assert e.shape == (3 * (~s.is_quad).sum() + 4 * s.is_quad.sum(), 2, 2)
-    # the edges are each polygon's boundary: their lengths add up to the perimeters
-    c = s.corners
-    perimeter = np.linalg.norm(np.roll(c, -1, axis=1) - c, axis=2).sum()
-    assert np.isclose(np.linalg.norm(e[:, 1] - e[:, 0], axis=1).sum(), perimeter)
-    tri_first = np.flatnonzero(~s.is_quad)[0]
-    start = 3 * (~s.is_quad[:tri_first]).sum() + 4 * s.is_quad[:tri_first].sum()
-    assert np.array_equal(e[start + 2], np.stack([c[tri_first, 2], c[tri_first, 0]]))

@@ -284,8 +284,11 @@ class SpacetimePath:
             nbytes += edges.nbytes
         self.bytes_uploaded = nbytes
 
+        values = self._uniform_values(scene)
         for program in self._programs():
-            self._set_uniforms(program, scene)
+            for name, value in values.items():
+                if name in program:
+                    program[name].value = value
 
     @staticmethod
     def _shared_edges(scene: SpacetimeScene, quad: np.ndarray) -> np.ndarray:
@@ -303,22 +306,20 @@ class SpacetimePath:
     def _programs(self) -> list:
         return [p for p in (self._program, self._line_program, self._skirt_program) if p is not None]
 
-    def _set_uniforms(self, program, scene: SpacetimeScene) -> None:
+    def _uniform_values(self, scene: SpacetimeScene) -> dict:
+        """The scene and style uniforms by name, the same for every program of the path."""
         style = self.style
         lo, hi = scene.bounds()
-        values = {"elements": 0, "ramp": 1,
-                  "lam_k": scene.lam * 1e6, "mu_k": scene.mu * 1e6,  # GPa → kJ/m³ per strain²
-                  "log_denominator": float(np.log1p(style.U_max)),
-                  "height_scale": 0.0 if scene.is_bar else float(style.height_scale),
-                  "light": tuple(float(v) for v in LIGHT),
-                  "lighting": 1.0 if (style.lighting and not scene.is_bar) else 0.0,
-                  "t_slice": 0.0 if scene.is_bar else float(scene.t),
-                  # heights are >= 0: a floor a little below 0 keeps every skirt's bottom edge
-                  # under the lower neighbour instead of on it
-                  "skirt_floor": -1e-3 * float(max(np.max(hi - lo), 1e-9))}
-        for name, value in values.items():
-            if name in program:
-                program[name].value = value
+        return {"elements": 0, "ramp": 1,
+                "lam_k": scene.lam * 1e6, "mu_k": scene.mu * 1e6,  # GPa → kJ/m³ per strain²
+                "log_denominator": float(np.log1p(style.U_max)),
+                "height_scale": 0.0 if scene.is_bar else float(style.height_scale),
+                "light": tuple(float(v) for v in LIGHT),
+                "lighting": 1.0 if (style.lighting and not scene.is_bar) else 0.0,
+                "t_slice": 0.0 if scene.is_bar else float(scene.t),
+                # heights are >= 0: a floor a little below 0 keeps every skirt's bottom edge
+                # under the lower neighbour instead of on it
+                "skirt_floor": -1e-3 * float(max(np.max(hi - lo), 1e-9))}
 
     def _spacetime_origin(self) -> np.ndarray:
         """The float64 point subtracted from spacetime points (x, y, t) before the float32

@@ -29,7 +29,7 @@ import numpy as np
 
 from .mesh import SpacetimeMesh
 
-__all__ = ["Slice", "slice_at", "TimeSlicer", "quadrisect", "polygon_areas", "slice_edges"]
+__all__ = ["Slice", "slice_at", "TimeSlicer", "quadrisect", "polygon_areas"]
 
 
 @dataclass
@@ -294,13 +294,3 @@ _QUAD_CHILD_EDGES = ([0, -1, -1, 3], [0, 1, -1, -1], [-1, 1, 2, -1], [-1, -1, 2,
 def _child_outer(outer: np.ndarray, parent_edges) -> np.ndarray:
     idx = np.asarray(parent_edges)
     return np.where(idx >= 0, outer[:, np.maximum(idx, 0)], False)
-
-
-def slice_edges(s: Slice) -> np.ndarray:
-    """(E, 2, 2) the boundary edges of every polygon (3 per triangle, 4 per quad), polygon by
-    polygon in corner order, for drawing edge overdraw against cracks."""
-    c = s.corners
-    ends = np.stack([c, np.roll(c, -1, axis=1)], axis=2)  # (P, 4, 2, 2)
-    keep = np.ones(c.shape[:2], dtype=bool)
-    keep[~s.is_quad, 2] = False  # the zero-length (c2, c3) of a triangle
-    return ends[keep]
