@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ..scene.derived import _as_elements, _classify, triangulate
+from ..scene.derived import as_elements, classify_elements, triangulate
 
 __all__ = ["RESTART", "QuadStrips", "TriStrips", "join_strips", "quad_strips", "tri_strips",
            "unstripify"]
@@ -175,8 +175,8 @@ def quad_strips(elements, cutoff: int = 1) -> QuadStrips:
     """
     if int(cutoff) != cutoff or cutoff < 1:
         raise ValueError(f"cutoff must be an integer >= 1, got {cutoff}")
-    e = _as_elements(elements)
-    quad, tri, _ = _classify(e)
+    e = as_elements(elements)
+    quad, tri, _ = classify_elements(e)
     degenerate = ~(quad | tri)
     neighbour, neighbour_edge = _quad_neighbours(e, quad, tri)
     order, entry, lengths, leftover, passes = _bandify(neighbour, neighbour_edge, quad, int(cutoff))

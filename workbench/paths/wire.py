@@ -28,8 +28,6 @@ import numpy as np
 from ..algo.strips import RESTART, join_strips, quad_strips, unstripify
 from .base import MeshPath
 
-
-
 # boundary bits of the flat per-triangle mask: which iso-lines of the wire coordinate are
 # element edges no other element shares
 U0, U1, V0, V1, W0 = 1, 2, 4, 8, 16
@@ -39,10 +37,10 @@ TRIANGLE = 32  # u = 1 and v = 1 are corners of a triangle, not edges
 def single_use_edges(elements, pairs) -> np.ndarray:
     """(P,) bool: whether each node pair of ``pairs`` (P, 2) is an edge of exactly one
     non-degenerate element of ``elements`` ((M, 4) node indices, triangles repeating c)."""
-    from ..scene.derived import _classify
+    from ..scene.derived import classify_elements
 
     e = np.asarray(elements, np.int64)
-    quad, tri, _ = _classify(e)
+    quad, tri, _ = classify_elements(e)
     used = (quad | tri)[np.repeat(np.arange(len(e)), 4)]
     u, v = e.ravel(), e[:, [1, 2, 3, 0]].ravel()
     keep = used & (u != v)

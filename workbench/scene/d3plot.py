@@ -17,7 +17,7 @@ they are written mid, inner, outer, so the first; otherwise bottom to top, so th
 strain or thickness in a d3plot; their values are NaN. Beams, solids and thick shells are not
 read. Part ids are the user part ids, names come from the part titles.
 
-Refused with :class:`~workbench.scene.io.ParseError`: a file lasso-python cannot read, or one
+Refused with :class:`~workbench.scene.parse.ParseError`: a file lasso-python cannot read, or one
 without shell elements.
 """
 
@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .io import ParseError, build_mesh
 from .mesh import FEMesh
+from .parse import ParseError, build_mesh
 
 RIGID_MATERIAL_TYPE = 20
 

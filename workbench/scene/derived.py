@@ -30,13 +30,16 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 __all__ = [
-    "Triangulation",
     "GouraudSplit",
+    "Triangulation",
+    "as_coords",
+    "as_elements",
+    "classify_elements",
+    "element_normals",
+    "gouraud_split",
+    "node_normals",
     "triangulate",
     "unique_edges",
-    "element_normals",
-    "node_normals",
-    "gouraud_split",
 ]
 
 # A cross product shorter than this share of the largest it could be for the given vectors is
@@ -52,8 +55,13 @@ _NEXT = np.array([1, 2, 3, 0])
 
 
 # --------------------------------------------------------------------------- input checks
-def _as_elements(elements) -> np.ndarray:
-    """(M, 4) int32 contiguous copy/view of ``elements``; refuses other shapes, dtypes, signs."""
+def as_elements(elements) -> np.ndarray:
+    """``elements`` as (M, 4) int32 C-contiguous node indices (a view where it already is one).
+
+    (M, 3) triangles are padded by repeating their third node. Refuses with ValueError any other
+    shape, a non-integer dtype (an empty float array is accepted), negative node indices and
+    indices beyond the int32 range.
+    """
     e = np.asarray(elements)
     if e.ndim != 2 or e.shape[1] not in (3, 4):
         raise ValueError(f"elements must be (M, 4) or (M, 3) node indices, got shape {e.shape}")
@@ -71,8 +79,13 @@ def _as_elements(elements) -> np.ndarray:
     return np.ascontiguousarray(e, dtype=np.int32)
 
 
-def _as_coords(coords, elements: np.ndarray, what: str = "coords") -> np.ndarray:
-    """(N, 3) float64 coordinates covering every node ``elements`` names, all finite."""
+def as_coords(coords, elements: np.ndarray, what: str = "coords") -> np.ndarray:
+    """``coords`` as (N, 3) float64 coordinates in model units (a view where it already is one).
+
+    ``elements`` are node indices as returned by :func:`as_elements`. Refuses with ValueError,
+    naming the argument as ``what``, any other shape, fewer nodes than ``elements`` reference
+    and non-finite coordinates.
+    """
     c = np.asarray(coords, dtype=np.float64)
     if c.ndim != 2 or c.shape[1] != 3:
         raise ValueError(f"{what} must be (N, 3), got shape {c.shape}")
@@ -84,11 +97,13 @@ def _as_coords(coords, elements: np.ndarray, what: str = "coords") -> np.ndarray
     return c
 
 
-def _classify(e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Element kinds and canonical corners.
+def classify_elements(e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Element kinds and canonical corners of ``e``, (M, 4) integer node indices.
 
-    Returns ``quad`` (M,) bool, ``tri`` (M,) bool and ``canon`` (M, 4) int8: for each corner the
-    first corner of the same element holding the same node (its own index when unrepeated).
+    Returns ``quad`` (M,) bool, ``tri`` (M,) bool (an element that is neither is degenerate, see
+    the module docstring) and ``canon`` (M, 4) int8: for each corner the first corner of the same
+    element holding the same node (its own index when unrepeated). Checks and refuses nothing:
+    ``e`` must already have that shape, as :func:`as_elements` returns.
     """
     a, b, c, d = e[:, 0], e[:, 1], e[:, 2], e[:, 3]
     eq01, eq12, eq23, eq30 = a == b, b == c, c == d, d == a
@@ -176,9 +191,9 @@ def triangulate(elements, nodes) -> Triangulation:
     Refuses elements that are not (M, 4)/(M, 3) non-negative integers and ``nodes`` that are not
     finite (N, 3) covering every referenced node.
     """
-    e = _as_elements(elements)
-    coords = _as_coords(nodes, e, "nodes")
-    quad, tri, canon = _classify(e)
+    e = as_elements(elements)
+    coords = as_coords(nodes, e, "nodes")
+    quad, tri, canon = classify_elements(e)
     m = len(e)
     cand = np.zeros((m, 2, 3), np.int8)
     if quad.any():
@@ -215,7 +230,7 @@ def unique_edges(elements) -> np.ndarray:
     never the diagonals a triangulation adds; a triangle (a, b, c, c) gives its three edges.
     Zero-length edges (a node repeated in consecutive corners) are dropped.
     """
-    e = _as_elements(elements)
+    e = as_elements(elements)
     u = e.ravel()
     v = e[:, _NEXT].ravel()
     keep = u != v
@@ -239,8 +254,8 @@ def element_normals(elements, coords) -> np.ndarray:
     element whose cross product is zero or rounding noise (degenerate or collinear nodes) gets
     the zero vector, never NaN.
     """
-    e = _as_elements(elements)
-    c = _as_coords(coords, e)
+    e = as_elements(elements)
+    c = as_coords(coords, e)
     n, ok = _diagonal_cross(e, c)
     return _unit_or_zero(n, ok)
 
@@ -253,11 +268,11 @@ def node_normals(elements, coords) -> np.ndarray:
     opposite winding cancel. Nodes no element references, and nodes whose sum cancels to
     rounding noise, get the zero vector (never NaN). N is ``len(coords)``.
     """
-    e = _as_elements(elements)
-    c = _as_coords(coords, e)
+    e = as_elements(elements)
+    c = as_coords(coords, e)
     n, ok = _diagonal_cross(e, c)
     w = np.where(ok[:, None], 0.5 * n, 0.0)
-    _, _, canon = _classify(e)
+    _, _, canon = classify_elements(e)
     rows, cols = np.nonzero(canon == np.arange(4, dtype=np.int8))
     nodes = e[rows, cols]
     total = _bincount3(nodes, w[rows], len(c))
@@ -304,7 +319,7 @@ class GouraudSplit:
         wound against their patch's majority are flipped, see :func:`gouraud_split`). Vertices
         whose group has no area, or whose sum cancels to rounding noise, get the zero vector.
         """
-        c = _as_coords(coords, self.node_elements)
+        c = as_coords(coords, self.node_elements)
         # the per-step hot path of every Gouraud render path: one compiled pass
         return _split_normals(self.node_elements, c, self.corner_element, self.corner_vertex,
                               self.corner_sign.astype(np.float64), self.n_vertices, _ZERO_REL)
@@ -382,19 +397,19 @@ def gouraud_split(elements, coords_list, crease_deg: float, triangulation: Trian
     covering the referenced nodes, an empty ``coords_list``, a crease angle outside [0, 180] and
     a triangulation of other elements.
     """
-    e = _as_elements(elements)
+    e = as_elements(elements)
     m = len(e)
     crease = float(crease_deg)
     if not (0.0 <= crease <= 180.0):
         raise ValueError(f"crease_deg must be within [0, 180] degrees, got {crease_deg}")
     if isinstance(coords_list, np.ndarray) and coords_list.ndim == 2:
         coords_list = [coords_list]
-    sets = [_as_coords(c, e, f"coords_list[{i}]") for i, c in enumerate(coords_list)]
+    sets = [as_coords(c, e, f"coords_list[{i}]") for i, c in enumerate(coords_list)]
     if not sets:
         raise ValueError("coords_list must hold at least one (N, 3) coordinate set")
     tri_elem, tri_corner = _check_triangulation(triangulation, e)
 
-    quad, tri, canon = _classify(e)
+    quad, tri, canon = classify_elements(e)
     good = quad | tri
     cid = 4 * np.arange(m, dtype=np.int64)[:, None] + canon  # canonical corner id per corner
     f, g, agree, lo_corners, hi_corners = _edge_pairs(e, good, cid)

@@ -14,7 +14,8 @@ Coordinates are taken as they are in the file and labelled with ``units`` (milli
 told otherwise); nothing is scaled. Every refusal is a :class:`ParseError` that names the file
 (and, for keyword decks, the line and the card), except a missing file, which is a
 :class:`FileNotFoundError`. Errors raised inside meshio, trimesh and lasso-python are wrapped
-into :class:`ParseError` with the original exception chained.
+into :class:`ParseError` with the original exception chained. :class:`ParseError` and
+:func:`build_mesh` live in :mod:`workbench.scene.parse` and are re-exported here.
 """
 
 from __future__ import annotations
@@ -27,7 +28,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .mesh import FEMesh, MeshError
+from .d3plot import read_d3plot
+from .keyword import read_keyword
+from .mesh import FEMesh
+from .parse import ParseError, build_mesh
 
 KEYWORD_SUFFIXES = (".k", ".key", ".dyn", ".kw")
 TRIMESH_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".glb", ".gltf")
@@ -40,37 +44,6 @@ MESHIO_SUFFIXES = (
 FORMATS = ("keyword", "d3plot", "meshio", "trimesh")
 
 _MESHIO_SHELLS = {"quad": 4, "quad8": 4, "quad9": 4, "triangle": 3, "triangle6": 3, "triangle7": 3}
-
-
-class ParseError(ValueError):
-    """A mesh file that cannot be read: where (``path``, 1-based ``line``), what (``card``) and why.
-
-    ``line``, ``card`` and ``keyword`` are None where they do not apply (a binary file, a whole
-    file refused). ``message`` says what was expected. ``str()`` reads
-    ``"file.k:123: *NODE: expected 3 coordinates, got 'abc' in '...'"``.
-    """
-
-    def __init__(self, path, message: str, line: int | None = None, card: str | None = None,
-                 keyword: str | None = None):
-        self.path = Path(path)
-        self.message = message
-        self.line = line
-        self.card = card
-        self.keyword = keyword
-        super().__init__(str(self))
-
-    def __str__(self) -> str:
-        where = str(self.path) if self.line is None else f"{self.path}:{self.line}"
-        text = f"{where}: "
-        if self.keyword:
-            text += f"*{self.keyword}: "
-        text += self.message
-        if self.card is not None:
-            text += f" in {self.card!r}"
-        return text
-
-    def __reduce__(self):
-        return (type(self), (self.path, self.message, self.line, self.card, self.keyword))
 
 
 def supported_formats() -> str:
@@ -112,26 +85,14 @@ def load(path, *, format: str | None = None, units: str = "mm") -> FEMesh:
         raise ParseError(path, "not a file")
     fmt = detect_format(path) if format is None else format
     if fmt == "keyword":
-        from .keyword import read_keyword
-
         return read_keyword(path, units=units)
     if fmt == "d3plot":
-        from .d3plot import read_d3plot
-
         return read_d3plot(path, units=units)
     if fmt == "meshio":
         return read_meshio(path, units=units)
     if fmt == "trimesh":
         return read_trimesh(path, units=units)
     raise ValueError(f"unknown format {fmt!r}; choose one of {FORMATS}")
-
-
-def build_mesh(path, **kwargs) -> FEMesh:
-    """``FEMesh(**kwargs)`` with a refusal of the model reported as :class:`ParseError` on ``path``."""
-    try:
-        return FEMesh(**kwargs)
-    except MeshError as exc:
-        raise ParseError(path, str(exc)) from exc
 
 
 # --------------------------------------------------------------------------- meshio

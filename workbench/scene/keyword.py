@@ -22,7 +22,7 @@ with ``$`` are comments; keywords are case-insensitive; any other keyword is ski
 data. Node and element ids may be any integers; they are kept in ``node_ids`` / ``element_ids``
 and mapped to indices. Coordinates are taken as they are (millimetres by default).
 
-Refused with :class:`~workbench.scene.io.ParseError` (file, 1-based line, card text and what was
+Refused with :class:`~workbench.scene.parse.ParseError` (file, 1-based line, card text and what was
 expected): a malformed card, an element that names an undefined node, duplicate node or element
 ids, a deck without shell elements, an undefined parameter, a missing or cyclic include, and
 the variants that would change the geometry if ignored (``*INCLUDE_TRANSFORM``,
@@ -39,8 +39,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .io import ParseError, build_mesh
 from .mesh import FEMesh
+from .parse import ParseError, build_mesh
 
 # Card layouts in standard-format column widths; I10 widens fields under 10 to 10, long to 20.
 _NODE = (8, 16, 16, 16, 8, 8)
@@ -629,7 +629,7 @@ def _eight_node(block: _Block, cards: np.ndarray) -> int | None:
     """The line of the first element card with a node among n5..n8, or None."""
     if len(cards) == 0:
         return None
-    widths, starts = _layout(_SHELL, block.fmt)
+    _, starts = _layout(_SHELL, block.fmt)
     lines = block.src.pick(cards)
     chars = np.array(lines, dtype=f"S{starts[10]}").view(np.uint8).reshape(len(lines), -1)
     tail = chars[:, starts[6]:]

@@ -24,7 +24,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components, dijkstra
 
-from ...scene.derived import _as_coords, _as_elements, element_normals, unique_edges
+from ...scene.derived import as_coords, as_elements, element_normals, unique_edges
 
 __all__ = [
     "CLOSING",
@@ -134,8 +134,8 @@ def feature_edges(elements, coords, alpha_g1_deg: float = 12.0, *, close_lines: 
     elements or coordinates that are not of the mesh conventions, non-finite coordinates, an
     angle outside [0, 180].
     """
-    e = _as_elements(elements)
-    c = _as_coords(coords, e)
+    e = as_elements(elements)
+    c = as_coords(coords, e)
     alpha = _check_angle(alpha_g1_deg)
     edges = unique_edges(e)
     n_edges = len(edges)
@@ -299,7 +299,7 @@ def patches(elements, feature_edges) -> np.ndarray:
     order. Labels are 0..P-1, numbered in order of each patch's first element. Refused: bad
     elements, feature edges that are not element edges or belong to other elements.
     """
-    e = _as_elements(elements)
+    e = as_elements(elements)
     edges = unique_edges(e)
     is_feature = _feature_edge_array(feature_edges, edges)
     elem, edge_id, _ = _incidence(e, edges)
@@ -328,7 +328,7 @@ def element_adjacency(elements, labels=None):
     Every pair of elements on a shared edge is a neighbour pair (on a non-manifold edge, all of
     them that carry the same label). Elements are never their own neighbours.
     """
-    e = _as_elements(elements)
+    e = as_elements(elements)
     m = len(e)
     edges = unique_edges(e)
     elem, edge_id, _ = _incidence(e, edges)
@@ -381,8 +381,8 @@ def planar_subpatches(elements, coords, patch_labels, d: float) -> np.ndarray:
     Refused: bad elements or coordinates, ``patch_labels`` that is not (M,) integer, ``d``
     negative or not finite.
     """
-    e = _as_elements(elements)
-    c = _as_coords(coords, e)
+    e = as_elements(elements)
+    c = as_coords(coords, e)
     m = len(e)
     lab = np.asarray(patch_labels)
     if lab.shape != (m,) or lab.dtype.kind not in "iu":

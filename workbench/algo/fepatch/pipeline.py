@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...scene.derived import _as_coords, _as_elements, gouraud_split, triangulate
+from ...scene.derived import as_coords, as_elements, gouraud_split, triangulate
 from .atlas import build_atlas, plane_frames
 from .features import G0, feature_edges, patches, planar_subpatches
 from .lines import line_tolerance, simplify_polyline
@@ -35,8 +35,15 @@ from .normalmap import dropped_axis
 from .polygon import polygon_area, triangulate_polygon
 from .surface import TexturedSurface
 
-__all__ = ["FEPatchParams", "PARAMETER_SETS", "FEModel", "parse_params", "build_model",
-           "border_network", "simplified_triangles"]
+__all__ = [
+    "PARAMETER_SETS",
+    "FEModel",
+    "FEPatchParams",
+    "border_network",
+    "build_model",
+    "parse_params",
+    "simplified_triangles",
+]
 
 STAGES = ("features, subpatches, lines", "retriangulation", "textures")
 
@@ -434,8 +441,8 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
     from .wiretex import checkerboard, wire_texture
 
     p = parse_params(params)
-    e = _as_elements(elements).astype(np.int64)
-    c = _as_coords(coords, e)
+    e = as_elements(elements).astype(np.int64)
+    c = as_coords(coords, e)
     if len(e) == 0:
         raise ValueError("the mesh has no elements")
     # the original's own triangles (drawn as they are; not part of the preprocessing stages)

@@ -1,0 +1,51 @@
+"""What every mesh reader shares: the :class:`ParseError` refusal and :func:`build_mesh`.
+
+The readers (:mod:`workbench.scene.keyword`, :mod:`workbench.scene.d3plot` and the meshio and
+trimesh readers in :mod:`workbench.scene.io`) import from here, and :mod:`workbench.scene.io`
+imports the readers, so that no reader depends on the module that dispatches to it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .mesh import FEMesh, MeshError
+
+
+class ParseError(ValueError):
+    """A mesh file that cannot be read: where (``path``, 1-based ``line``), what (``card``) and why.
+
+    ``line``, ``card`` and ``keyword`` are None where they do not apply (a binary file, a whole
+    file refused). ``message`` says what was expected. ``str()`` reads
+    ``"file.k:123: *NODE: expected 3 coordinates, got 'abc' in '...'"``.
+    """
+
+    def __init__(self, path, message: str, line: int | None = None, card: str | None = None,
+                 keyword: str | None = None):
+        self.path = Path(path)
+        self.message = message
+        self.line = line
+        self.card = card
+        self.keyword = keyword
+        super().__init__(str(self))
+
+    def __str__(self) -> str:
+        where = str(self.path) if self.line is None else f"{self.path}:{self.line}"
+        text = f"{where}: "
+        if self.keyword:
+            text += f"*{self.keyword}: "
+        text += self.message
+        if self.card is not None:
+            text += f" in {self.card!r}"
+        return text
+
+    def __reduce__(self):
+        return (type(self), (self.path, self.message, self.line, self.card, self.keyword))
+
+
+def build_mesh(path, **kwargs) -> FEMesh:
+    """``FEMesh(**kwargs)`` with a refusal of the model reported as :class:`ParseError` on ``path``."""
+    try:
+        return FEMesh(**kwargs)
+    except MeshError as exc:
+        raise ParseError(path, str(exc)) from exc
