@@ -52,50 +52,93 @@ def cmd_info(args) -> int:
     return 0
 
 
+def _option(text: str) -> tuple[str, object]:
+    """``KEY=VALUE`` of ``--option``: VALUE read as a Python literal (number, tuple, bool), else
+    kept as a string."""
+    import ast
+
+    key, sep, value = text.partition("=")
+    if not sep or not key:
+        raise argparse.ArgumentTypeError(f"expected KEY=VALUE, got {text!r}")
+    try:
+        return key.strip(), ast.literal_eval(value)
+    except (ValueError, SyntaxError):
+        return key.strip(), value
+
+
+# render flags that set Style fields of the mesh paths, with their defaults
+MESH_FLAGS = {"field": None, "step": 0, "bands": 0, "wireframe": False, "crease_deg": 30.0,
+              "strips": "none", "fepatch": "A"}
+
+
+def _render_options(args, kind: str) -> dict:
+    """The path options of ``workbench render``: the mesh flags (mesh paths only; set on a
+    spacetime path they are refused), ``--colormap`` and every ``--option``."""
+    flags = {"field": args.field, "step": args.step, "bands": args.bands,
+             "wireframe": args.wireframe, "crease_deg": args.crease, "strips": args.strips,
+             "fepatch": args.fepatch}
+    if kind == "mesh":
+        options = dict(flags)
+    else:
+        given = [k for k, v in flags.items() if v != MESH_FLAGS[k]]
+        if given:
+            raise ValueError(f"--{given[0].replace('_deg', '').replace('_', '-')} applies to the "
+                             f"mesh paths, not to a spacetime scene")
+        options = {}
+    if args.colormap is not None:
+        options["colormap"] = args.colormap
+    options.update(dict(args.option or ()))
+    return options
+
+
 def cmd_render(args) -> int:
     from .experiment.figures import save_field_figure, save_png
-    from .gl import Camera, Framebuffer, create_context
-    from .paths import Style, make_path
+    from .experiment.measure import default_camera, measure
+    from .gl import create_context
+    from .paths import make_path, path_class
     from .scene.builtin import load_scene
+    from .scene.mesh import FEMesh
 
-    mesh = load_scene(args.mesh)
-    if args.field is not None and args.field not in mesh.node_fields and args.field not in mesh.element_fields:
-        known = sorted([*mesh.node_fields, *mesh.element_fields]) or ["(none)"]
-        raise KeyError(f"{mesh.name} has no field {args.field!r}; fields: {', '.join(known)}")
-    if not 0 <= args.step < mesh.n_steps:
-        raise ValueError(f"{mesh.name} has {mesh.n_steps} steps; --step {args.step} is outside")
+    scene = load_scene(args.mesh)
+    is_mesh = isinstance(scene, FEMesh)
+    if is_mesh:
+        fields = [*scene.node_fields, *scene.element_fields]
+        if args.field is not None and args.field not in fields:
+            known = sorted(fields) or ["(none)"]
+            raise KeyError(f"{scene.name} has no field {args.field!r}; fields: {', '.join(known)}")
+        if not 0 <= args.step < scene.n_steps:
+            raise ValueError(f"{scene.name} has {scene.n_steps} steps; --step {args.step} is outside")
     path_name = args.path
     if path_name is None:
-        if args.field is None:
+        if not is_mesh:
+            path_name = "spacetime_pixel"
+        elif args.field is None:
             path_name = "gouraud"
         else:
-            path_name = "element_color" if args.field in mesh.element_fields else "pixel_color"
-    style = Style(field=args.field, step=args.step, colormap=args.colormap, bands=args.bands,
-                  wireframe=args.wireframe, crease_deg=args.crease, strips=args.strips,
-                  fepatch=args.fepatch)
+            path_name = "element_color" if args.field in scene.element_fields else "pixel_color"
+    kind = path_class(path_name).scene_kind
+    if kind != ("mesh" if is_mesh else "spacetime"):
+        raise ValueError(f"path {path_name!r} draws {kind} scenes; {args.mesh!r} is "
+                         f"{'an FE mesh' if is_mesh else 'a spacetime scene'}")
+    path = make_path(path_name, **_render_options(args, kind))
     ctx = create_context()
-    width, height = args.size
-    camera = Camera.fit_box(*mesh.bounds(all_steps=True), azimuth=args.view[0], elevation=args.view[1],
-                        projection=args.projection, aspect=width / height, up=args.up)
-    fb = Framebuffer(ctx, (width, height), samples=args.samples)
-    path = make_path(path_name, style)
-    path.prepare(ctx, mesh, camera)
-    if args.step:
-        path.set_step(args.step)
-    fb.clear()
-    path.draw()
-    image = fb.read()
+    size = args.size
+    camera = default_camera(scene, size, view=args.view, projection=args.projection, up=args.up,
+                            style=path.style)
+    result = measure(ctx, scene, path, camera=camera, size=size, samples=args.samples,
+                     timed=False)
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
-    if args.field is not None and not args.raw:
-        save_field_figure(out, image, value_range=path.scale.value_range, colormap=args.colormap,
-                          label=args.field, units=args.units, title=f"{mesh.name} ({path_name})",
-                          bands=args.bands)
+    scale = getattr(path, "scale", None)
+    if is_mesh and args.field is not None and not args.raw and scale is not None:
+        save_field_figure(out, result.image, value_range=scale.value_range,
+                          colormap=path.style.colormap, label=args.field, units=args.units,
+                          title=f"{scene.name} ({path_name})", bands=args.bands)
     else:
-        save_png(out, image)
+        save_png(out, result.image)
     strips = f", {path.strips} strip{'s' * (path.strips != 1)}" if path.strips else ""
-    print(f"{out}: {mesh.name}, {path.triangles} triangles, {path.vertices_sent} vertices sent"
-          f"{strips}, path {path_name}")
+    print(f"{out}: {result.row['scene']}, {path.triangles} triangles, {path.vertices_sent} "
+          f"vertices sent{strips}, path {path_name}")
     return 0
 
 
@@ -201,13 +244,29 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("info", help="renderer, OpenGL version, library versions, shared data")
     p.set_defaults(func=cmd_info)
 
-    p = sub.add_parser("render", help="render one mesh to a PNG",
-                       description="Render a mesh file (LS-DYNA .k, d3plot, meshio or trimesh formats) or a "
-                                   "built-in scene (car, d3plot, semicylinders, panels) offscreen.")
+    from .paths import PATHS, path_class
+
+    mesh_paths = sorted(n for n in PATHS if path_class(n).scene_kind == "mesh")
+    spacetime_paths = sorted(n for n in PATHS if path_class(n).scene_kind == "spacetime")
+    p = sub.add_parser(
+        "render", help="render one scene to a PNG",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Render a mesh file (LS-DYNA .k, d3plot, meshio or trimesh formats), a built-in "
+                    "scene (car, d3plot, semicylinders[:N], panels[:Q]) or a spacetime scene "
+                    "(spacetime:radial[:N], spacetime:bar) offscreen, through the one measurement "
+                    "function (untimed).",
+        epilog="render paths:\n  FE meshes:        " + ", ".join(mesh_paths) +
+               "\n  spacetime scenes: " + ", ".join(spacetime_paths) +
+               "\nany option of a path's style: --option KEY=VALUE (e.g. --option edge_overdraw=skirts"
+               "\n  --option height_scale=800 for a spacetime path, --option clip_planes=((1,0,0,0),))")
     p.add_argument("mesh", help="mesh file or built-in scene name")
     p.add_argument("-o", "--output", required=True, help="PNG file to write")
     p.add_argument("--field", help="node or element field to colour by")
-    p.add_argument("--path", help="render path (default: gouraud; pixel_color or element_color with --field)")
+    p.add_argument("--path", metavar="PATH",
+                   help="render path (default: gouraud; pixel_color or element_color with --field; "
+                        "spacetime_pixel on a spacetime scene); listed below")
+    p.add_argument("-O", "--option", type=_option, action="append", metavar="KEY=VALUE",
+                   help="any style option of the path (repeatable)")
     p.add_argument("--wireframe", action="store_true", help="overdraw element edges")
     p.add_argument("--strips", choices=("none", "triangle", "quad"), default="none",
                    help="draw a triangle list (default), meshoptimizer triangle strips or quad strips")
@@ -222,7 +281,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--projection", choices=("orthographic", "perspective"), default="orthographic")
     p.add_argument("--step", type=int, default=0, help="time step to draw (default 0)")
     p.add_argument("--bands", type=int, default=0, help="number of contour bands (0: smooth)")
-    p.add_argument("--colormap", default="viridis", help="matplotlib colormap name")
+    p.add_argument("--colormap", help="matplotlib colormap name (default: the path's own)")
     p.add_argument("--crease", type=float, default=30.0, help="Gouraud crease angle in degrees")
     p.add_argument("--samples", type=int, default=0, help="MSAA samples (0: none)")
     p.add_argument("--units", default="", help="units of the field, for the colour bar label")

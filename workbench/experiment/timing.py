@@ -76,10 +76,10 @@ class Timing:
 
 
 def time_draw(ctx, fb, draw: Callable[[], Any], warmup: int = 2, repeat: int = 7,
-              readback_repeat: int | None = None) -> Timing:
+              readback_repeat: int | None = None, background=(1.0, 1.0, 1.0, 1.0)) -> Timing:
     """Time ``draw()`` into framebuffer ``fb`` on ``ctx``: GPU, wall and read-back milliseconds.
 
-    Each repetition clears ``fb`` (and waits for the clear) outside the clock, then measures wall
+    Each repetition clears ``fb`` to ``background`` RGBA (and waits for the clear) outside the clock, then measures wall
     time around ``draw()`` inside a GPU timer query plus ``ctx.finish()``. ``draw`` must draw into
     the bound framebuffer and must not open a time query of its own (queries of one kind do not
     nest). Read-back is then timed separately: ``fb.read()`` of the finished last draw, repeated
@@ -93,7 +93,7 @@ def time_draw(ctx, fb, draw: Callable[[], Any], warmup: int = 2, repeat: int = 7
     wall: list[float] = []
     gpu: list[float] = []
     for i in range(warmup + repeat):
-        fb.clear()
+        fb.clear(background)
         ctx.finish()
         start = time.perf_counter()
         with timer:

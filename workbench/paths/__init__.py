@@ -1,7 +1,10 @@
-"""Render paths: comparable ways of drawing an FE mesh, all behind one small interface."""
+"""Render paths: comparable ways of drawing a scene, all behind one protocol
+(:class:`~workbench.paths.base.RenderPath`) and in one registry (``PATHS``)."""
 
-from .base import PATHS, MeshPath, RenderPath, Style, make_path
+from . import fetexture, fields, spacetime, surface, wire  # noqa: F401  (each registers its paths)
+from .base import (PATHS, GLPath, MeshPath, RenderPath, Style, check_options, make_path,
+                   path_class, path_options)
 from .colormap import ColorScale, colormap_lut, scale_for
 
-__all__ = ["PATHS", "ColorScale", "MeshPath", "RenderPath", "Style", "colormap_lut", "make_path",
-           "scale_for"]
+__all__ = ["PATHS", "ColorScale", "GLPath", "MeshPath", "RenderPath", "Style", "check_options",
+           "colormap_lut", "make_path", "path_class", "path_options", "scale_for"]

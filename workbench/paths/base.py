@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -52,7 +53,8 @@ from ..algo.strips import RESTART, quad_strips, tri_strips
 from ..gl import load_program
 from .colormap import NO_VALUE, ColorScale, scale_for
 
-NEEDS = frozenset({"triangles", "face_normals", "gouraud", "edges", "node_field", "element_field"})
+# what a path may ask the scene to derive and cache (see workbench.scene.derive)
+NEEDS = frozenset({"triangles", "edges", "gouraud", "fepatch"})
 MAX_CLIP_PLANES = 4
 GL_CLIP_DISTANCE0 = 0x3000
 POLYGON_OFFSET = (1.0, 1.0)  # fill pass under a wire frame: (factor, units)
@@ -162,24 +164,40 @@ def _word(value) -> str:
 
 
 class RenderPath(ABC):
-    """One way of drawing an FE mesh, built once (``prepare``) and drawn many times (``draw``).
+    """One way of drawing a scene, built once (``prepare``) and drawn many times (``draw``).
 
-    ``needs`` names the derived data the path asks the mesh for (a subset of
-    ``{"triangles", "face_normals", "gouraud", "edges", "node_field", "element_field"}``); an
-    instance drawing a wire frame adds ``"edges"`` to its own ``needs``. After ``prepare``:
-    ``triangles``, ``vertices`` and ``edges`` (wire-frame lines, 0 without) drawn,
-    ``bytes_uploaded`` (everything uploaded by prepare, textures included),
-    ``bytes_per_step`` (what one ``set_step`` uploads), ``vertices_sent`` (vertex indices one
-    draw sends down the pipeline, restart markers excluded: 3 per listed triangle) and
-    ``strips`` (primitives restarted, 0 for a triangle list).
+    The protocol every registered path meets: ``prepare(ctx, scene, camera)`` once, then any
+    number of ``set_camera``, ``set_step`` and ``draw``, then ``release``. A prepared path is a
+    context manager: ``with path:`` releases its GL objects on the way out, also when a draw
+    raises.
+
+    ``style_class`` is the dataclass of options the path takes (:class:`Style` for the mesh
+    paths); ``scene_kind`` names what ``prepare`` accepts ("mesh": an
+    :class:`~workbench.scene.mesh.FEMesh`; "spacetime": a
+    :class:`~workbench.scene.spacetime.SpacetimeScene`). ``needs`` names the data the path asks
+    the scene to derive and cache (a subset of :data:`NEEDS`, read by
+    :func:`workbench.scene.derive.derive` before ``prepare``); an instance drawing a wire
+    frame adds ``"edges"`` to its own ``needs``. After ``prepare``: ``triangles``,
+    ``vertices`` and ``edges`` (wire-frame lines, 0 without) drawn, ``bytes_uploaded``
+    (everything uploaded by prepare, textures included), ``bytes_per_step`` (what one
+    ``set_step`` uploads), ``vertices_sent`` (vertex indices one draw sends down the pipeline,
+    restart markers excluded: 3 per listed triangle) and ``strips`` (primitives restarted, 0
+    for a triangle list).
     """
 
     name: ClassVar[str]
     needs: ClassVar[frozenset[str]]
+    style_class: ClassVar[type] = Style
+    scene_kind: ClassVar[str] = "mesh"
+    fixed_options: ClassVar[frozenset[str]] = frozenset()
 
-    def __init__(self, style: Style | None = None) -> None:
-        self.style = style if style is not None else Style()
-        if self.style.wireframe:
+    def __init__(self, style=None) -> None:
+        style = style if style is not None else self.style_class()
+        if not isinstance(style, self.style_class):
+            raise TypeError(f"path {self.name!r} takes a {self.style_class.__name__}, "
+                            f"got {type(style).__name__}")
+        self.style = style
+        if getattr(self.style, "wireframe", False):
             self.needs = type(self).needs | {"edges"}
         self.triangles = self.vertices = self.edges = 0
         self.vertices_sent = self.strips = 0
@@ -187,8 +205,9 @@ class RenderPath(ABC):
         self.missing_values = 0
 
     @abstractmethod
-    def prepare(self, ctx: moderngl.Context, mesh, camera) -> None:
-        """Derive what ``needs`` says (only that) and upload it once, with ``style.step`` drawn."""
+    def prepare(self, ctx: moderngl.Context, scene, camera) -> None:
+        """Upload what the scene gives (derived data already cached by the scene), with
+        ``style.step`` drawn, for ``camera``."""
 
     @abstractmethod
     def set_camera(self, camera) -> None:
@@ -204,7 +223,13 @@ class RenderPath(ABC):
 
     @abstractmethod
     def release(self) -> None:
-        """Free every GL object the path holds."""
+        """Free every GL object the path holds; harmless when nothing is held."""
+
+    def __enter__(self) -> "RenderPath":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.release()
 
     def __init_subclass__(cls, **kwargs) -> None:
         super().__init_subclass__(**kwargs)
@@ -218,13 +243,42 @@ class RenderPath(ABC):
 PATHS: dict[str, type[RenderPath]] = {}
 
 
-def make_path(name: str, style: Style | None = None) -> RenderPath:
-    """A new, unprepared path of registry ``name``; ValueError listing the registry otherwise."""
+def path_class(name: str) -> type[RenderPath]:
+    """The registered path class ``name``; ValueError listing the registry otherwise."""
     try:
-        cls = PATHS[name]
+        return PATHS[name]
     except KeyError:
         raise ValueError(f"unknown render path {name!r}; known paths: {sorted(PATHS)}") from None
+
+
+def make_path(name: str, style=None, **options) -> RenderPath:
+    """A new, unprepared path of registry ``name`` with ``style`` (an instance of the path's
+    ``style_class``) or, instead, ``options`` naming fields of that class; ValueError for an
+    unknown path, or for an option the path does not take (naming it and the known ones)."""
+    cls = path_class(name)
+    if options:
+        if style is not None:
+            raise ValueError("give either a style or options, not both")
+        style = cls.style_class(**check_options(name, options))
     return cls(style)
+
+
+def path_options(name: str) -> frozenset[str]:
+    """The option names path ``name`` takes: the fields of its ``style_class`` but those the
+    path fixes itself (``fixed_options``, e.g. the shading of a spacetime path)."""
+    cls = path_class(name)
+    return frozenset(cls.style_class.__dataclass_fields__) - cls.fixed_options
+
+
+def check_options(name: str, options: dict) -> dict:
+    """``options`` unchanged when path ``name`` takes every key; ValueError naming the first
+    unknown key and the known ones otherwise."""
+    known = path_options(name)
+    for key in options:
+        if key not in known:
+            raise ValueError(f"path {name!r} takes no option {key!r}; "
+                             f"its options: {', '.join(sorted(known))}")
+    return options
 
 
 def field_kind(mesh, name: str) -> str:
@@ -238,21 +292,49 @@ def field_kind(mesh, name: str) -> str:
 
 
 class GLPath(RenderPath):
-    """GL-object bookkeeping and per-frame state shared by the paths: objects kept for
-    ``release``, the fill program ``_program`` and VAO ``_vao``, an optional pass of lines
-    (``_line_program``/``_line_vao``, drawn after the fill, which gets polygon offset), clip
-    planes and camera uniforms for both programs, and the draw itself."""
+    """The GL bookkeeping every path shares, once: objects kept for ``release``, the prepared
+    guard, the camera-origin check, clip-distance enabling, the fill program ``_program`` and
+    VAO ``_vao``, an optional pass of lines (``_line_program``/``_line_vao``, drawn after the
+    fill, which gets polygon offset), clip planes and camera uniforms for every program.
 
-    def __init__(self, style: Style | None = None) -> None:
+    ``prepare`` releases a previous preparation, calls ``_check_scene`` (refusals before any GL
+    object exists), records the context and the float64 upload origin, then ``_build``; if
+    ``_build`` raises, every object made so far is released.
+    """
+
+    def __init__(self, style=None) -> None:
         super().__init__(style)
         self.ctx = None
+        self.origin = None
         self._objects: list = []
         self._program = self._line_program = self._line_vao = None
         self._textures: list = []  # (texture, unit) bound before each draw
 
+    def prepare(self, ctx: moderngl.Context, scene, camera) -> None:
+        if self.ctx is not None:
+            self.release()
+        self._check_scene(scene)
+        self.ctx, self.origin = ctx, np.array(camera.origin, np.float64)
+        try:
+            self._build(ctx, scene, camera)
+        except BaseException:
+            self.release()
+            raise
+
+    def _check_scene(self, scene) -> None:
+        """Refuse a scene or style the path cannot draw (ValueError), before any GL object."""
+
+    @abstractmethod
+    def _build(self, ctx: moderngl.Context, scene, camera) -> None:
+        """Make and upload the GL objects (through ``_keep``), set the camera and the step."""
+
     def _keep(self, obj):
         self._objects.append(obj)
         return obj
+
+    def _require_prepared(self) -> None:
+        if self.ctx is None:
+            raise RuntimeError(f"path {self.name!r} is not prepared")
 
     def _programs(self) -> list:
         return [p for p in (self._program, self._line_program) if p is not None]
@@ -285,14 +367,29 @@ class GLPath(RenderPath):
         for program in self._programs():
             program["clip_planes"].write(data)
 
+    @contextmanager
+    def _clip_distances(self, count: int):
+        """``gl_ClipDistance`` 0 … count − 1 enabled for the draws inside the block."""
+        for i in range(count):
+            self.ctx.enable_direct(GL_CLIP_DISTANCE0 + i)
+        try:
+            yield
+        finally:
+            for i in range(count):
+                self.ctx.disable_direct(GL_CLIP_DISTANCE0 + i)
+
     def set_camera(self, camera) -> None:
-        if self.ctx is None:
-            raise RuntimeError(f"path {self.name!r} is not prepared")
+        """Camera uniforms for every program: ``mvp``, and where a program has them ``view``,
+        ``perspective``, ``eye_position`` and ``eye_axis`` (unit vector from target to eye)."""
+        self._require_prepared()
         if not np.array_equal(np.asarray(camera.origin, np.float64), self.origin):
             raise ValueError(f"camera origin {camera.origin} differs from the prepared origin "
                              f"{self.origin}: prepare the path again for a new origin")
         mvp, view = camera.mvp_bytes(), camera.view_bytes()
         perspective = 1.0 if camera.projection == "perspective" else 0.0
+        eye = np.asarray(camera.eye, np.float64)
+        axis = eye - np.asarray(camera.target, np.float64)
+        axis = tuple(float(v) for v in axis / np.linalg.norm(axis))
         for program in self._programs():
             names = self._uniforms(program)
             program["mvp"].write(mvp)
@@ -300,6 +397,10 @@ class GLPath(RenderPath):
                 program["view"].write(view)
             if "perspective" in names:
                 program["perspective"].value = perspective
+            if "eye_position" in names:
+                program["eye_position"].value = tuple(float(v) for v in eye)
+            if "eye_axis" in names:
+                program["eye_axis"].value = axis
 
     def _render(self, mode: int) -> None:
         """Draw the fill VAO with ``mode`` and then the line pass, in the style's GL state."""
@@ -307,19 +408,16 @@ class GLPath(RenderPath):
         ctx.enable_only(moderngl.DEPTH_TEST | (moderngl.CULL_FACE if style.cull_back else 0))
         if style.cull_back:
             ctx.front_face, ctx.cull_face = "ccw", "back"
-        for i in range(len(style.clip_planes)):
-            ctx.enable_direct(GL_CLIP_DISTANCE0 + i)
         for texture, unit in self._textures:
             texture.use(unit)
-        if self._line_vao is not None:
-            ctx.polygon_offset = POLYGON_OFFSET
-            self._vao.render(mode)
-            ctx.polygon_offset = (0.0, 0.0)
-            self._line_vao.render(moderngl.LINES)
-        else:
-            self._vao.render(mode)
-        for i in range(len(style.clip_planes)):
-            ctx.disable_direct(GL_CLIP_DISTANCE0 + i)
+        with self._clip_distances(len(style.clip_planes)):
+            if self._line_vao is not None:
+                ctx.polygon_offset = POLYGON_OFFSET
+                self._vao.render(mode)
+                ctx.polygon_offset = (0.0, 0.0)
+                self._line_vao.render(moderngl.LINES)
+            else:
+                self._vao.render(mode)
 
     def release(self) -> None:
         for obj in reversed(self._objects):
@@ -345,9 +443,7 @@ class MeshPath(GLPath):
     field_per: ClassVar[str | None] = None
 
     # ------------------------------------------------------------------ prepare
-    def prepare(self, ctx: moderngl.Context, mesh, camera) -> None:
-        if self.ctx is not None:
-            self.release()
+    def _check_scene(self, mesh) -> None:
         style = self.style
         for label in ("step", "reference_step"):
             if getattr(style, label) >= mesh.n_steps:
@@ -358,12 +454,6 @@ class MeshPath(GLPath):
             self._check_field(mesh)
             self.scale = scale_for(mesh, style.field, style.colormap, style.value_range,
                                    style.bands, style.hide_range)
-        self.mesh, self.ctx, self.origin = mesh, ctx, np.array(camera.origin, np.float64)
-        try:
-            self._build(ctx, camera)
-        except BaseException:
-            self.release()
-            raise
 
     def topology(self, mesh) -> tuple[np.ndarray | None, np.ndarray]:
         """(vertex_node, triangles): the node of each vertex (None: the nodes themselves) and
@@ -410,8 +500,9 @@ class MeshPath(GLPath):
         self.vertices_sent = triangles.size
         return triangles
 
-    def _build(self, ctx: moderngl.Context, camera) -> None:
-        mesh, style = self.mesh, self.style
+    def _build(self, ctx: moderngl.Context, mesh, camera) -> None:
+        self.mesh = mesh
+        style = self.style
         # row in the crease split of each vertex (None: vertex i is split vertex i)
         self._split_rows = None
         vertex_node, triangles = self.topology(mesh)
@@ -526,8 +617,7 @@ class MeshPath(GLPath):
         return reference + style.magnification * (current - reference)
 
     def set_step(self, step: int) -> int:
-        if self.ctx is None:
-            raise RuntimeError(f"path {self.name!r} is not prepared")
+        self._require_prepared()
         if int(step) != step or not 0 <= step < self.mesh.n_steps:
             raise ValueError(f"step {step} out of range: {self.mesh.name} has "
                              f"{self.mesh.n_steps} steps")
@@ -569,7 +659,3 @@ class MeshPath(GLPath):
     def draw(self) -> None:
         self.ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
         self._render(self.mode)
-
-
-# the path modules register themselves in PATHS on import
-from . import fetexture, fields, surface, wire  # noqa: E402,F401

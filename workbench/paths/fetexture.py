@@ -20,9 +20,10 @@ surface's ``line_edges`` (element edges the texture cannot show) are drawn after
 ``GL_LINES`` in ``Style.wire_color``, the fill under polygon offset (1, 1) as in
 :mod:`workbench.paths.base`.
 
-The surface comes from ``path.surface`` when set before :meth:`~FETexturePath.prepare`,
-otherwise from :func:`workbench.algo.fepatch.pipeline.build_model` on the mesh's step 0 with
-``Style.fepatch`` (cached per mesh and parameter string). The surface is built for one
+The path receives its prepared input: ``prepare`` takes either a ``TexturedSurface`` built by
+the caller, or an FE mesh whose fe2003 model the scene has derived and cached
+(``mesh.fepatch_model(Style.fepatch)``, asked for through ``needs = {"fepatch"}``); the path
+draws that model's ``original`` or ``simplified`` surface. The surface is built for one
 configuration, so only step 0 is drawn: ``Style.step`` other than 0, a deformation plot
 (magnification ≠ 1 with a reference step other than 0), ``set_step`` with another step,
 ``Style.wireframe`` (a second, line-overdraw wire frame) and ``Style.strips`` other than
@@ -34,53 +35,32 @@ relative to ``camera.origin`` (float64 subtraction first); clip planes and the c
 
 from __future__ import annotations
 
-import weakref
-
 import moderngl
 import numpy as np
 
+from ..algo.fepatch.surface import TexturedSurface
 from ..gl import load_program
 from .base import GLPath
 
-__all__ = ["FETexturePath", "FEWireTexturePath", "FENormalMapPath", "FENormalWirePath",
-           "fepatch_model"]
-
-# mesh -> {fepatch parameter string -> model}; a model lives as long as its mesh
-_MODELS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
-
-def fepatch_model(mesh, fepatch: str):
-    """The fe2003 model (``.original`` and ``.simplified`` surfaces) of ``mesh`` at step 0 for
-    the parameter string ``fepatch`` (see ``Style.fepatch``), built once per mesh and string."""
-    by_parameters = _MODELS.setdefault(mesh, {})
-    if fepatch not in by_parameters:
-        from ..algo.fepatch.pipeline import build_model
-
-        by_parameters[fepatch] = build_model(mesh.elements, mesh.coordinates(0), fepatch)
-    return by_parameters[fepatch]
+__all__ = ["FETexturePath", "FEWireTexturePath", "FENormalMapPath", "FENormalWirePath"]
 
 
 class FETexturePath(GLPath):
     """The shared implementation of the fe2003 texture paths (see the module docstring).
 
     Class switches: ``model_surface`` ("original" or "simplified": which surface of the model
-    is drawn when ``surface`` is not set), ``normal_map`` (per-pixel light from the normal map,
-    else per-vertex light from ``surface.normals``) and ``wire_texture`` (outlines from the wire
-    map). Attribute ``surface``: the :class:`TexturedSurface` to draw, None (default) to build
-    it from the mesh at ``prepare``.
+    is drawn from a mesh's model), ``normal_map`` (per-pixel light from the normal map, else
+    per-vertex light from ``surface.normals``) and ``wire_texture`` (outlines from the wire
+    map).
     """
 
-    needs = frozenset({"triangles"})
+    needs = frozenset({"fepatch"})
     model_surface: str = "simplified"
     normal_map: bool = True
     wire_texture: bool = False
 
-    def __init__(self, style=None) -> None:
-        super().__init__(style)
-        self.surface = None
-
     # ------------------------------------------------------------------ prepare
-    def _check_style(self, mesh) -> None:
+    def _check_style(self) -> None:
         style = self.style
         if style.step != 0:
             raise ValueError(f"path {self.name!r} draws the configuration its textured surface "
@@ -95,12 +75,14 @@ class FETexturePath(GLPath):
             raise ValueError(f"path {self.name!r} draws its surface's triangle list: "
                              f"use strips='none'")
 
-    def _surface_for(self, mesh):
-        if self.surface is not None:
-            return self.surface
-        if mesh is None:
-            raise ValueError(f"path {self.name!r} needs a mesh, or a surface set beforehand")
-        return getattr(fepatch_model(mesh, self.style.fepatch), self.model_surface)
+    def _surface_for(self, scene):
+        """The TexturedSurface ``scene`` is, or the one of the mesh's cached fe2003 model."""
+        if isinstance(scene, TexturedSurface):
+            return scene
+        if not hasattr(scene, "fepatch_model"):
+            raise ValueError(f"path {self.name!r} draws an FE mesh or a TexturedSurface, "
+                             f"got {type(scene).__name__}")
+        return getattr(scene.fepatch_model(self.style.fepatch), self.model_surface)
 
     def _check_surface(self, surface) -> None:
         if len(surface.triangles) == 0:
@@ -117,21 +99,12 @@ class FETexturePath(GLPath):
                 (surface.normal_axis.min() < 0 or surface.normal_axis.max() > 2):
             raise ValueError("normal_axis must be 0, 1 or 2")
 
-    def prepare(self, ctx: moderngl.Context, mesh, camera) -> None:
-        """Upload the surface (built from ``mesh`` when ``surface`` is None) and its textures
-        for ``camera``; refuses the styles listed in the module docstring."""
-        if self.ctx is not None:
-            self.release()
-        self._check_style(mesh)
-        surface = self._surface_for(mesh)
+    def _check_scene(self, scene) -> None:
+        """Refuse the styles listed in the module docstring and an unusable surface."""
+        self._check_style()
+        surface = self._surface_for(scene)
         self._check_surface(surface)
-        self.mesh, self.ctx, self.origin = mesh, ctx, np.array(camera.origin, np.float64)
         self._surface = surface
-        try:
-            self._build(ctx, camera)
-        except BaseException:
-            self.release()
-            raise
 
     def _texture(self, ctx, data: np.ndarray, unit: int, name: str) -> int:
         height, width, channels = data.shape
@@ -143,7 +116,7 @@ class FETexturePath(GLPath):
         self._textures.append((tex, unit))
         return data.nbytes
 
-    def _build(self, ctx: moderngl.Context, camera) -> None:
+    def _build(self, ctx: moderngl.Context, scene, camera) -> None:
         surface, style = self._surface, self.style
         defines = {"NUM_CLIP": len(style.clip_planes), "NORMAL_MAP": int(self.normal_map),
                    "WIRE_TEXTURE": int(self.wire_texture)}
@@ -195,8 +168,7 @@ class FETexturePath(GLPath):
     def set_step(self, step: int) -> int:
         """Upload the surface's positions (float32 relative to the origin); only step 0, the
         configuration the surface was built for, is accepted."""
-        if self.ctx is None:
-            raise RuntimeError(f"path {self.name!r} is not prepared")
+        self._require_prepared()
         if step != 0:
             raise ValueError(f"path {self.name!r} draws the configuration its textured surface "
                              f"was built for (step 0), got step {step}")

@@ -33,7 +33,7 @@ class VertexColorPath(MeshPath):
     """Gouraud normals, colormap evaluated at the vertices, RGB interpolated."""
 
     name = "vertex_color"
-    needs = frozenset({"gouraud", "node_field"})
+    needs = frozenset({"gouraud"})
     vertex_shader, fragment_shader = "vertex_color.vert.glsl", "vertex_color.frag.glsl"
     split = True
     field_per = "node"
@@ -43,7 +43,7 @@ class PixelColorPath(MeshPath):
     """Gouraud normals, scalar interpolated, colour looked up per fragment (the reference)."""
 
     name = "pixel_color"
-    needs = frozenset({"gouraud", "node_field"})
+    needs = frozenset({"gouraud"})
     vertex_shader, fragment_shader = "pixel_color.vert.glsl", "pixel_color.frag.glsl"
     split = True
     field_per = "node"
@@ -54,7 +54,7 @@ class ElementColorPath(MeshPath):
     vertex per element (``flat`` varying, last-vertex convention)."""
 
     name = "element_color"
-    needs = frozenset({"triangles", "element_field"})
+    needs = frozenset({"triangles"})
     vertex_shader, fragment_shader = "element_color.vert.glsl", "element_color.frag.glsl"
     field_per = "element"
 

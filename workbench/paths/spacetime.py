@@ -42,7 +42,7 @@ evaluation at pixel centres is the exact image the paths are measured against.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import moderngl
 import numpy as np
@@ -51,6 +51,8 @@ from ..algo.spacetime.shading import LIGHT
 from ..gl import load_program
 from ..gl.camera import Camera
 from ..gl.texbuffer import TextureBuffer
+from ..scene.spacetime import SpacetimeScene  # noqa: F401  (re-exported: the data drawn)
+from .base import GLPath
 from .colormap import colormap_lut
 
 SHADINGS = ("per_vertex", "per_pixel")
@@ -58,7 +60,6 @@ OVERDRAWS = ("none", "over", "behind", "skirts")
 ELEMENT_STORES = ("buffer", "texture")
 ELEMENT_TEXELS = 12
 ELEMENTS_PER_ROW = 341  # 4092 texels per row
-GL_CLIP_DISTANCE0 = 0x3000
 
 
 @dataclass
@@ -97,65 +98,6 @@ class SpacetimeStyle:
             raise ValueError(f"height_scale must be non-negative and finite, got {self.height_scale}")
 
 
-@dataclass
-class SpacetimeScene:
-    """What a spacetime path draws: polygons, each with the element whose solution it shows.
-
-    corners: (P, 4, 2) float64 convex polygons, a triangle repeating its third corner — (x, y)
-    in mm of a slice at time ``t`` (µs), or (x, t) spacetime triangles of a 1-D bar with
-    ``t=None``. element: (P,) indices into the solution arrays: ``coeffs`` (M, 20, 2)
-    displacement coefficients in element-local coordinates, ``centre`` and ``extent`` (M, 3)
-    float64 local frames in (x, y, t), and ``lam``/``mu`` the Lamé constants in GPa. outer:
-    (P, 4) bool, edge k (corner k to k + 1) on the domain boundary, where edge overdraw draws
-    nothing (:attr:`workbench.algo.spacetime.slicing.Slice.outer`); None: every edge is
-    treated as shared.
-    """
-
-    corners: np.ndarray
-    element: np.ndarray
-    coeffs: np.ndarray
-    centre: np.ndarray
-    extent: np.ndarray
-    lam: float
-    mu: float
-    t: float | None = None
-    outer: np.ndarray | None = None
-
-    @property
-    def is_bar(self) -> bool:
-        return self.t is None
-
-    def check(self) -> None:
-        """ValueError for inconsistent shapes, an empty scene, element indices out of range,
-        non-positive extents or non-finite corners, coefficients or centres."""
-        P = len(self.corners)
-        if self.corners.shape != (P, 4, 2) or self.element.shape != (P,):
-            raise ValueError(f"corners must be (P, 4, 2) and element (P,), got "
-                             f"{self.corners.shape} and {self.element.shape}")
-        if P == 0:
-            raise ValueError("nothing to draw: the scene has no polygons")
-        M = len(self.coeffs)
-        if self.coeffs.shape != (M, 20, 2) or self.centre.shape != (M, 3) or self.extent.shape != (M, 3):
-            raise ValueError("coeffs must be (M, 20, 2), centre and extent (M, 3)")
-        if self.element.min() < 0 or self.element.max() >= M:
-            raise ValueError(f"element indices must lie in [0, {M})")
-        if not np.isfinite(self.corners).all():
-            raise ValueError("polygon corners must be finite")
-        outer = self.outer
-        if outer is not None and (np.shape(outer) != (P, 4) or np.asarray(outer).dtype != bool):
-            raise ValueError(f"outer must be (P, 4) bool, got {np.shape(self.outer)}")
-        used = np.unique(self.element)
-        if (self.extent[used] <= 0).any():
-            raise ValueError("element extents must be positive")
-        if not (np.isfinite(self.coeffs[used]).all() and np.isfinite(self.centre[used]).all()):
-            raise ValueError("element coefficients and centres must be finite")
-
-    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """(lo, hi) of the polygons in the drawing plane, float64."""
-        flat = self.corners.reshape(-1, 2)
-        return flat.min(axis=0), flat.max(axis=0)
-
-
 def top_camera(grid, z_range: tuple[float, float] = (-1.0, 1.0), origin=None) -> Camera:
     """An orthographic camera looking down −z whose pixels are exactly those of ``grid``
     (a :class:`workbench.algo.spacetime.raster.PixelGrid`): pixel centres of the image read
@@ -173,23 +115,27 @@ def top_camera(grid, z_range: tuple[float, float] = (-1.0, 1.0), origin=None) ->
                   near=0.5 * depth, far=2.5 * depth)
 
 
-class SpacetimePath:
-    """One spacetime render path (``per_vertex`` or ``per_pixel``), prepared for one scene.
+class SpacetimePath(GLPath):
+    """The shared implementation of the two registered spacetime paths (``spacetime_vertex``,
+    ``spacetime_pixel``; :func:`spacetime_path` picks one by ``style.shading``), prepared for one scene: a
+    :class:`~workbench.scene.spacetime.SpacetimeScene` (a slice, or the bar's spacetime), built
+    by the caller. The scene is one configuration, so ``set_step`` accepts only step 0.
 
     After :meth:`prepare`: ``polygons``, ``triangles``, ``lines`` (shared edges overdrawn) and
     ``skirts`` drawn, ``elements`` (element records uploaded), ``bytes_uploaded``.
     """
 
+    needs = frozenset()
+    style_class = SpacetimeStyle
+    scene_kind = "spacetime"
+
     def __init__(self, style: SpacetimeStyle | None = None) -> None:
-        self.style = style if style is not None else SpacetimeStyle()
-        self.ctx = None
-        self._objects: list = []
-        self._textures: list = []
-        self.polygons = self.triangles = self.lines = self.skirts = 0
-        self.elements = self.bytes_uploaded = 0
+        super().__init__(style)
+        self.polygons = self.lines = self.skirts = self.elements = 0
 
     @property
-    def name(self) -> str:
+    def label(self) -> str:
+        """The shading and the overdraw, e.g. ``per_pixel+overdraw skirts``."""
         overdraw = self.style.edge_overdraw
         return self.style.shading + ("" if overdraw == "none" else f"+overdraw {overdraw}")
 
@@ -198,22 +144,11 @@ class SpacetimePath:
         """Whether the overdraw goes to the far half of the depth range, behind the fill."""
         return self.style.edge_overdraw in ("behind", "skirts")
 
-    def _keep(self, obj):
-        self._objects.append(obj)
-        return obj
-
-    def prepare(self, ctx: moderngl.Context, scene: SpacetimeScene, camera: Camera) -> None:
-        """Upload ``scene`` (polygons, element records, ramp) relative to ``camera.origin``."""
-        if self.ctx is not None:
-            self.release()
+    def _check_scene(self, scene) -> None:
+        if not isinstance(scene, SpacetimeScene):
+            raise ValueError(f"path {self.name!r} draws a spacetime scene (e.g. spacetime:radial), "
+                             f"got {type(scene).__name__}")
         scene.check()
-        self.ctx, self.origin, self.scene = ctx, np.asarray(camera.origin, np.float64), scene
-        try:
-            self._build(ctx, scene)
-            self.set_camera(camera)
-        except BaseException:
-            self.release()
-            raise
 
     def _load(self, ctx, defines: dict, depth_half: int | None, skirt: bool = False):
         defines = dict(defines)
@@ -225,7 +160,8 @@ class SpacetimePath:
                                        geometry="spacetime_skirt.geom.glsl" if skirt else None,
                                        defines=defines))
 
-    def _build(self, ctx, scene: SpacetimeScene) -> None:
+    def _build(self, ctx, scene: SpacetimeScene, camera: Camera) -> None:
+        self.scene = scene
         style = self.style
         defines = {}
         if style.shading == "per_vertex":
@@ -289,6 +225,10 @@ class SpacetimePath:
             for name, value in values.items():
                 if name in program:
                     program[name].value = value
+        self.vertices, self.vertices_sent = len(positions), tris.size
+        self.edges = self.lines
+        self.set_camera(camera)
+        self.bytes_per_step = 0
 
     @staticmethod
     def _shared_edges(scene: SpacetimeScene, quad: np.ndarray) -> np.ndarray:
@@ -356,47 +296,52 @@ class SpacetimePath:
         texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
         return texture
 
-    def set_camera(self, camera: Camera) -> None:
-        """Camera uniforms; ``camera.origin`` must be the one given to ``prepare``."""
-        if self.ctx is None:
-            raise RuntimeError("spacetime path is not prepared")
-        if not np.array_equal(np.asarray(camera.origin, np.float64), self.origin):
-            raise ValueError("camera origin differs from the prepared origin: prepare again")
-        eye = np.asarray(camera.eye, np.float64)
-        axis = eye - np.asarray(camera.target, np.float64)
-        axis /= np.linalg.norm(axis)
-        for program in self._programs():
-            program["mvp"].write(camera.mvp_bytes())
-            for name, value in (("eye_position", eye), ("eye_axis", axis)):
-                if name in program:
-                    program[name].value = tuple(float(v) for v in value)
-            if "perspective" in program:
-                program["perspective"].value = 1.0 if camera.projection == "perspective" else 0.0
+    def set_step(self, step: int) -> int:
+        """The scene is one slice: step 0 is the only one; nothing is uploaded."""
+        self._require_prepared()
+        if step != 0:
+            raise ValueError(f"path {self.name!r} draws one slice (step 0), got step {step}: "
+                             f"slice the spacetime mesh at another time for another scene")
+        return 0
 
     def draw(self) -> None:
         """Draw into the bound framebuffer: the fill, then the edge lines and skirts if asked for."""
         ctx = self.ctx
         ctx.enable_only(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="
-        behind = self._behind
-        if behind:  # the near and far planes, clipped by distance
-            ctx.enable_direct(GL_CLIP_DISTANCE0)
-            ctx.enable_direct(GL_CLIP_DISTANCE0 + 1)
         for texture, unit in self._textures:
             texture.use(unit)
-        self._vao.render(moderngl.TRIANGLES)
-        if self._line_vao is not None:
-            self._line_vao.render(moderngl.LINES)
-        if self._skirt_vao is not None:
-            self._skirt_vao.render(moderngl.LINES)
-        if behind:
-            ctx.disable_direct(GL_CLIP_DISTANCE0)
-            ctx.disable_direct(GL_CLIP_DISTANCE0 + 1)
+        with self._clip_distances(2 if self._behind else 0):  # the near and far planes
+            self._vao.render(moderngl.TRIANGLES)
+            if self._line_vao is not None:
+                self._line_vao.render(moderngl.LINES)
+            if self._skirt_vao is not None:
+                self._skirt_vao.render(moderngl.LINES)
         ctx.depth_func = "<"
 
-    def release(self) -> None:
-        for obj in reversed(self._objects):
-            obj.release()
-        self._objects.clear()
-        self._textures = []
-        self.ctx = None
+
+class SpacetimeVertexPath(SpacetimePath):
+    """st2005 per vertex: colour and Phong lighting at the polygon vertices, interpolated."""
+
+    name = "spacetime_vertex"
+    fixed_options = frozenset({"shading"})
+
+    def __init__(self, style: SpacetimeStyle | None = None) -> None:
+        super().__init__(replace(style or SpacetimeStyle(), shading="per_vertex"))
+
+
+class SpacetimePixelPath(SpacetimePath):
+    """st2005 per pixel: strain energy, colour and the exact height-field normal per fragment."""
+
+    name = "spacetime_pixel"
+    fixed_options = frozenset({"shading"})
+
+    def __init__(self, style: SpacetimeStyle | None = None) -> None:
+        super().__init__(replace(style or SpacetimeStyle(), shading="per_pixel"))
+
+
+def spacetime_path(style: SpacetimeStyle | None = None) -> SpacetimePath:
+    """The registered spacetime path for ``style.shading`` (default per pixel), with ``style``."""
+    style = style or SpacetimeStyle()
+    cls = SpacetimeVertexPath if style.shading == "per_vertex" else SpacetimePixelPath
+    return cls(style)

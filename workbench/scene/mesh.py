@@ -247,6 +247,17 @@ class FEMesh:
             cache[crease_deg] = gouraud_split(self.elements, coords, crease_deg, self.triangulation)
         return cache[crease_deg]
 
+    def fepatch_model(self, fepatch: str = "A"):
+        """The fe2003 model of step 0 (``.original`` and ``.simplified`` textured surfaces) for
+        the parameter string ``fepatch`` ("A", "B" or "alpha_g1,d,l_outer,l_inner"; see
+        :func:`workbench.algo.fepatch.pipeline.build_model`), built once per string."""
+        cache = self.__dict__.setdefault("_fepatch_cache", {})
+        if fepatch not in cache:
+            from ..algo.fepatch.pipeline import build_model
+
+            cache[fepatch] = build_model(self.elements, self.coordinates(0), fepatch)
+        return cache[fepatch]
+
     def __repr__(self) -> str:
         return (f"FEMesh({self.name!r}: {self.n_nodes} nodes, {self.n_elements} elements "
                 f"({self.n_quads} quads), {len(np.unique(self.parts))} parts, {self.n_steps} steps)")
