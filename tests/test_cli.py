@@ -196,3 +196,38 @@ def test_simplify_writes_a_surface_within_the_tolerance(tmp_path, capsys):
     h = hausdorff(original.nodes, original.triangles, np.asarray(simplified.vertices),
                   np.asarray(simplified.faces), tol=1e-6)
     assert h.upper <= tol * (1 + 1e-6)
+
+
+def test_render_reaches_a_spacetime_path(tmp_path, capsys):
+    out = tmp_path / "slice.png"
+    assert main(["render", "spacetime:radial:4", "--path", "spacetime_vertex", "-O",
+                 "height_scale=800", "-O", "edge_overdraw=skirts", "--size", "64x64",
+                 "-o", str(out)]) == 0
+    image = np.asarray(Image.open(out))
+    assert image.shape[:2] == (64, 64)
+    assert (image[..., :3] != 255).any(axis=2).mean() > 0.8  # the plate fills the top view
+    assert "path spacetime_vertex" in capsys.readouterr().out
+
+
+def test_render_help_lists_every_path(capsys):
+    from workbench.paths import PATHS
+
+    with pytest.raises(SystemExit):
+        main(["render", "--help"])
+    printed = capsys.readouterr().out
+    for name in PATHS:
+        assert name in printed
+
+
+@pytest.mark.parametrize("args, message", [
+    (["spacetime:radial:4", "--path", "gouraud"], "draws mesh scenes"),
+    (["spacetime:radial:4", "--bands", "3"], "--bands applies to the mesh paths"),
+    (["semicylinders:2", "--path", "spacetime_pixel"], "draws spacetime scenes"),
+    (["semicylinders:2", "-O", "glow=1"], "takes no option 'glow'"),
+    (["spacetime:nowhere"], "no spacetime scene 'spacetime:nowhere'"),
+    (["semicylinders:many"], "must be an integer"),
+])
+def test_render_refuses_mismatches_in_one_line(args, message, tmp_path, capsys):
+    assert main(["render", *args, "-o", str(tmp_path / "x.png")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1

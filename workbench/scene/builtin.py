@@ -16,7 +16,7 @@ from ..data import CAR_DECK, D3PLOT, shared_file
 from .mesh import FEMesh
 
 BUILTIN = ("car", "d3plot", "semicylinders", "panels", "spacetime:radial", "spacetime:bar")
-SIZED = ("semicylinders", "panels", "spacetime")  # names that take a size after a colon
+SIZED = ("semicylinders", "panels", "spacetime:radial", "spacetime:bar")  # take ":size"
 
 
 def builtin_scene(name: str, quick: bool = False, size: int | None = None):
@@ -51,7 +51,10 @@ def parse_scene_spec(spec: str) -> tuple[str, int | None] | None:
     integer."""
     name, size = spec, None
     head, _, tail = spec.rpartition(":")
-    if spec not in BUILTIN and head and (head in SIZED or head.startswith("spacetime:")):
+    if spec.startswith("spacetime:") and spec not in BUILTIN and head not in SIZED:
+        known = ", ".join(n for n in BUILTIN if n.startswith("spacetime:"))
+        raise KeyError(f"no spacetime scene {spec!r}; built in: {known} (with an optional :N)")
+    if spec not in BUILTIN and head in SIZED:
         name = head
         try:
             size = int(tail)
