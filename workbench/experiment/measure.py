@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from dataclasses import dataclass
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -127,6 +127,7 @@ def measure(ctx, scene, path, style=None, camera: Camera | None = None,
         with path:
             start = time.perf_counter()
             path.prepare(ctx, scene, camera)
+            ctx.finish()  # the uploads count as preparation
             prepare_ms = (time.perf_counter() - start) * 1e3
             if isinstance(scene, FEMesh):
                 undeclared = derived_items(scene) - held - needed_items(path.needs, path.style)

@@ -135,6 +135,6 @@ class QuadWirePath(MeshPath):
     def static_attributes(self):
         return [(self._wire_coord, "3f", "wire"), (self._boundary, "1f", "boundary")]
 
-    def _build(self, ctx, camera) -> None:
-        super()._build(ctx, camera)
+    def _build(self, ctx, mesh, camera) -> None:
+        super()._build(ctx, mesh, camera)
         self._program["wire_color"].value = self.style.wire_color
