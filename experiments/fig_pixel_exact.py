@@ -40,31 +40,28 @@ Run: ``workbench run fig_pixel_exact [--quick]`` or ``python experiments/fig_pix
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from workbench.algo.spacetime.exact import colour_error, edge_distance, exact_image
-from workbench.algo.spacetime.fields import BAR, STEEL, RadialPulse, ReflectingWave
-from workbench.algo.spacetime.mesh import front_refined, interval_mesh, rect_triangulation
-from workbench.algo.spacetime.poly import (evaluate, evaluate_float32_global,
-                                           evaluate_float32_local, fit_cubic, local_frames)
+from workbench.algo.spacetime.fields import BAR, STEEL, RadialPulse
+from workbench.algo.spacetime.mesh import front_refined, rect_triangulation
+from workbench.algo.spacetime.poly import evaluate, evaluate_float32_global, evaluate_float32_local
 from workbench.algo.spacetime.raster import PixelGrid
 from workbench.algo.spacetime.slicing import TimeSlicer, polygon_areas, quadrisect, slice_at
 from workbench.experiment.compare import crack_pixels
 from workbench.experiment.figures import save_field_figure, save_image_grid
+from workbench.experiment.measure import measure
 from workbench.experiment.registry import experiment, main
 from workbench.experiment.tables import atomic_open, write_table
-from workbench.experiment.timing import time_call, time_draw
-from workbench.gl import Camera, Framebuffer, create_context, renderer
+from workbench.experiment.timing import time_call
+from workbench.gl import Camera, create_context, renderer
 from workbench.paths.colormap import colormap_lut
-from workbench.paths.spacetime import (OVERDRAWS, SpacetimePath, SpacetimeScene, SpacetimeStyle,
-                                       top_camera)
+from workbench.paths.spacetime import OVERDRAWS, SpacetimeStyle, spacetime_path, top_camera
+from workbench.scene.spacetime import (DOMAIN, PULSE, T_SLICE, Solution, SpacetimeScene, bar_scene,
+                                       plate_solution, slice_scene, window)
 
-DOMAIN = 100.0  # mm, the square plate
-PULSE = dict(centre=(30.0, 35.0), a=2.0, t0=2.0)
-T_SLICE = 5.0  # µs: the ring is ~40 mm out
 U_MAX = 100.0  # kJ/m³, top of the log colour scale
 HEIGHT_SCALE = 800.0  # mm of height per mm/µs (peak speeds ~1e-2 mm/µs)
 COLORMAP = "plasma"  # its dark end is blue, not black, so lighting shows everywhere
@@ -76,91 +73,16 @@ EDGE_PX = 0.01  # pixel centres this close to an element edge may go to either e
 RESOLUTIONS = {1_000: 7, 10_000: 28, 100_000: 115, 1_000_000: 390}
 
 
-@dataclass
-class Solution:
-    """A fitted spacetime solution: mesh, cubic coefficients, local frames and timings."""
-
-    label: str
-    mesh: object
-    coeffs: np.ndarray
-    centre: np.ndarray
-    extent: np.ndarray
-    field: object
-    material: object
-    mesh_s: float
-    fit_s: float
-
-
-def plate_solution(n: int, t_lo: float, t_hi: float, *, offset=(0.0, 0.0), bands: int = 2,
-                   refine: bool = True, seed: int = 0) -> Solution:
-    """The radial pulse on the plate meshed with n×n cells over [t_lo, t_hi] µs, refined along
-    the front in ``bands`` bands (non-conforming at band boundaries), fitted per element."""
-    offset = np.asarray(offset, np.float64)
-    field = RadialPulse(origin=tuple(offset), **PULSE)
-    start = time.perf_counter()
-    pts, tris = rect_triangulation(n, n, size=(DOMAIN, DOMAIN), origin=tuple(offset),
-                                   jitter=0.25, seed=seed)
-    h = DOMAIN / n
-    mesh = front_refined(pts, tris, t_hi, STEEL.p_wave_speed, t_start=t_lo, bands=bands,
-                         front_distance=field.front_distance if refine else None,
-                         width=1.5 * h, levels=1, rng_seed=seed)
-    mesh_s = time.perf_counter() - start
-    start = time.perf_counter()
-    coeffs = fit_cubic(mesh.points, mesh.simplices, field.displacement)
-    centre, extent = local_frames(mesh.points, mesh.simplices)
-    fit_s = time.perf_counter() - start
-    return Solution(f"plate {n}x{n}", mesh, coeffs, centre, extent, field, STEEL, mesh_s, fit_s)
-
-
-def window(n: int, layers: float = 1.0) -> tuple[float, float]:
-    """A time window about ``layers`` tent layers deep for n×n cells, with T_SLICE at 60 % of
-    it — off the flat front between its two bands, which lies at 50 %."""
-    depth = layers * (DOMAIN / n) / STEEL.p_wave_speed
-    return T_SLICE - 0.6 * depth, T_SLICE + 0.4 * depth
-
-
-def slice_scene(sol: Solution, s) -> SpacetimeScene:
-    m = sol.material
-    return SpacetimeScene(s.corners, s.element, sol.coeffs, sol.centre, sol.extent, m.lam, m.mu,
-                          t=s.t, outer=s.outer)
-
-
-def bar_scene(n: int = 24, t_end: float = 16.0):
-    """The st2005 Fig. 3 bar: 100 mm, fixed at x = 0, a pulse starting at its centre, meshed in
-    (x, t) by tent pitching; returns (scene, solution)."""
-    field = ReflectingWave()
-    pts, segs = interval_mesh(n, length=DOMAIN, jitter=0.25, seed=1)
-    mesh = front_refined(pts, segs, t_end, BAR.p_wave_speed, bands=1, front_distance=None)
-    coeffs = fit_cubic(mesh.points, mesh.simplices, field.displacement)
-    centre, extent = local_frames(mesh.points, mesh.simplices)
-    tri = mesh.points[mesh.simplices]  # (M, 3, 2) in (x, t)
-    area = (tri[:, 1, 0] - tri[:, 0, 0]) * (tri[:, 2, 1] - tri[:, 0, 1]) - \
-           (tri[:, 2, 0] - tri[:, 0, 0]) * (tri[:, 1, 1] - tri[:, 0, 1])
-    tri[area < 0] = tri[area < 0][:, [0, 2, 1]]
-    corners = np.concatenate([tri, tri[:, 2:3]], axis=1)
-    scene = SpacetimeScene(corners, np.arange(len(corners)), coeffs, centre, extent,
-                           BAR.lam, BAR.mu, t=None)
-    sol = Solution(f"bar {n}", mesh, coeffs, centre, extent, field, BAR, 0.0, 0.0)
-    return scene, sol
-
-
 class Renderer:
-    """One GL context and framebuffer; draws scenes in the top view (against the exact
-    image) and in an oblique perspective view (cracks). ``last_prepare_ms`` and ``last_bytes``:
-    what preparing the last path took (uploading the slice and its element texture, and
-    linking the programs) and uploaded."""
+    """One GL context; measures spacetime scenes in the top view (against the exact image) and
+    in an oblique perspective view (cracks), each through
+    :func:`~workbench.experiment.measure.measure`."""
 
     def __init__(self, width: int, repeat: int) -> None:
         self.ctx = create_context()
         self.name = renderer(self.ctx)
         self.width, self.repeat = width, repeat
         self.table = colormap_lut(COLORMAP)
-        self._fbs: dict = {}
-
-    def fb(self, size):
-        if size not in self._fbs:
-            self._fbs[size] = Framebuffer(self.ctx, size)
-        return self._fbs[size]
 
     def style(self, shading, overdraw="none", lighting=True, store="buffer") -> SpacetimeStyle:
         return SpacetimeStyle(shading=shading, edge_overdraw=overdraw, lighting=lighting,
@@ -180,44 +102,27 @@ class Renderer:
         return float(HEIGHT_SCALE * speed.max()) + 1e-3
 
     def top(self, scene, style, *, time_it=False, origin=None):
-        """(image, grid, timing or None) of the top view."""
+        """(measurement, grid) of the top view, timed with ``time_it``; ``origin`` (3,) is the
+        float64 upload origin (default the grid centre)."""
         grid = self.grid(scene)
         camera = top_camera(grid, (-1.0, self.heights(scene) + 1.0), origin=origin)
-        return self._draw(scene, style, camera, (grid.width, grid.height), BACKGROUND,
-                          time_it) + (grid,)
+        return self._measure(scene, style, camera, (grid.width, grid.height), BACKGROUND,
+                             time_it), grid
 
-    def oblique(self, scene, style, *, size=None, time_it=False):
-        """(image, timing or None) of a perspective view from 35° above the plate."""
+    def oblique(self, scene, style, *, size=None):
+        """(H, W, 4) uint8 image of a perspective view from 35° above the plate, on
+        CRACK_BACKGROUND."""
         lo, hi = scene.bounds()
         top = self.heights(scene)
         camera = Camera.fit_box(np.r_[lo, 0.0], np.r_[hi, top], azimuth=25, elevation=35,
                                 projection="perspective", up="z", margin=0.9,
                                 aspect=4 / 3, origin=np.r_[(lo + hi) / 2, 0.0])
         size = size or (self.width, self.width * 3 // 4)
-        return self._draw(scene, style, camera, size, CRACK_BACKGROUND, time_it)
+        return self._measure(scene, style, camera, size, CRACK_BACKGROUND, False).image
 
-    def _draw(self, scene, style, camera, size, background, time_it):
-        path = SpacetimePath(style)
-        fb = self.fb(size)
-        try:
-            start = time.perf_counter()
-            path.prepare(self.ctx, scene, camera)
-            self.ctx.finish()
-            self.last_prepare_ms = 1e3 * (time.perf_counter() - start)
-            self.last_bytes = path.bytes_uploaded
-            fb.use()
-            fb.clear(background)
-            path.draw()
-            image = fb.read()
-            timing = None
-            if time_it:
-                def draw():
-                    fb.clear(background)
-                    path.draw()
-                timing = time_draw(self.ctx, fb, draw, warmup=2, repeat=self.repeat)
-            return image, timing
-        finally:
-            path.release()
+    def _measure(self, scene, style, camera, size, background, time_it):
+        return measure(self.ctx, scene, spacetime_path(style), camera=camera, size=size,
+                       repeats=self.repeat, background=background, timed=time_it)
 
     def exact(self, scene: SpacetimeScene, material, grid: PixelGrid, lighting=True):
         return exact_image(scene.corners, scene.element, scene.coeffs, scene.centre, scene.extent,
@@ -225,8 +130,6 @@ class Renderer:
                            height_scale=HEIGHT_SCALE, lighting=lighting and not scene.is_bar)
 
     def release(self) -> None:
-        for fb in self._fbs.values():
-            fb.release()
         self.ctx.release()
 
 
@@ -282,16 +185,16 @@ def size_rows(r: Renderer, quick: bool, say) -> tuple[list[dict], dict]:
         for shading in ("per_vertex", "per_pixel"):
             for overdraw, store in variants:
                 style = r.style(shading, overdraw, store=store)
-                image, timing, grid = r.top(scene, style, time_it=True)
+                m, grid = r.top(scene, style, time_it=True)
                 if exact is None:
                     exact = r.exact(scene, sol.material, grid)
-                oblique, _ = r.oblique(scene, style)
+                oblique = r.oblique(scene, style)
                 row = dict(target_polygons=target, cells=f"{n}x{n}", tets=sol.mesh.n_simplices,
                            polygons=s.n_polygons, quads=int(s.is_quad.sum()),
                            slice_ms=float(np.median(slice_ms[1:])), path=shading,
-                           edge_overdraw=overdraw, element_store=store, **timing.as_row(),
-                           prepare_ms=r.last_prepare_ms, upload_bytes=r.last_bytes,
-                           **error_columns(image, exact, scene.corners, grid),
+                           edge_overdraw=overdraw, element_store=store, **m.timing.as_row(),
+                           prepare_ms=m.row["prepare_ms"], upload_bytes=m.row["bytes_uploaded"],
+                           **error_columns(m.image, exact, scene.corners, grid),
                            crack_pixels=int(crack_pixels(oblique, CRACK_BACKGROUND).sum()),
                            renderer=r.name, image=f"{grid.width}x{grid.height}")
                 rows.append(row)
@@ -345,14 +248,15 @@ def slicing_rows(quick: bool, say) -> list[dict]:
     brute = [time_call(lambda t=t: slice_at(mesh, float(t)), warmup=0, repeat=5).wall_ms
              for t in times[:: max(1, len(times) // 5)]]
     area = float(polygon_areas(s).sum())
-    row = dict(tets=mesh.n_simplices, build_s=build_s, sort_s=sort_s, frames=len(times),
-               polygons_median=int(np.median(polys)), polygons_max=int(max(polys)),
-               incremental_ms_median=float(np.median(inc[1:])), incremental_ms_max=float(max(inc[1:])),
-               first_frame_ms=inc[0], shared_facets_s=facets_s,
-               with_outer_ms_median=float(np.median(inc_outer[1:])),
-               brute_force_ms_median=float(np.median(brute)),
-               speedup=float(np.median(brute) / np.median(inc[1:])),
-               last_slice_area_error=abs(area - DOMAIN * DOMAIN) / (DOMAIN * DOMAIN))
+    row = {"tets": mesh.n_simplices, "build_s": build_s, "sort_s": sort_s, "frames": len(times),
+           "polygons_median": int(np.median(polys)), "polygons_max": int(max(polys)),
+           "incremental_ms_median": float(np.median(inc[1:])),
+           "incremental_ms_max": float(max(inc[1:])),
+           "first_frame_ms": inc[0], "shared_facets_s": facets_s,
+           "with_outer_ms_median": float(np.median(inc_outer[1:])),
+           "brute_force_ms_median": float(np.median(brute)),
+           "speedup": float(np.median(brute) / np.median(inc[1:])),
+           "last_slice_area_error": abs(area - DOMAIN * DOMAIN) / (DOMAIN * DOMAIN)}
     say(f"  incremental {row['incremental_ms_median']:.1f} ms/frame (max {row['incremental_ms_max']:.1f}, "
         f"{row['with_outer_ms_median']:.1f} with boundary edges), "
         f"brute force {row['brute_force_ms_median']:.1f} ms, {row['polygons_median']} polygons")
@@ -372,16 +276,16 @@ def sweep_rows(r: Renderer, quick: bool, keep: dict, say) -> list[dict]:
         q = s if factor is None else quadrisect(s, threshold)
         qs = slice_scene(sol, q)
         for shading in ("per_vertex", "per_pixel"):
-            image, timing, grid = r.top(qs, r.style(shading, "behind"), time_it=True)
+            m, grid = r.top(qs, r.style(shading, "behind"), time_it=True)
             if exact is None:  # children show their parent's element: one exact image for all
                 exact = r.exact(slice_scene(sol, s), sol.material, grid)
-            oblique, _ = r.oblique(qs, r.style(shading, "behind"))
-            skirted, _ = r.oblique(qs, r.style(shading, "skirts"))
+            oblique = r.oblique(qs, r.style(shading, "behind"))
+            skirted = r.oblique(qs, r.style(shading, "skirts"))
             rows.append(dict(sweep="quadrisection", cells=sol.label,
                              threshold_mm2=None if factor is None else threshold,
                              threshold_vs_mean_area=factor, polygons=q.n_polygons, path=shading,
-                             wall_ms=timing.wall_ms, gpu_ms=timing.gpu_ms,
-                             **error_columns(image, exact, s.corners, grid),
+                             wall_ms=m.timing.wall_ms, gpu_ms=m.timing.gpu_ms,
+                             **error_columns(m.image, exact, s.corners, grid),
                              crack_pixels=int(crack_pixels(oblique, CRACK_BACKGROUND).sum()),
                              crack_pixels_skirts=int(crack_pixels(skirted, CRACK_BACKGROUND).sum()),
                              renderer=r.name))
@@ -394,13 +298,14 @@ def sweep_rows(r: Renderer, quick: bool, keep: dict, say) -> list[dict]:
         scene_n = slice_scene(sol_n, sn)
         ex = None
         for shading in ("per_vertex", "per_pixel"):
-            image, timing, grid = r.top(scene_n, r.style(shading, "behind"), time_it=True)
+            m, grid = r.top(scene_n, r.style(shading, "behind"), time_it=True)
             if ex is None:
                 ex = r.exact(scene_n, sol_n.material, grid)
                 closed = closed_form_error(sol_n, grid, ex)
             rows.append(dict(sweep="resolution", cells=f"{n}x{n}", polygons=sn.n_polygons,
-                             path=shading, wall_ms=timing.wall_ms, gpu_ms=timing.gpu_ms,
-                             **error_columns(image, ex, scene_n.corners, grid), fit_U_err_max=closed,
+                             path=shading, wall_ms=m.timing.wall_ms, gpu_ms=m.timing.gpu_ms,
+                             **error_columns(m.image, ex, scene_n.corners, grid),
+                             fit_U_err_max=closed,
                              renderer=r.name))
         say(f"  resolution {n}x{n}: {sn.n_polygons} polygons, fitted U off the closed form by "
             f"{closed:.3g} kJ/m³")
@@ -457,7 +362,8 @@ def stability_rows(r: Renderer, quick: bool, say) -> list[dict]:
                                ("10^4 element sizes away, global float32", far, np.zeros(3))):
         s = slice_at(sol.mesh, T_SLICE)
         scene = slice_scene(sol, s)
-        image, _, grid = r.top(scene, r.style("per_pixel"), origin=origin)
+        m, grid = r.top(scene, r.style("per_pixel"), origin=origin)
+        image = m.image
         exact = r.exact(scene, sol.material, grid)
         # float32 emulation of the same evaluation at the pixel centres
         xs, ys = grid.centres()
@@ -482,7 +388,8 @@ def stability_rows(r: Renderer, quick: bool, say) -> list[dict]:
                      ("slice through a vertex", vertex_t)):
         s = slice_at(near.mesh, t)
         scene = slice_scene(near, s)
-        image, _, grid = r.top(scene, r.style("per_pixel"))
+        m, grid = r.top(scene, r.style("per_pixel"))
+        image = m.image
         exact = r.exact(scene, near.material, grid)
         areas = polygon_areas(s)
         rows.append(dict(case=label, t_us=t, polygons=s.n_polygons,
@@ -497,7 +404,8 @@ def stability_rows(r: Renderer, quick: bool, say) -> list[dict]:
     s = slice_at(early.mesh, 0.5)
     scene = slice_scene(early, s)
     for shading in ("per_vertex", "per_pixel"):
-        image, _, grid = r.top(scene, r.style(shading))
+        m, grid = r.top(scene, r.style(shading))
+        image = m.image
         exact = r.exact(scene, early.material, grid)
         zero = exact.covered & (exact.U < 1e-9)
         rows.append(dict(case=f"U ≈ 0 and |v| ≈ 0 regions ({shading})", polygons=s.n_polygons,
@@ -513,11 +421,11 @@ def stability_rows(r: Renderer, quick: bool, say) -> list[dict]:
 
 # --------------------------------------------------------------------------------- figures
 def figures(r: Renderer, out_dir: Path, keep: dict, say) -> None:
-    bar, bar_sol = bar_scene()
+    bar, _ = bar_scene()
     images, errors = {}, {}
     for shading in ("per_vertex", "per_pixel"):
-        image, _, grid = r.top(bar, r.style(shading, lighting=False))
-        images[shading] = image
+        m, grid = r.top(bar, r.style(shading, lighting=False))
+        images[shading] = m.image
     exact = r.exact(bar, BAR, grid, lighting=False)
     for shading in images:
         errors[shading] = error_map(images[shading], exact)
@@ -529,10 +437,11 @@ def figures(r: Renderer, out_dir: Path, keep: dict, say) -> None:
     say(f"  fig3: bar, {len(bar.corners)} spacetime triangles, per-vertex error max "
         f"{errors['per_vertex'].max():.0f}, per-pixel {errors['per_pixel'].max():.1f} (1/255)")
 
-    sol, scene, s = keep[10_000]
+    sol, scene, _ = keep[10_000]
     images = {}
     for shading in ("per_vertex", "per_pixel"):
-        images[shading], _, grid = r.top(scene, r.style(shading))
+        m, grid = r.top(scene, r.style(shading))
+        images[shading] = m.image
     exact = r.exact(scene, sol.material, grid)
     panels = [images["per_vertex"], images["per_pixel"], exact.rgba8(),
               error_map(images["per_vertex"], exact), error_map(images["per_pixel"], exact)]
@@ -542,7 +451,7 @@ def figures(r: Renderer, out_dir: Path, keep: dict, say) -> None:
     h, w = grid.height, grid.width
     box = (slice(h // 4, h // 2), slice(w // 2, w // 2 + w // 4))
     save_image_grid(out_dir / "fig5_crop.png", [p[box] for p in panels], titles, columns=5)
-    unlit, _, _ = r.top(scene, r.style("per_pixel", lighting=False))
+    unlit = r.top(scene, r.style("per_pixel", lighting=False))[0].image
     save_field_figure(out_dir / "fig5_colorbar.png", unlit,
                       value_range=(0.0, float(np.log1p(U_MAX))), colormap=COLORMAP,
                       label="ln(1 + U / (1 kJ/m³)), clamped at U_max", units="",
@@ -557,13 +466,13 @@ def figures(r: Renderer, out_dir: Path, keep: dict, say) -> None:
                                     ("lines behind", scene_k, "behind"),
                                     ("behind + quadrisection", quads, "behind"),
                                     ("skirts", scene_k, "skirts")):
-            image, _ = r.oblique(sc, r.style("per_pixel", overdraw))
+            image = r.oblique(sc, r.style("per_pixel", overdraw))
             row.append(image)
             titles.append(f"{s_k.n_polygons} polygons, {label}: "
                           f"{int(crack_pixels(image, CRACK_BACKGROUND).sum())} crack px")
         panels += crop_to_cracks(row)
     save_image_grid(out_dir / "fig4_cracks.png", panels, titles, columns=5)
-    panels = [r.oblique(scene, r.style(sh, "skirts"))[0] for sh in ("per_vertex", "per_pixel")]
+    panels = [r.oblique(scene, r.style(sh, "skirts")) for sh in ("per_vertex", "per_pixel")]
     save_image_grid(out_dir / "fig8_height.png", panels, ["(a) per-vertex colour", "(b) per-pixel colour"])
 
 

@@ -3,8 +3,13 @@
 For each scene the table has one row per path and option — GPU ms, wall ms, read-back ms,
 million triangles per second, bytes uploaded (and per time step) — with the colour error of
 each per-vertex path against the per-pixel path of the same style (the colour reference),
-over the pixels either draws. On llvmpipe the GPU timer query covers only part of the
-rasterizer's work; wall time (draw + ``finish``) is the figure to compare there.
+over the pixels either draws, and what the path's ``needs`` saved: ``derive_ms`` and
+``derive_bytes`` of the scene data it made the mesh derive (triangulation, element edges,
+crease-split Gouraud vertices), ``skipped_ms`` and ``skipped_bytes`` of the rest, which a scene
+deriving everything would have computed for nothing (both from nothing, on a fresh copy of the
+mesh). Every path is measured by :func:`workbench.experiment.measure.measure`. On llvmpipe
+the GPU timer query covers only part of the rasterizer's work; wall time (draw + ``finish``)
+is the figure to compare there.
 In the same run the same triangles are drawn by pyrender through EGL at the same size, with
 the same culling and comparable lighting (SSIM against our Gouraud image shows the comparison
 is like for like), and a bare position-only draw gives the floor. ``targets.md`` holds the
@@ -21,17 +26,19 @@ from pathlib import Path
 import numpy as np
 
 from workbench.data import CAR_DECK, shared_file
-from workbench.experiment.compare import compare_images, coverage
+from workbench.experiment.compare import compare_drawn, difference_image
 from workbench.experiment.figures import save_field_figure, save_image_grid
+from workbench.experiment.measure import measure
 from workbench.experiment.reference import PyrenderReference
 from workbench.experiment.registry import experiment, main
 from workbench.experiment.tables import write_table
-from workbench.experiment.timing import time_call, time_draw
-from workbench.gl import Camera, Framebuffer, create_context, renderer
+from workbench.experiment.timing import time_call
+from workbench.gl import Camera, create_context, renderer
 from workbench.paths import Style, make_path
 from workbench.paths.colormap import scale_for
 from workbench.scene import generators
 from workbench.scene.builtin import builtin_scene
+from workbench.scene.derive import MESH_ITEMS, derivation_cost
 
 BANDS = 10
 
@@ -50,10 +57,11 @@ def scenes(quick: bool, say):
         rigid = [part for part, title in car.part_names.items() if "rigid" in title.lower()]
         car = generators.crash_sequence(car, steps=4 if quick else 12, still_parts=rigid)
         yield ("car", car, car.n_steps - 1, "displacement", "thickness", "mm",
-               dict(azimuth=-35.0, elevation=20.0, up="z"), (640, 400) if quick else (1000, 625))
+               {"azimuth": -35.0, "elevation": 20.0, "up": "z"},
+               (640, 400) if quick else (1000, 625))
     n = 64 if quick else 250
     yield (f"semicylinders n={n}", generators.semicylinders(n=n), 0, "distance", None, "mm",
-           dict(azimuth=25.0, elevation=15.0), (500, 500) if quick else (1000, 1000))
+           {"azimuth": 25.0, "elevation": 15.0}, (500, 500) if quick else (1000, 1000))
 
 
 def path_configs(step: int, field: str, element_field: str | None, value_range, clip_plane):
@@ -96,33 +104,32 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
         lo, hi = mesh.bounds(all_steps=True)
         center = (lo + hi) / 2.0
         camera = Camera.fit_box(lo, hi, aspect=size[0] / size[1], **view)
-        framebuffers = {samples: Framebuffer(ctx, size, samples=samples) for samples in (0, 4)}
         value_range = scale_for(mesh, field).value_range
         clip_plane = (*(-camera.view_matrix()[0, :3]), float(camera.view_matrix()[0, :3] @ center))
         images: dict[str, np.ndarray] = {}
+        costs: dict[float, dict] = {}
         for row_label, name, style, samples, reference in path_configs(step, field, element_field,
                                                                        value_range, clip_plane):
-            fb = framebuffers[samples]
             path = make_path(name, style)
-            path.prepare(ctx, mesh, camera)
-            timing = time_draw(ctx, fb, path.draw, repeat=repeat)
-            fb.clear()
-            path.draw()
-            images[row_label] = image = fb.read()
-            row = dict(renderer=gl_renderer, scene=label, path=row_label, path_name=name, parameters=style.summary(),
-                       width=size[0], height=size[1], msaa=samples, triangles=path.triangles, vertices=path.vertices,
+            probe = set_step_time(repeat) if mesh.n_steps > 1 else None
+            m = measure(ctx, mesh, path, camera=camera, size=size, repeats=repeat,
+                        samples=samples, probe=probe)
+            images[row_label] = image = m.image
+            row = dict(renderer=gl_renderer, scene=label, path=row_label, path_name=name,
+                       parameters=style.summary(), width=size[0], height=size[1], msaa=samples,
+                       triangles=path.triangles, vertices=path.vertices,
                        bytes_uploaded=path.bytes_uploaded, bytes_per_step=path.bytes_per_step,
-                       **timing.as_row(), mtri_per_s=path.triangles / timing.wall_ms / 1e3)
-            if mesh.n_steps > 1:
-                steps = iter(np.resize(np.arange(mesh.n_steps), 64))
-                row["set_step_ms"] = time_call(lambda: path.set_step(int(next(steps))), repeat=repeat).wall_ms
+                       **m.timing.as_row(), mtri_per_s=path.triangles / m.timing.wall_ms / 1e3)
+            if probe is not None:
+                row["set_step_ms"] = m.row["set_step_ms"]
+            row.update(needs_saving(mesh, path.needs, style, costs))
             if reference is not None:
-                diff = _compare_drawn(image, images[reference])
+                diff = compare_drawn(image, images[reference])
                 row.update(reference=reference, max_err_255=diff.max_abs, share_differing=diff.share_differing,
                            psnr_db=diff.psnr, ssim=diff.ssim)
             rows.append(row)
-            path.release()
-            say(f"  {row_label}: gpu {timing.gpu_ms:.2f} ms, wall {timing.wall_ms:.2f} ms")
+            say(f"  {row_label}: gpu {m.timing.gpu_ms:.2f} ms, wall {m.timing.wall_ms:.2f} ms, "
+                f"needs skipped {row['skipped_bytes'] / 2**20:.1f} MiB")
 
         split = mesh.gouraud(Style().crease_deg)
         coords = mesh.coordinates(step)
@@ -131,7 +138,7 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
         ref_image = ref.render()
         ref_timing = ref.time(warmup=2, repeat=repeat)
         ref.release()
-        diff = _compare_drawn(ref_image, images["gouraud, 4x MSAA"])
+        diff = compare_drawn(ref_image, images["gouraud, 4x MSAA"])
         rows.append(dict(renderer=gl_renderer, scene=label, path="pyrender (EGL)", path_name="pyrender",
                          width=size[0], height=size[1], msaa=4, triangles=len(split.triangles),
                          vertices=split.n_vertices, **ref_timing.as_row(),
@@ -142,17 +149,20 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
 
         by_path = {r["path"]: r for r in rows if r["scene"] == label}
         contour, contour_msaa = by_path["pixel bands"], by_path["pixel bands, 4x MSAA"]
-        targets.append(dict(
-            renderer=gl_renderer, scene=label, size=f"{size[0]}x{size[1]}", triangles=contour["triangles"],
-            contour_wall_ms=contour["wall_ms"], position_only_wall_ms=by_path["position"]["wall_ms"],
-            contour_over_position_only=contour["wall_ms"] / by_path["position"]["wall_ms"],
-            contour_msaa_incl_readback_ms=contour_msaa["wall_ms"] + contour_msaa["readback_ms"],
-            pyrender_incl_readback_ms=ref_timing.wall_ms,
-            contour_msaa_over_pyrender=(contour_msaa["wall_ms"] + contour_msaa["readback_ms"]) / ref_timing.wall_ms,
-            pyrender_ssim=diff.ssim,
-            nodes=len(mesh.used_nodes()), crease_vertices_added=split.added,
-            bytes_per_step=contour["bytes_per_step"], bytes_at_prepare=contour["bytes_uploaded"],
-        ))
+        targets.append({
+            "renderer": gl_renderer, "scene": label, "size": f"{size[0]}x{size[1]}",
+            "triangles": contour["triangles"], "contour_wall_ms": contour["wall_ms"],
+            "position_only_wall_ms": by_path["position"]["wall_ms"],
+            "contour_over_position_only": contour["wall_ms"] / by_path["position"]["wall_ms"],
+            "contour_msaa_incl_readback_ms": contour_msaa["wall_ms"] + contour_msaa["readback_ms"],
+            "pyrender_incl_readback_ms": ref_timing.wall_ms,
+            "contour_msaa_over_pyrender":
+                (contour_msaa["wall_ms"] + contour_msaa["readback_ms"]) / ref_timing.wall_ms,
+            "pyrender_ssim": diff.ssim,
+            "nodes": len(mesh.used_nodes()), "crease_vertices_added": split.added,
+            "bytes_per_step": contour["bytes_per_step"],
+            "bytes_at_prepare": contour["bytes_uploaded"],
+        })
 
         stem = label.split()[0]
         save_field_figure(out_dir / f"{stem}_bands_wire.png", images["pixel bands + wire"],
@@ -160,25 +170,39 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
                           title=f"{label}: per-pixel bands + element wire frame", bands=BANDS)
         save_image_grid(out_dir / f"{stem}_vertex_vs_pixel.png",
                         [images["vertex smooth"], images["pixel smooth"],
-                         _difference(images["vertex smooth"], images["pixel smooth"])],
+                         difference_image(images["vertex smooth"], images["pixel smooth"])],
                         ["colour per vertex", "colour per pixel (reference)", "|difference| x8"])
         save_image_grid(out_dir / f"{stem}_pyrender.png", [images["gouraud, 4x MSAA"], ref_image],
                         ["workbench gouraud, 4x MSAA", f"pyrender (SSIM {diff.ssim:.3f})"])
-        for fb in framebuffers.values():
-            fb.release()
     write_table(targets, out_dir, name="targets", title="Targets: contour path against pyrender and a bare draw")
     return rows
 
 
-def _compare_drawn(image: np.ndarray, reference: np.ndarray):
-    """Image errors over the pixels either image draws (the white background does not count)."""
-    return compare_images(reference, image, mask=coverage(image) | coverage(reference))
+def set_step_time(repeat: int):
+    """A :func:`measure` probe giving ``set_step_ms``: the median wall ms of uploading one time
+    step into the prepared path, cycling through the mesh's steps."""
+    def probe(path) -> dict:
+        steps = iter(np.resize(np.arange(path.mesh.n_steps), 64))
+        return {"set_step_ms": time_call(lambda: path.set_step(int(next(steps))),
+                                         repeat=repeat).wall_ms}
+    return probe
 
 
-def _difference(a: np.ndarray, b: np.ndarray, gain: int = 8) -> np.ndarray:
-    diff = np.abs(a[..., :3].astype(np.int16) - b[..., :3].astype(np.int16)).max(axis=2)
-    grey = 255 - np.clip(diff * gain, 0, 255).astype(np.uint8)
-    return np.dstack([grey, grey, grey, np.full_like(grey, 255)])
+def needs_saving(mesh, needs, style, costs: dict) -> dict:
+    """What a path's ``needs`` made the scene derive and what they let it skip:
+    ``derive_ms``/``derive_bytes`` of the items the path needs, ``skipped_ms``/``skipped_bytes``
+    of the other mesh items (:data:`MESH_ITEMS`), in ms and bytes from nothing (a fresh copy of
+    the mesh). Both come from one :func:`derivation_cost` of every mesh item per crease angle,
+    kept in ``costs``, so that they add up to deriving everything."""
+    crease = float(style.crease_deg)
+    if crease not in costs:
+        costs[crease] = derivation_cost(mesh, MESH_ITEMS, style).items
+    items = costs[crease]
+    own = set(needs) | ({"triangles"} if "gouraud" in needs else set())
+    derived = [items[k] for k in items if k in own]
+    skipped = [items[k] for k in items if k not in own]
+    return {"derive_ms": sum(ms for ms, _ in derived), "derive_bytes": sum(b for _, b in derived),
+            "skipped_ms": sum(ms for ms, _ in skipped), "skipped_bytes": sum(b for _, b in skipped)}
 
 
 if __name__ == "__main__":

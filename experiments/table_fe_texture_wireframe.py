@@ -41,16 +41,16 @@ from workbench.algo.hausdorff import hausdorff
 from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.compare import compare_images, wire_agreement
 from workbench.experiment.figures import save_image_grid
+from workbench.experiment.measure import measure
 from workbench.experiment.registry import experiment, main
 from workbench.experiment.tables import atomic_open, write_table
-from workbench.experiment.timing import time_draw
-from workbench.gl import Camera, Framebuffer, create_context, renderer
-from workbench.paths import Style, make_path
+from workbench.gl import Camera, create_context, renderer
+from workbench.paths import Style
 from workbench.scene import generators
 from workbench.scene.builtin import builtin_scene
 from workbench.scene.mesh import FEMesh
 
-VIEW = dict(azimuth=-35.0, elevation=25.0, up="z")
+VIEW = {"azimuth": -35.0, "elevation": 25.0, "up": "z"}
 WIRE = (0.0, 0.0, 0.0)
 OVERDRAW = "original + line overdraw"
 SHADED = "original, shaded"
@@ -78,19 +78,19 @@ def cases(quick: bool, say):
 
 
 def params_rows() -> list[dict]:
-    return [dict(set=name, alpha_g1_deg=p.alpha_g1_deg, d_mm=p.d, l_outer_mm=p.l_outer,
-                 l_inner_mm=p.l_inner) for name, p in PARAMETER_SETS.items()]
+    return [{"set": name, "alpha_g1_deg": p.alpha_g1_deg, "d_mm": p.d, "l_outer_mm": p.l_outer,
+             "l_inner_mm": p.l_inner} for name, p in PARAMETER_SETS.items()]
 
 
 def preprocessing_row(case: Case, model) -> dict:
-    row = dict(mesh=case.label, set=model.params.label, elements=model.n_elements,
-               patches=model.n_patches, subpatches=model.n_subpatches,
-               g0_edges=model.features["G0"], g1_edges=model.features["G1"],
-               closing_edges=model.features["closing"], line_nodes=model.line_nodes,
-               line_nodes_kept=model.line_nodes_kept, fallback_subpatches=len(model.fallback),
-               original_triangles=len(model.original.triangles),
-               simplified_triangles=len(model.simplified.triangles),
-               atlas=f"{model.atlas_size[0]}x{model.atlas_size[1]}")
+    row = {"mesh": case.label, "set": model.params.label, "elements": model.n_elements,
+           "patches": model.n_patches, "subpatches": model.n_subpatches,
+           "g0_edges": model.features["G0"], "g1_edges": model.features["G1"],
+           "closing_edges": model.features["closing"], "line_nodes": model.line_nodes,
+           "line_nodes_kept": model.line_nodes_kept, "fallback_subpatches": len(model.fallback),
+           "original_triangles": len(model.original.triangles),
+           "simplified_triangles": len(model.simplified.triangles),
+           "atlas": f"{model.atlas_size[0]}x{model.atlas_size[1]}"}
     for stage in STAGES:
         row[f"{stage} s"] = model.seconds[stage]
     row["total s"] = sum(model.seconds.values())
@@ -104,37 +104,25 @@ def simplification_error(case: Case, model) -> dict:
     diag = float(np.linalg.norm(hi - lo))
     h = hausdorff(orig.positions, orig.triangles, simp.positions, simp.triangles,
                   one_sided=True, tol=BRACKET_REL * diag)
-    return dict(hausdorff_mm=h.upper, hausdorff_lower_mm=h.lower,
-                hausdorff_pct_diag=100.0 * h.upper / diag, hausdorff_s=h.seconds,
-                within_d=bool(h.upper <= model.params.d))
+    return {"hausdorff_mm": h.upper, "hausdorff_lower_mm": h.lower,
+            "hausdorff_pct_diag": 100.0 * h.upper / diag, "hausdorff_s": h.seconds,
+            "within_d": bool(h.upper <= model.params.d)}
 
 
 class Drawer:
-    """Draws paths of one mesh with one camera and frame buffer, timing each."""
+    """What every draw of one mesh shares: the camera (fitted to the mesh at ``VIEW``), the
+    image size (W, H) and the timed repetitions; :meth:`draw` measures one path."""
 
     def __init__(self, ctx, mesh: FEMesh, size, repeat: int):
         self.ctx, self.mesh, self.size, self.repeat = ctx, mesh, size, repeat
         lo, hi = mesh.bounds()
         self.camera = Camera.fit_box(lo, hi, aspect=size[0] / size[1], **VIEW)
-        self.fb = Framebuffer(ctx, size)
 
-    def draw(self, name: str, style: Style, surface=None):
-        path = make_path(name, style)
-        if surface is not None:
-            path.surface = surface
-        path.prepare(self.ctx, self.mesh, self.camera)
-        try:
-            timing = time_draw(self.ctx, self.fb, path.draw, repeat=self.repeat)
-            self.fb.clear()
-            path.draw()
-            image = self.fb.read()
-            info = dict(triangles=path.triangles, line_edges=path.edges)
-        finally:
-            path.release()
-        return image, timing, info
-
-    def release(self) -> None:
-        self.fb.release()
+    def draw(self, name: str, style: Style, scene=None):
+        """The :class:`~workbench.experiment.measure.Measurement` of path ``name`` drawing
+        ``scene`` (default the mesh; or a TexturedSurface built by the caller)."""
+        return measure(self.ctx, self.mesh if scene is None else scene, name, style,
+                       camera=self.camera, size=self.size, repeats=self.repeat)
 
 
 def table_rows(case: Case, models: dict, drawer: Drawer, gl_renderer: str, say):
@@ -151,21 +139,20 @@ def table_rows(case: Case, models: dict, drawer: Drawer, gl_renderer: str, say):
     rows, images = [], {}
     for label, path_name, set_name, style in configs:
         model = models.get(set_name) if set_name else None
-        if model is not None:
+        if model is not None:  # the mesh's cached model of this set is drawn
             style = Style(fepatch=set_name, crease_deg=model.params.alpha_g1_deg, wire_color=WIRE)
-            surface = model.original if path_name == "fe_wire_texture" else model.simplified
-        else:
-            surface = None
-        image, timing, info = drawer.draw(path_name, style, surface)
-        images[label] = image
+        m = drawer.draw(path_name, style)
+        images[label] = m.image
         row = dict(renderer=gl_renderer, mesh=case.label, size=f"{drawer.size[0]}x{drawer.size[1]}",
-                   path=label, set=set_name or "", triangles=info["triangles"],
-                   line_edges=info["line_edges"], **timing.as_row())
+                   path=label, set=set_name or "", triangles=m.row["triangles"],
+                   line_edges=m.row["edges"], **m.timing.as_row())
         if model is not None:
+            surface = model.original if path_name == "fe_wire_texture" else model.simplified
             row.update(rgba_texels_per_element=model.rgba_texels_per_element,
                        texture_mb=surface.texture_bytes / 2**20)
         rows.append(row)
-        say(f"  {case.label} {label}: {info['triangles']} triangles, wall {timing.wall_ms:.1f} ms")
+        say(f"  {case.label} {label}: {m.row['triangles']} triangles, "
+            f"wall {m.timing.wall_ms:.1f} ms")
     by = {r["path"]: r for r in rows}
     base = by[OVERDRAW]
     for r in rows:
@@ -204,24 +191,26 @@ def sweep_configs(quick: bool) -> list[tuple[str, FEPatchParams, float]]:
 
 
 def sweep_rows(case: Case, drawer: Drawer, quick: bool, say) -> list[dict]:
-    overdraw_image, overdraw_timing, _ = drawer.draw(
-        "gouraud", Style(crease_deg=PARAMETER_SETS["A"].alpha_g1_deg, wireframe=True,
-                         wire_color=WIRE))
+    overdraw = drawer.draw("gouraud", Style(crease_deg=PARAMETER_SETS["A"].alpha_g1_deg,
+                                            wireframe=True, wire_color=WIRE))
     rows = []
     for label, params, texels in sweep_configs(quick):
+        # an atlas resolution of its own: built here, the simplified surface drawn as the scene
         model = build_model(case.mesh.elements, case.mesh.nodes, params, texels_per_edge=texels)
         style = Style(crease_deg=params.alpha_g1_deg, wire_color=WIRE)
-        image, timing, info = drawer.draw("fe_normal_wire", style, model.simplified)
+        m = drawer.draw("fe_normal_wire", style, model.simplified)
         row = dict(mesh=case.label, config=label, alpha_g1_deg=params.alpha_g1_deg, d_mm=params.d,
                    l_outer_mm=params.l_outer, l_inner_mm=params.l_inner,
-                   texels_per_edge=texels, triangles=info["triangles"],
-                   line_edges=info["line_edges"], preprocessing_s=sum(model.seconds.values()),
-                   wall_ms=timing.wall_ms, speed_vs_overdraw=overdraw_timing.wall_ms / timing.wall_ms,
+                   texels_per_edge=texels, triangles=m.row["triangles"],
+                   line_edges=m.row["edges"], preprocessing_s=sum(model.seconds.values()),
+                   wall_ms=m.timing.wall_ms,
+                   speed_vs_overdraw=overdraw.timing.wall_ms / m.timing.wall_ms,
                    rgba_texels_per_element=model.rgba_texels_per_element,
-                   **wire_agreement(image, overdraw_image, WIRE),
+                   **wire_agreement(m.image, overdraw.image, WIRE),
                    **simplification_error(case, model))
         rows.append(row)
-        say(f"  sweep {label}: {info['triangles']} triangles, speed x{row['speed_vs_overdraw']:.2f}, "
+        say(f"  sweep {label}: {m.row['triangles']} triangles, "
+            f"speed x{row['speed_vs_overdraw']:.2f}, "
             f"wire IoU {row['wire_iou_1px']:.3f}, Hausdorff {row['hausdorff_mm']:.3f} mm")
     return rows
 
@@ -270,34 +259,27 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
     for case in cases(quick, say):
         say(f"{case.label}: {case.mesh.n_elements} elements")
         models = {}
-        for name, params in PARAMETER_SETS.items():
-            models[name] = build_model(case.mesh.elements, case.mesh.nodes, params)
+        for name in PARAMETER_SETS:
+            models[name] = case.mesh.fepatch_model(name)  # derived once, cached by the mesh
             pre.append(preprocessing_row(case, models[name]))
             say(f"  set {name}: preprocessing {pre[-1]['total s']:.1f} s, "
                 f"{pre[-1]['simplified_triangles']} of {pre[-1]['original_triangles']} triangles")
         drawer = Drawer(ctx, case.mesh, size, repeat)
-        try:
-            mesh_rows, images = table_rows(case, models, drawer, gl_renderer, say)
-            rows += mesh_rows
-            if first:
-                h, w = size[1], size[0]
-                box = (h // 3, h // 3 + h // 3, w // 3, w // 3 + w // 3)
-                save_image_grid(out_dir / "crops.png",
-                                [crop(images[OVERDRAW], box),
-                                 crop(images["simplified A + normal map + wire texture"], box)],
-                                [f"{case.label}: original + line overdraw",
-                                 "simplified A + normal map + wire texture"])
-                first = False
-        finally:
-            drawer.release()
+        mesh_rows, images = table_rows(case, models, drawer, gl_renderer, say)
+        rows += mesh_rows
+        if first:
+            h, w = size[1], size[0]
+            box = (h // 3, h // 3 + h // 3, w // 3, w // 3 + w // 3)
+            save_image_grid(out_dir / "crops.png",
+                            [crop(images[OVERDRAW], box),
+                             crop(images["simplified A + normal map + wire texture"], box)],
+                            [f"{case.label}: original + line overdraw",
+                             "simplified A + normal map + wire texture"])
+            first = False
     sweep_case = next((c for c in cases(True, say) if c.label.startswith("car")), None)
     if sweep_case is not None:
         say(f"sweep on {sweep_case.label}")
-        drawer = Drawer(ctx, sweep_case.mesh, size, repeat)
-        try:
-            sweep = sweep_rows(sweep_case, drawer, quick, say)
-        finally:
-            drawer.release()
+        sweep = sweep_rows(sweep_case, Drawer(ctx, sweep_case.mesh, size, repeat), quick, say)
     write_table(pre, out_dir, "preprocessing", title="fe2003 Table 2: preprocessing seconds")
     write_table(rows, out_dir, "table3", columns=TABLE3,
                 title="fe2003 Table 3: time per frame against error (all columns: table.md)")

@@ -27,17 +27,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from workbench.algo.strips import quad_strips, tri_strips
 from workbench.data import CAR_DECK, D3PLOT, shared_file
-from workbench.experiment.compare import wire_agreement
+from workbench.experiment.compare import difference_map, wire_agreement
 from workbench.experiment.figures import save_image_grid
+from workbench.experiment.measure import measure
 from workbench.experiment.registry import experiment, main
 from workbench.experiment.tables import atomic_open, write_table
-from workbench.experiment.timing import time_call, time_draw
-from workbench.gl import Camera, Framebuffer, VertexShaderInvocations, create_context, renderer
-from workbench.paths import Style, make_path
+from workbench.experiment.timing import time_call
+from workbench.gl import Camera, VertexShaderInvocations, create_context, renderer
+from workbench.paths import Style
 from workbench.scene import generators
 from workbench.scene.builtin import builtin_scene
 
@@ -90,18 +89,19 @@ def stripping_row(model: Model, repeat: int) -> dict:
     tri = tri_strips(mesh.triangles, mesh.n_nodes)
     t_quad = time_call(lambda: quad_strips(mesh.elements), repeat=repeat)
     t_tri = time_call(lambda: tri_strips(mesh.triangles, mesh.n_nodes), repeat=repeat)
-    return dict(
-        mesh=model.label, kind=model.kind, elements=mesh.n_elements, quads=mesh.n_quads,
-        triangle_elements=len(quads.triangles), degenerate=len(quads.degenerate),
-        verts_4n=four_n,
-        tri_strips=tri.n_strips, tri_verts=tri.n_vertices, tri_verts_pct=100 * tri.n_vertices / four_n,
-        tri_length=tri.mean_triangles_per_strip, tri_strip_ms=t_tri.wall_ms,
-        quad_strips=quads.n_strips, quad_leftover=len(quads.leftover),
-        quad_verts=quads.vertex_count, quad_verts_pct=100 * quads.vertex_count / four_n,
-        quad_length=quads.mean_triangles_per_strip, quad_passes=quads.passes,
-        quad_strip_ms=t_quad.wall_ms,
-        quad_over_tri_verts=quads.vertex_count / tri.n_vertices,
-    )
+    return {
+        "mesh": model.label, "kind": model.kind, "elements": mesh.n_elements, "quads": mesh.n_quads,
+        "triangle_elements": len(quads.triangles), "degenerate": len(quads.degenerate),
+        "verts_4n": four_n,
+        "tri_strips": tri.n_strips, "tri_verts": tri.n_vertices,
+        "tri_verts_pct": 100 * tri.n_vertices / four_n,
+        "tri_length": tri.mean_triangles_per_strip, "tri_strip_ms": t_tri.wall_ms,
+        "quad_strips": quads.n_strips, "quad_leftover": len(quads.leftover),
+        "quad_verts": quads.vertex_count, "quad_verts_pct": 100 * quads.vertex_count / four_n,
+        "quad_length": quads.mean_triangles_per_strip, "quad_passes": quads.passes,
+        "quad_strip_ms": t_quad.wall_ms,
+        "quad_over_tri_verts": quads.vertex_count / tri.n_vertices,
+    }
 
 
 def paper_rows(rows: list[dict]) -> list[dict]:
@@ -133,12 +133,12 @@ def cutoff_rows(model: Model, cutoffs) -> list[dict]:
     rows = []
     for cutoff in cutoffs:
         quads = quad_strips(mesh.elements, cutoff)
-        t = time_call(lambda: quad_strips(mesh.elements, cutoff), warmup=0, repeat=5)
-        rows.append(dict(mesh=model.label, cutoff=cutoff, strips=quads.n_strips,
-                         leftover_quads=len(quads.leftover), verts=quads.vertex_count,
-                         verts_pct=100 * quads.vertex_count / four_n,
-                         length=quads.mean_triangles_per_strip, passes=quads.passes,
-                         strip_ms=t.wall_ms, meshopt_verts_pct=100 * tri.n_vertices / four_n))
+        t = time_call(lambda c=cutoff: quad_strips(mesh.elements, c), warmup=0, repeat=5)
+        rows.append({"mesh": model.label, "cutoff": cutoff, "strips": quads.n_strips,
+                     "leftover_quads": len(quads.leftover), "verts": quads.vertex_count,
+                     "verts_pct": 100 * quads.vertex_count / four_n,
+                     "length": quads.mean_triangles_per_strip, "passes": quads.passes,
+                     "strip_ms": t.wall_ms, "meshopt_verts_pct": 100 * tri.n_vertices / four_n})
     return rows
 
 
@@ -175,53 +175,56 @@ def save_cutoff_figure(path: Path, rows: list[dict]) -> None:
 
 DRAW_CONFIGS = (
     # row label, path, style keywords, baseline row for the pixel comparison
-    ("list, shorter diagonal", "gouraud", dict(), None),
-    ("list, strip diagonal", "gouraud", dict(quad_diagonal="strip"), None),
-    ("meshopt triangle strips", "gouraud", dict(strips="triangle", quad_diagonal="strip"),
+    ("list, shorter diagonal", "gouraud", {}, None),
+    ("list, strip diagonal", "gouraud", {"quad_diagonal": "strip"}, None),
+    ("meshopt triangle strips", "gouraud", {"strips": "triangle", "quad_diagonal": "strip"},
      "list, strip diagonal"),
-    ("quad strips", "gouraud", dict(strips="quad"), "list, strip diagonal"),
-    ("list + line-overdraw wire", "gouraud", dict(quad_diagonal="strip", wireframe=True), None),
-    ("quad_wire (single pass)", "quad_wire", dict(), None),
+    ("quad strips", "gouraud", {"strips": "quad"}, "list, strip diagonal"),
+    ("list + line-overdraw wire", "gouraud", {"quad_diagonal": "strip", "wireframe": True}, None),
+    ("quad_wire (single pass)", "quad_wire", {}, None),
 )
+
+
+def vertex_shader_invocations(ctx):
+    """A :func:`measure` probe: ``vs_invocations``, the vertex-shader invocations of one more
+    draw of the prepared path (pipeline statistics query), None where the context has none."""
+    def probe(path) -> dict:
+        if not VertexShaderInvocations.supported(ctx):
+            return {"vs_invocations": None}
+        counter = VertexShaderInvocations(ctx)
+        try:
+            with counter:
+                path.draw()
+            return {"vs_invocations": counter.invocations}
+        finally:
+            counter.release()
+    return probe
 
 
 def draw_rows(ctx, model: Model, size, repeat: int, say) -> tuple[list[dict], dict]:
     mesh = model.mesh
     lo, hi = mesh.bounds()
-    view = dict(azimuth=-35.0, elevation=25.0, up="z")
+    view = {"azimuth": -35.0, "elevation": 25.0, "up": "z"}
     camera = Camera.fit_box(lo, hi, aspect=size[0] / size[1], **view)
-    fb = Framebuffer(ctx, size)
-    counter = VertexShaderInvocations(ctx) if VertexShaderInvocations.supported(ctx) else None
     gl_renderer = renderer(ctx)
     rows, images = [], {}
     for label, name, kw, baseline in DRAW_CONFIGS:
         style = Style(**kw)
-        path = make_path(name, style)
-        path.prepare(ctx, mesh, camera)
-        timing = time_draw(ctx, fb, path.draw, repeat=repeat)
-        fb.clear()
-        invocations = None
-        if counter is not None:
-            with counter:
-                path.draw()
-            invocations = counter.invocations
-        images[label] = image = fb.read()
+        m = measure(ctx, mesh, name, style, camera=camera, size=size, repeats=repeat,
+                    probe=vertex_shader_invocations(ctx))
+        images[label] = image = m.image
         row = dict(renderer=gl_renderer, mesh=model.label, size=f"{size[0]}x{size[1]}", path=label,
-                   path_name=name, parameters=style.summary(), triangles=path.triangles,
-                   vertices=path.vertices, vertices_sent=path.vertices_sent, strips=path.strips,
-                   vs_invocations=invocations, bytes_per_step=path.bytes_per_step,
-                   **timing.as_row())
+                   path_name=name, parameters=style.summary(), triangles=m.row["triangles"],
+                   vertices=m.row["vertices"], vertices_sent=m.row["vertices_sent"],
+                   strips=m.row["strips"], vs_invocations=m.row["vs_invocations"],
+                   bytes_per_step=m.row["bytes_per_step"], **m.timing.as_row())
         if baseline is not None:
-            diff = np.abs(image.astype(np.int16) - images[baseline].astype(np.int16)).max(axis=-1)
+            diff = difference_map(image, images[baseline])
             row.update(baseline=baseline, pixels_differing=int((diff > 0).sum()),
                        max_diff_255=int(diff.max()))
         rows.append(row)
-        path.release()
-        say(f"  {model.label} {size[0]}x{size[1]} {label}: wall {timing.wall_ms:.1f} ms, "
-            f"{path.vertices_sent} vertices sent")
-    if counter is not None:
-        counter.release()
-    fb.release()
+        say(f"  {model.label} {size[0]}x{size[1]} {label}: wall {m.timing.wall_ms:.1f} ms, "
+            f"{m.row['vertices_sent']} vertices sent")
     by = {r["path"]: r for r in rows}
     base = by["list, strip diagonal"]
     for r in rows:

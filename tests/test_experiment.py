@@ -14,7 +14,9 @@ from workbench.experiment import (EXPERIMENTS, PyrenderReference, Timing, atomic
                                   save_image_grid, save_png, time_call, time_draw, write_table)
 from workbench.experiment import tables as tables_module
 from workbench.experiment.figures import MIN_PANEL_HEIGHT
+from workbench.experiment.measure import measure
 from workbench.gl import Camera, Framebuffer, create_context
+from workbench.paths import RenderPath
 
 # the workbench paths' lighting: colour · (0.25 + 0.75 |n·l|), headlight along the view direction
 VERT = """#version 330
@@ -42,28 +44,54 @@ def ctx():
     return create_context()
 
 
-class QuadDraw:
-    """A lit quad as a tiny render path: GL objects made once, ``draw()`` into the bound target."""
+class QuadDraw(RenderPath):
+    """A lit quad as a tiny render path, kept out of the registry: ``prepare(ctx, (corners,
+    normals), camera)`` makes the GL objects once, ``draw()`` draws into the bound target."""
 
-    def __init__(self, ctx, camera, corners, normals):
+    needs = frozenset()
+
+    def __init__(self):
+        super().__init__()
+        self.name = "test quad"
+        self._objects = []
+
+    def prepare(self, ctx, scene, camera):
+        corners, normals = scene
+        self.ctx = ctx
         self.prog = ctx.program(vertex_shader=VERT, fragment_shader=FRAG)
-        self.prog["mvp"].write(camera.mvp_bytes())
-        light = np.asarray(camera.eye) - np.asarray(camera.target)
-        self.prog["light"].value = tuple(light / np.linalg.norm(light))
+        self.set_camera(camera)
         self.prog["base"].value = BASE
         order = [0, 1, 2, 0, 2, 3]
         data = np.c_[camera.relative(corners)[order], np.asarray(normals, np.float32)[order]]
         self.vbo = ctx.buffer(data.astype(np.float32).tobytes())
         self.vao = ctx.vertex_array(self.prog, [(self.vbo, "3f 3f", "position", "normal")])
-        self.ctx = ctx
+        self._objects = [self.vao, self.vbo, self.prog]
+        self.triangles, self.vertices, self.vertices_sent = 2, 6, 6
+        self.bytes_uploaded = data.nbytes
+
+    def set_camera(self, camera):
+        self.prog["mvp"].write(camera.mvp_bytes())
+        light = np.asarray(camera.eye) - np.asarray(camera.target)
+        self.prog["light"].value = tuple(light / np.linalg.norm(light))
+
+    def set_step(self, step):
+        return 0
 
     def draw(self):
         self.ctx.disable(self.ctx.CULL_FACE)
         self.vao.render()
 
     def release(self):
-        for obj in (self.vao, self.vbo, self.prog):
+        for obj in self._objects:
             obj.release()
+        self._objects = []
+
+
+def quad_path(ctx, camera, corners, normals) -> QuadDraw:
+    """A prepared :class:`QuadDraw` of the quad."""
+    path = QuadDraw()
+    path.prepare(ctx, (corners, normals), camera)
+    return path
 
 
 def quad(offset=0.0):
@@ -243,7 +271,7 @@ def test_atomic_write_text_replaces(tmp_path):
 def test_time_draw_reports_ordered_statistics(ctx):
     o, corners, normals = quad()
     camera = Camera.fit(o, 1.0, margin=1.0, aspect=64 / 48)
-    path = QuadDraw(ctx, camera, corners, normals)
+    path = quad_path(ctx, camera, corners, normals)
     fb = Framebuffer(ctx, (64, 48))
     calls = []
 
@@ -414,14 +442,9 @@ def test_image_grid_places_panels_side_by_side(tmp_path):
 
 
 def render_ours(ctx, camera, corners, normals, size):
-    path = QuadDraw(ctx, camera, corners, normals)
-    fb = Framebuffer(ctx, size)
-    fb.clear()
-    path.draw()
-    image = fb.read()
-    path.release()
-    fb.release()
-    return image
+    """(H, W, 4) uint8 image of one untimed draw of the quad on white."""
+    return measure(ctx, (corners, normals), QuadDraw(), camera=camera, size=size,
+                   timed=False).image
 
 
 @pytest.mark.parametrize("offset", [0.0, 1e6])
@@ -430,7 +453,7 @@ def test_pyrender_matches_our_camera_and_lighting(ctx, offset):
     o, corners, normals = quad(offset)
     camera = Camera.fit(o, 1.0, margin=1.0, aspect=64 / 48)
     # GL objects of the caller made before pyrender runs: they must still draw afterwards
-    path = QuadDraw(ctx, camera, corners, normals)
+    path = quad_path(ctx, camera, corners, normals)
     fb = Framebuffer(ctx, size)
 
     with PyrenderReference(corners, [[0, 1, 2], [0, 2, 3]], normals, camera, size,

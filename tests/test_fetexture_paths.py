@@ -16,7 +16,8 @@ import pytest
 import workbench.paths.fetexture  # noqa: F401  (registers the paths)
 from workbench.algo.fepatch.normalmap import decode_normals, encode_normals
 from workbench.algo.fepatch.surface import TexturedSurface
-from workbench.gl import Camera, Framebuffer
+from workbench.experiment.measure import measure
+from workbench.gl import Camera
 from workbench.paths import PATHS, Style, make_path
 from workbench.scene.mesh import FEMesh
 
@@ -107,19 +108,12 @@ def camera(centre=FAR, **kw):
     return Camera.fit(np.asarray(centre, np.float64), 1.0, margin=1.0, **kw)
 
 
-def draw(ctx, name, surf, cam, mesh=None, **style):
-    """(image, path) of one path drawing ``surf`` on white; the path is released."""
+def draw(ctx, name, surf, cam, **style):
+    """(image, path) of one path drawing the surface ``surf`` once on white, untimed; the path
+    is released."""
     style = {"wire_color": WIRE, **style}
-    fb = Framebuffer(ctx, (SIZE, SIZE))
-    path = make_path(name, Style(**style))
-    path.surface = surf
-    path.prepare(ctx, mesh, cam)
-    fb.clear()
-    path.draw()
-    image = fb.read()
-    path.release()
-    fb.release()
-    return image, path
+    m = measure(ctx, surf, name, Style(**style), camera=cam, size=(SIZE, SIZE), timed=False)
+    return m.image, m.path
 
 
 def is_wire(image):
@@ -172,11 +166,11 @@ def edge_points():
 # --------------------------------------------------------------------------- tests
 def test_registry_and_refusals(ctx):
     for name in NAMES:
-        assert PATHS[name].needs == frozenset({"triangles"})
-        assert make_path(name).surface is None
+        assert PATHS[name].needs == frozenset({"fepatch"})
+        assert not hasattr(make_path(name), "surface")
     surf, cam = surface(), camera()
-    for style, match in ((dict(step=1), "step 0"), (dict(wireframe=True), "wireframe"),
-                         (dict(strips="triangle"), "strips")):
+    for style, match in (({"step": 1}, "step 0"), ({"wireframe": True}, "wireframe"),
+                         ({"strips": "triangle"}, "strips")):
         with pytest.raises(ValueError, match=match):
             draw(ctx, "fe_normal_map", surf, cam, **style)
     with pytest.raises(ValueError, match="no wire_map"):
@@ -185,9 +179,10 @@ def test_registry_and_refusals(ctx):
     no_normals.normals = None
     with pytest.raises(ValueError, match="no normals"):
         draw(ctx, "fe_wire_texture", no_normals, cam)
+    with pytest.raises(ValueError, match="FE mesh or a TexturedSurface"):
+        make_path("fe_normal_map").prepare(ctx, None, cam)
     path = make_path("fe_normal_map")
-    path.surface = surf
-    path.prepare(ctx, None, cam)
+    path.prepare(ctx, surf, cam)
     with pytest.raises(ValueError, match="step 0"):
         path.set_step(1)
     with pytest.raises(ValueError, match="origin"):
@@ -264,15 +259,9 @@ def test_wire_texture_matches_gouraud(ctx, projection):
                            uv=grid_uv()[vertex], normal_axis=np.full(len(vertex), 2),
                            normals=split.normals(mesh.nodes), wire_map=base.wire_map)
     cam = camera(centre, azimuth=30.0, elevation=25.0, projection=projection)
-    ours, _ = draw(ctx, "fe_wire_texture", surf, cam, mesh)
-    fb = Framebuffer(ctx, (SIZE, SIZE))
-    path = make_path("gouraud", Style())
-    path.prepare(ctx, mesh, cam)
-    fb.clear()
-    path.draw()
-    reference = fb.read()
-    path.release()
-    fb.release()
+    ours, _ = draw(ctx, "fe_wire_texture", surf, cam)
+    reference = measure(ctx, mesh, "gouraud", Style(), camera=cam, size=(SIZE, SIZE),
+                        timed=False).image
     wire = is_wire(ours)
     assert wire.sum() > 200
     assert np.array_equal(covered(ours), covered(reference))

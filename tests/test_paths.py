@@ -9,11 +9,11 @@ A surface facing the camera has |n·l| = 1, so its lit colour equals its unlit c
 import moderngl
 import numpy as np
 import pytest
-
-from workbench.gl import Camera, Framebuffer
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from workbench.experiment.measure import measure
+from workbench.gl import Camera, Framebuffer
 from workbench.paths import PATHS, ColorScale, MeshPath, Style, colormap_lut, make_path, scale_for
 from workbench.paths.fields import provoking_vertices
 from workbench.scene.mesh import FEMesh
@@ -47,16 +47,9 @@ def camera(centre=(0.0, 0.0, 0.0), **kw):
 
 
 def render(ctx, name, mesh, cam, size=SIZE, **style):
-    """(image, path) of one path drawn on white; the path is released."""
-    fb = Framebuffer(ctx, (size, size))
-    path = make_path(name, Style(**style))
-    path.prepare(ctx, mesh, cam)
-    fb.clear()
-    path.draw()
-    image = fb.read()
-    path.release()
-    fb.release()
-    return image, path
+    """(image, path) of one path drawn once on white, untimed; the path is released."""
+    m = measure(ctx, mesh, name, Style(**style), camera=cam, size=(size, size), timed=False)
+    return m.image, m.path
 
 
 def covered(image):
@@ -77,14 +70,14 @@ def colors(image, mask):
 def test_registry_and_bad_names():
     assert set(PATHS) == {"position", "flat", "gouraud", "vertex_color", "pixel_color",
                           "element_color", "quad_wire", "fe_wire_texture", "fe_normal_map",
-                          "fe_normal_wire"}
+                          "fe_normal_wire", "spacetime_vertex", "spacetime_pixel"}
     assert MESH_PATHS == sorted(set(PATHS) - {"fe_wire_texture", "fe_normal_map",
-                                              "fe_normal_wire"})
+                                              "fe_normal_wire", "spacetime_vertex",
+                                              "spacetime_pixel"})
     with pytest.raises(ValueError, match="known paths"):
         make_path("phong")
-    for name, cls in PATHS.items():
-        assert cls.needs <= {"triangles", "face_normals", "gouraud", "edges", "node_field",
-                             "element_field"}
+    for cls in PATHS.values():
+        assert cls.needs <= {"triangles", "edges", "gouraud", "fepatch"}
     assert "edges" in make_path("flat", Style(wireframe=True)).needs
     assert "edges" not in make_path("flat").needs
     assert make_path("position").needs == {"triangles"}

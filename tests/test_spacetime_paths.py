@@ -9,9 +9,11 @@ from workbench.algo.spacetime.fields import BAR, STEEL
 from workbench.algo.spacetime.poly import evaluate
 from workbench.algo.spacetime.raster import PixelGrid
 from workbench.experiment.compare import crack_pixels
-from workbench.gl import Camera, Framebuffer
+from workbench.experiment.measure import measure
+from workbench.gl import Camera
+from workbench.paths import PATHS, make_path
 from workbench.paths.colormap import colormap_lut
-from workbench.paths.spacetime import SpacetimePath, SpacetimeScene, SpacetimeStyle, top_camera
+from workbench.paths.spacetime import SpacetimeScene, SpacetimeStyle, spacetime_path, top_camera
 
 U_MAX = 300.0
 SIZE = 96
@@ -47,17 +49,9 @@ def _scene(n=4, offset=(0.0, 0.0), seed=0, t=3.0, moving=True, scale=1.0):
 
 
 def _render(ctx, scene, style, camera, size, background=(1.0, 1.0, 1.0, 1.0)):
-    path = SpacetimePath(style)
-    fb = Framebuffer(ctx, size)
-    try:
-        path.prepare(ctx, scene, camera)
-        fb.use()
-        fb.clear(background)
-        path.draw()
-        return fb.read()
-    finally:
-        path.release()
-        fb.release()
+    """(H, W, 4) uint8 image of one untimed draw of the path for ``style.shading``."""
+    return measure(ctx, scene, spacetime_path(style), camera=camera, size=size,
+                   background=background, timed=False).image
 
 
 def _exact(scene, grid, lighting=True, height_scale=20.0):
@@ -211,6 +205,16 @@ def test_scene_and_style_refusals():
                          STEEL.lam, STEEL.mu, t=1.0)
     with pytest.raises(ValueError, match="finite"):
         bad.check()
+
+
+def test_spacetime_path_is_the_registered_path_of_the_shading():
+    for shading, name in (("per_vertex", "spacetime_vertex"), ("per_pixel", "spacetime_pixel")):
+        path = spacetime_path(SpacetimeStyle(shading=shading, U_max=U_MAX))
+        assert type(path) is PATHS[name] and path.style.shading == shading
+        assert path.style.U_max == U_MAX
+    # a registered path fixes its shading whatever the style says
+    assert make_path("spacetime_vertex", SpacetimeStyle()).style.shading == "per_vertex"
+    assert spacetime_path().name == "spacetime_pixel"
 
 
 def test_overdraw_behind_keeps_the_near_and_far_planes(ctx):

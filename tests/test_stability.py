@@ -5,8 +5,9 @@ import pytest
 
 from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.compare import compare_images
-from workbench.gl import Camera, Framebuffer, create_context
-from workbench.paths import Style, make_path
+from workbench.experiment.measure import measure
+from workbench.gl import Camera, create_context
+from workbench.paths import Style
 from workbench.scene import load
 
 SIZE = (320, 200)
@@ -26,17 +27,10 @@ def ctx():
 
 
 def render(ctx, mesh, path_name, style):
+    """(H, W, 4) uint8 image of one untimed draw of the whole mesh on white."""
     center, radius = mesh.bounding_sphere()
     camera = Camera.fit(center, radius, azimuth=-35, elevation=20, up="z", aspect=SIZE[0] / SIZE[1])
-    fb = Framebuffer(ctx, SIZE)
-    path = make_path(path_name, style)
-    path.prepare(ctx, mesh, camera)
-    fb.clear()
-    path.draw()
-    image = fb.read()
-    path.release()
-    fb.release()
-    return image
+    return measure(ctx, mesh, path_name, style, camera=camera, size=SIZE, timed=False).image
 
 
 @pytest.mark.parametrize("path_name, style", [

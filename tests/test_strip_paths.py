@@ -7,13 +7,13 @@ import moderngl
 import numpy as np
 import pytest
 from skimage.morphology import dilation, footprint_rectangle
+from test_paths import render
 
 from workbench.algo.strips import quad_strips
+from workbench.experiment.measure import measure
 from workbench.gl import Camera, Framebuffer, VertexShaderInvocations
 from workbench.paths import Style, make_path
 from workbench.scene.mesh import FEMesh
-
-from test_paths import render
 
 BACKGROUND = np.array([255, 255, 255, 255], np.uint8)
 SHADED = {"position": None, "flat": None, "gouraud": None, "pixel_color": "h",
@@ -54,7 +54,7 @@ draw = functools.partial(render, size=160)
 @pytest.mark.parametrize("name", sorted(SHADED))
 def test_quad_strips_draw_the_unstripped_image_pixel_for_pixel(ctx, name):
     mesh, cam = scene_with_defects(), oblique()
-    kw = dict(field=SHADED[name], bands=7 if name == "vertex_color" else 0)
+    kw = {"field": SHADED[name], "bands": 7 if name == "vertex_color" else 0}
     listed, flat_list = draw(ctx, name, mesh, cam, quad_diagonal="strip", **kw)
     stripped, strip_path = draw(ctx, name, mesh, cam, strips="quad", **kw)
     assert (listed != BACKGROUND).any(axis=-1).sum() > 4000
@@ -68,7 +68,7 @@ def test_triangle_strips_draw_the_same_triangles(ctx, name):
     # meshoptimizer may start a triangle at another of its corners, which can move a rounding
     # in the interpolation: at most 1/255 on a few pixels
     mesh, cam = scene_with_defects(), oblique()
-    kw = dict(field=SHADED[name], bands=7 if name == "vertex_color" else 0)
+    kw = {"field": SHADED[name], "bands": 7 if name == "vertex_color" else 0}
     listed, _ = draw(ctx, name, mesh, cam, quad_diagonal="strip", **kw)
     stripped, path = draw(ctx, name, mesh, cam, strips="triangle", quad_diagonal="strip", **kw)
     same_cover = (listed != BACKGROUND).any(-1) == (stripped != BACKGROUND).any(-1)
@@ -92,17 +92,11 @@ def test_triangle_strips_equal_their_own_triangles_listed(ctx, name):
             return unstripify(tri_strips(listed, n_vertices).indices)
 
     mesh, cam = scene_with_defects(), oblique()
-    kw = dict(field=SHADED[name], bands=7 if name == "vertex_color" else 0,
-              quad_diagonal="strip")
+    kw = {"field": SHADED[name], "bands": 7 if name == "vertex_color" else 0,
+          "quad_diagonal": "strip"}
     stripped, _ = draw(ctx, name, mesh, cam, size=240, strips="triangle", **kw)
-    fb = Framebuffer(ctx, (240, 240))
-    path = StripOrderList(Style(**kw))
-    path.prepare(ctx, mesh, cam)
-    fb.clear()
-    path.draw()
-    listed = fb.read()
-    path.release()
-    fb.release()
+    listed = measure(ctx, mesh, StripOrderList(Style(**kw)), camera=cam, size=(240, 240),
+                     timed=False).image
     assert (listed != BACKGROUND).any(axis=-1).sum() > 10000
     assert stripped.tobytes() == listed.tobytes()
 

@@ -94,6 +94,24 @@ def compare_images(a, b, mask=None) -> ImageDiff:
                      ssim=ssim)
 
 
+def compare_drawn(image, reference, background=(1.0, 1.0, 1.0, 1.0)) -> ImageDiff:
+    """:func:`compare_images` of ``image`` against ``reference`` over the pixels either draws
+    (differs from ``background``, as in :func:`coverage`): a background both leave empty does
+    not count towards the statistics."""
+    mask = coverage(image, background) | coverage(reference, background)
+    return compare_images(reference, image, mask=mask)
+
+
+def difference_image(a, b, gain: int = 8) -> np.ndarray:
+    """(H, W, 4) uint8 opaque grey picture of how ``a`` and ``b`` differ in RGB: white where
+    they agree, darker by ``gain`` grey levels per 1/255 of the largest channel difference
+    (black from 255 / ``gain`` on)."""
+    a, b = _check_image(a, "a"), _check_image(b, "b")
+    diff = difference_map(a[..., :3], b[..., :3]).astype(np.int32)
+    grey = (255 - np.clip(diff * int(gain), 0, 255)).astype(np.uint8)
+    return np.dstack([grey, grey, grey, np.full_like(grey, 255)])
+
+
 def _background_bytes(background) -> np.ndarray:
     bg = np.asarray(background)
     if bg.ndim != 1 or bg.shape[0] not in (3, 4):
