@@ -1,4 +1,4 @@
-"""The ``workbench`` command: info, render, list, run and reproduce.
+"""The ``workbench`` command: info, render, hausdorff, simplify, list, run, reproduce and sweep.
 
 Bad input (an unreadable or malformed mesh file, an empty mesh, a missing OpenGL driver, an
 unknown name) ends with a one-line message on stderr and exit status 2, never a traceback (set WORKBENCH_DEBUG=1 to see one).
@@ -321,6 +321,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_true", help="small sizes and few repetitions")
     p.add_argument("--figures", default="figures", help="output folder (default figures/)")
     p.set_defaults(func=cmd_reproduce)
+
+    from .experiment.sweep import add_sweep_parser
+
+    add_sweep_parser(sub)
     return parser
 
 

@@ -444,6 +444,8 @@ class MeshPath(GLPath):
 
     # ------------------------------------------------------------------ prepare
     def _check_scene(self, mesh) -> None:
+        if not hasattr(mesh, "n_steps") or not hasattr(mesh, "elements"):
+            raise ValueError(f"path {self.name!r} draws an FE mesh, got {type(mesh).__name__}")
         style = self.style
         for label in ("step", "reference_step"):
             if getattr(style, label) >= mesh.n_steps:

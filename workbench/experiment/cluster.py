@@ -1,0 +1,191 @@
+"""The Dask cluster a sweep runs on, the GL context each worker keeps, and the per-host draw lock.
+
+:func:`sweep_cluster` starts a :class:`~distributed.LocalCluster` of worker processes on this
+machine (one thread each) or connects to an existing scheduler, registers
+:class:`GLContextPlugin` (every worker creates one headless EGL context, in the thread its tasks
+run on, and reuses it for every task) and closes what it started on the way out, also on
+KeyboardInterrupt. A task reaches its worker's context with :func:`worker_context`.
+
+Timed draws disturb each other, so a task holds :func:`draw_lock` (one
+:class:`distributed.Lock` per host name, held through the scheduler) around its timed
+measurement; error-only work takes no lock and runs in parallel.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import os
+import socket
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+import dask
+from distributed import Client, LocalCluster, Lock, WorkerPlugin, get_worker
+
+PLUGIN_NAME = "workbench-gl"
+CONNECT_TIMEOUT_S = 30
+WORKER_WAIT_S = 60
+
+
+class GLContextPlugin(WorkerPlugin):
+    """Gives a worker one EGL context per task thread (one in all with ``threads_per_worker=1``).
+
+    An EGL context is current in the thread that created it only, so :meth:`setup` creates the
+    first one in the worker's task executor; a worker running tasks in more threads gets one
+    more context per thread, on first use. ``renderer`` is the renderer string of the first
+    context. A worker without EGL fails :meth:`setup` with
+    :class:`~workbench.gl.GLUnavailable`.
+    """
+
+    name = PLUGIN_NAME
+
+    def __init__(self) -> None:
+        self.renderer: str | None = None
+        self._contexts: dict[int, object] = {}
+
+    async def setup(self, worker) -> None:
+        _import_in_main_thread()
+        executor = worker.executors.get("default")
+        await asyncio.get_running_loop().run_in_executor(executor, self._start)
+
+    def _start(self) -> None:
+        """Create the first context and import what every point uses, so that the first
+        point's time is not spent importing."""
+        self.context()
+        from skimage.metrics import structural_similarity  # noqa: F401
+
+        from .. import paths  # noqa: F401  (registers every path)
+        from . import compare, measure, sweep_points  # noqa: F401
+
+    def context(self):
+        """The moderngl context of the calling thread, created on first use."""
+        thread = threading.get_ident()
+        ctx = self._contexts.get(thread)
+        if ctx is None:
+            from ..gl import create_context, renderer
+
+            ctx = create_context()
+            self._contexts[thread] = ctx
+            if self.renderer is None:
+                self.renderer = renderer(ctx)
+        return ctx
+
+    def teardown(self, worker) -> None:
+        self._contexts.clear()  # the process exits with its contexts; releasing needs their threads
+
+
+def _import_in_main_thread() -> None:
+    """Import the libraries that must first be imported in a process's main thread (the
+    worker's event loop runs there; tasks run in executor threads). pymeshlab imported first
+    in another thread makes the process abort at exit (glibc: "malloc_consolidate(): unaligned
+    fastbin chunk detected")."""
+    if threading.current_thread() is not threading.main_thread():
+        return
+    try:
+        import pymeshlab  # noqa: F401
+    except ImportError:
+        pass
+
+
+def worker_context():
+    """The GL context of the worker running the calling task (RuntimeError elsewhere)."""
+    try:
+        plugin = get_worker().plugins[PLUGIN_NAME]
+    except (ValueError, KeyError):
+        raise RuntimeError("no workbench GL context: not running on a sweep worker") from None
+    return plugin.context()
+
+
+def _worker_renderer(dask_worker) -> str | None:
+    plugin = dask_worker.plugins.get(PLUGIN_NAME)
+    return None if plugin is None else plugin.renderer
+
+
+def draw_lock_name(host: str | None = None) -> str:
+    """The name of the lock serializing timed draws on ``host`` (default this machine)."""
+    return f"workbench-draw-{host or socket.gethostname()}"
+
+
+@contextmanager
+def draw_lock() -> Iterator[None]:
+    """Hold this host's draw lock for the block (inside a task on a sweep worker)."""
+    lock = Lock(draw_lock_name())
+    lock.acquire()
+    try:
+        yield
+    finally:
+        lock.release()
+
+
+@dataclass
+class SweepCluster:
+    """A connected client, the number of workers it found, and the renderer they draw with."""
+
+    client: Client
+    workers: int
+    renderer: str
+    address: str
+
+
+def _renderer_of(client: Client) -> str:
+    """The one renderer string every worker reports; ValueError when they differ (times drawn
+    on different renderers are not comparable, nor are their cache keys)."""
+    found = client.run(_worker_renderer)
+    names = sorted({r for r in found.values() if r is not None})
+    if len(names) != 1:
+        raise ValueError(f"the cluster's workers report renderers {names or ['(none)']}; "
+                         f"a sweep needs workers on one renderer")
+    return names[0]
+
+
+@contextmanager
+def sweep_cluster(workers: int | None = None, scheduler: str | None = None, *,
+                  raster_threads: int | None = None) -> Iterator[SweepCluster]:
+    """A :class:`SweepCluster`: a new LocalCluster of ``workers`` processes (default
+    ``os.cpu_count()``, one thread each), or the cluster at ``scheduler``
+    (``tcp://host:port``), with :class:`GLContextPlugin` registered on every worker.
+
+    ``raster_threads`` sets llvmpipe's rasterizer threads (``LP_NUM_THREADS``) in the local
+    workers, unless the environment sets it already: 1 suits error-only sweeps, whose workers
+    fill the cores by themselves; None leaves llvmpipe one thread per core, as timed draws
+    (one at a time per host) want.
+
+    Everything started here is closed on the way out. Refused: ``workers`` < 1 and ``workers``
+    together with ``scheduler`` (ValueError), a scheduler that cannot be reached or has no
+    workers within a minute (OSError).
+    """
+    if scheduler is not None and workers is not None:
+        raise ValueError("--workers sizes a local cluster; an existing scheduler keeps its workers")
+    if workers is not None and (int(workers) != workers or workers < 1):
+        raise ValueError(f"workers must be a positive integer, got {workers}")
+    cluster = client = None
+    try:
+        if scheduler is None:
+            # the statistical profiler samples every task thread's stack every 10 ms, holding
+            # the GIL: it would slow down and disturb what the workers time
+            env = {}
+            if raster_threads is not None and "LP_NUM_THREADS" not in os.environ:
+                env["LP_NUM_THREADS"] = str(int(raster_threads))
+            with dask.config.set({"distributed.worker.profile.enabled": False}):
+                cluster = LocalCluster(n_workers=int(workers or os.cpu_count() or 1),
+                                       processes=True, threads_per_worker=1,
+                                       dashboard_address=None, silence_logs=logging.CRITICAL,
+                                       env=env)
+            client = Client(cluster)
+        else:
+            try:
+                client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+                client.wait_for_workers(1, timeout=WORKER_WAIT_S)
+            except TimeoutError as exc:
+                raise OSError(f"scheduler {scheduler}: {exc or 'no workers'}") from None
+        client.register_plugin(GLContextPlugin(), name=PLUGIN_NAME)
+        count = len(client.scheduler_info(n_workers=-1)["workers"])
+        yield SweepCluster(client, count, _renderer_of(client), client.scheduler.address)
+    finally:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
