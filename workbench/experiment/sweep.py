@@ -17,9 +17,9 @@ A config::
 
 Grid keys: ``scene`` (a built-in scene name or a mesh file), ``path`` (registry names),
 ``size`` ("WxH" pixels, default 400x300), ``samples`` (MSAA), ``view`` ([azimuth, elevation]
-in degrees, default [30, 25]), ``simplifier`` and ``tolerance`` (see below), and any option of
-the grid's paths (the fields of their style class: ``bands``, ``field``, ``wireframe``,
-``strips``, ``clip_planes``, ``fepatch``, ``edge_overdraw`` …). The sweep runs the Cartesian
+in degrees, default [30, 25]), ``simplifier``, ``tolerance`` and ``quadrisection`` (see below),
+and any option of the grid's paths (the fields of their style class: ``bands``, ``field``,
+``wireframe``, ``strips``, ``clip_planes``, ``fepatch``, ``edge_overdraw`` …). The sweep runs the Cartesian
 product in the order the keys are written, the last key varying fastest. A key that no path of
 the grid takes is refused before anything runs.
 
@@ -36,7 +36,11 @@ value when written as such; a list of them sweeps them.
 :mod:`workbench.experiment.simplifiers` ("pymeshlab quadric", "open3d quadric",
 "meshoptimizer simplify", "libigl qslim", "libigl decimate") or "none";
 ``tolerance`` is in % of each part's bounding-sphere diameter (default 0.5), and the reference
-simplifiers aim at the triangle count ours reaches at that tolerance. Such a point simplifies
+simplifiers aim at the triangle count ours reaches at that tolerance.
+
+**Quadrisection** (st2005 §4.2): ``quadrisection`` splits a spacetime scene's polygons down to
+that fraction of their mean area before they are drawn (``polygons`` records how many); the
+reference image is drawn from the unsplit scene. Such a point simplifies
 the scene, measures the certified one-sided Hausdorff distance original → simplified and draws
 the simplified mesh (see :func:`workbench.experiment.sweep_points.simplified_scene`).
 
@@ -91,7 +95,7 @@ __all__ = ["SweepConfig", "SweepResult", "Point", "load_config", "grid_points", 
 
 TOP_KEYS = ("name", "repeats", "reference", "timed", "metric", "grid")
 SWEEP_KEYS = ("scene", "path", "size", "samples", "view")
-SIMPLIFY_KEYS = ("simplifier", "tolerance")
+SIMPLIFY_KEYS = ("simplifier", "tolerance", "quadrisection")  # preprocessing of the scene
 # how deeply nested one value of a sequence-valued key is (a list of numbers: 1)
 VALUE_DEPTH = {"view": 1, "value_range": 1, "hide_range": 1, "base_color": 1, "wire_color": 1,
                "clip_planes": 2}
@@ -187,6 +191,11 @@ def _check_sweep_values(key: str, values: list) -> list:
             if v not in simplifier_names():
                 raise ValueError(f"unknown simplifier {v!r}; known: "
                                  f"{', '.join(repr(s) for s in simplifier_names())}")
+        elif key == "quadrisection":
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not v > 0:
+                raise ValueError(f"quadrisection must be a positive fraction of the mean "
+                                 f"polygon area, got {v!r}")
+            v = float(v)
         elif key == "tolerance":
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v < 100:
                 raise ValueError(f"tolerance must be a percentage in (0, 100), got {v!r}")
@@ -320,7 +329,8 @@ def grid_points(config: SweepConfig, *, quick: bool = False,
         point = Point(index=len(points), scene=values["scene"], path=path, options=options,
                       size=values.get("size", DEFAULT_SIZE), samples=values.get("samples", 0),
                       view=values.get("view", DEFAULT_VIEW), simplifier=simplifier,
-                      tolerance=tolerance, reference=config.reference,
+                      tolerance=tolerance, quadrisection=values.get("quadrisection"),
+                      reference=config.reference,
                       reference_options=reference_options, repeats=repeats, timed=timed,
                       quick=quick)
         identity = json.dumps(point.params(), sort_keys=True)

@@ -41,7 +41,8 @@ class Point:
     ``options`` (the style options this path takes, by name), ``size`` (W, H) pixels,
     ``samples`` (MSAA), ``view`` (azimuth, elevation in degrees), ``simplifier`` and
     ``tolerance`` (% of each part's bounding-sphere diameter; both None without
-    simplification), ``reference`` (path name whose image gives the error, or None) with
+    simplification), ``quadrisection`` (a spacetime scene's polygons split down to this fraction
+    of their mean area, None: not split), ``reference`` (path name whose image gives the error, or None) with
     ``reference_options`` (the grid's options that path takes), ``repeats`` (timed draws),
     ``timed`` and ``quick`` (smaller built-in scenes). ``index`` is the position in the grid.
     """
@@ -55,6 +56,7 @@ class Point:
     view: tuple[float, float] = (30.0, 25.0)
     simplifier: str | None = None
     tolerance: float | None = None
+    quadrisection: float | None = None
     reference: str | None = None
     reference_options: dict = field(default_factory=dict)
     repeats: int = 7
@@ -66,7 +68,7 @@ class Point:
         return json.loads(json.dumps(dict(
             scene=self.scene, path=self.path, options=self.options, size=list(self.size),
             samples=self.samples, view=list(self.view), simplifier=self.simplifier,
-            tolerance=self.tolerance, reference=self.reference,
+            tolerance=self.tolerance, quadrisection=self.quadrisection, reference=self.reference,
             reference_options=self.reference_options if self.reference else {},
             repeats=self.repeats if self.timed else None, timed=self.timed, quick=self.quick)))
 
@@ -78,6 +80,8 @@ class Point:
         row["size"] = f"{self.size[0]}x{self.size[1]}"
         if self.simplifier is not None:
             row.update(simplifier=self.simplifier, tolerance=self.tolerance)
+        if self.quadrisection is not None:
+            row["quadrisection"] = self.quadrisection
         return row
 
 
@@ -199,11 +203,12 @@ def scene_kind(scene) -> str:
 
 
 def _reference_image(ctx, point: Point, scene, camera, measured):
-    """The reference path's image of the unsimplified scene with the point's options: the
-    point's own image when it draws the reference path on the unsimplified scene."""
+    """The reference path's image of the unsimplified, unsplit scene with the point's options:
+    the point's own image when it draws the reference path on that very scene."""
     from .measure import measure
 
-    if point.reference == point.path and point.simplifier in (None, NO_SIMPLIFIER):
+    if point.reference == point.path and point.simplifier in (None, NO_SIMPLIFIER) \
+            and point.quadrisection is None:
         return measured.image
     from ..paths import make_path
 
@@ -233,6 +238,12 @@ def measured_columns(point: Point, ctx) -> dict:
     scene, columns = original, {}
     if point.simplifier is not None:
         scene, columns = simplified_scene(original, point)
+    if point.quadrisection is not None:
+        if kind != "spacetime":
+            raise ValueError(f"quadrisection splits spacetime polygons; {point.scene!r} is a "
+                             f"{kind} scene")
+        scene = original.quadrisected(point.quadrisection)
+        columns["polygons"] = len(scene.corners)
     kwargs = dict(camera=camera, size=point.size, samples=point.samples)
     if point.timed:
         waited = time.perf_counter()

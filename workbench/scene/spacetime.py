@@ -21,7 +21,7 @@ import numpy as np
 from ..algo.spacetime.fields import BAR, STEEL, RadialPulse, ReflectingWave
 from ..algo.spacetime.mesh import front_refined, interval_mesh, rect_triangulation
 from ..algo.spacetime.poly import evaluate, fit_cubic, local_frames
-from ..algo.spacetime.slicing import slice_at
+from ..algo.spacetime.slicing import Slice, polygon_areas, quadrisect, slice_at
 
 DOMAIN = 100.0  # mm, the square plate
 PULSE = dict(centre=(30.0, 35.0), a=2.0, t0=2.0)
@@ -92,6 +92,22 @@ class SpacetimeScene:
         speed = evaluate(self.coeffs, self.centre, self.extent, np.repeat(self.element, 4),
                          c[:, 0], c[:, 1], self.t)["speed"]
         return float(speed.max())
+
+    def quadrisected(self, fraction: float) -> "SpacetimeScene":
+        """The scene with every polygon larger than ``fraction`` × the mean polygon area split
+        through its edge midpoints, recursively (st2005 §4.2,
+        :func:`workbench.algo.spacetime.slicing.quadrisect`); children keep their element and
+        outer edges. ValueError for a fraction that is not positive and finite."""
+        if not (np.isfinite(fraction) and fraction > 0):
+            raise ValueError(f"quadrisection fraction must be positive, got {fraction}")
+        is_quad = ~np.all(self.corners[:, 3] == self.corners[:, 2], axis=1)
+        s = Slice(0.0 if self.t is None else self.t, self.corners, self.element, is_quad,
+                  self.outer)
+        q = quadrisect(s, float(fraction) * float(polygon_areas(s).mean()))
+        return SpacetimeScene(q.corners, q.element, self.coeffs, self.centre, self.extent,
+                              self.lam, self.mu, t=self.t,
+                              outer=None if self.outer is None else q.outer,
+                              name=f"{self.name} quadrisected {fraction:g}")
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) of the polygons in the drawing plane, float64."""
