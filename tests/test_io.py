@@ -587,3 +587,88 @@ def test_trimesh_errors_are_parse_errors(tmp_path):
     with pytest.raises(ParseError, match="trimesh") as info:
         load(path)
     assert info.value.path == path
+
+
+# --------------------------------------------------------------------------- integer fields
+def test_integral_floats_in_integer_fields_of_every_card_type_read(tmp_path):
+    """Other pre-processors write integer fields as floats (``0.000E+00``, ``8.``); LS-DYNA
+    reads an integral float there, in fixed columns and in comma format alike."""
+    path = write(tmp_path, "floats.k", [
+        "*KEYWORD",
+        "*PART",
+        "floated part",
+        "1.0,8.000E+00,1.0",
+        "*SECTION_SHELL",
+        "8,2,0.000E+00,0.000E+00,0.000E+00,0.000E+00,0",
+        "1.5,1.5,1.5,1.5",
+        "*NODE",
+        "  1.01E2             0.0             0.0             0.0",
+        "     102            10.0             0.0             0.0",
+        "103.0,10.0,10.0,0.0",
+        "     104             0.0            10.0             0.0",
+        "*ELEMENT_SHELL",
+        "    7.00     1.0   101.0   102.0   103.0   104.0",
+        "8.0,1,101,102.0,103,103.000",
+        "*END",
+    ])
+    mesh = load(path)
+    assert mesh.node_ids.tolist() == [101, 102, 103, 104]
+    assert mesh.element_ids.tolist() == [7, 8]
+    assert ids_of(mesh).tolist() == [[101, 102, 103, 104], [101, 102, 103, 103]]
+    assert np.allclose(mesh.element_fields["thickness"], 1.5)  # section 8 found as 8.000E+00
+    assert mesh.parts.tolist() == [mesh.parts[0]] * 2
+
+
+@pytest.mark.parametrize("card, field, value", [
+    ("    7.50       1     101     102     103     104", "element id", "7.50"),
+    ("7,1,101,102.5,103,104", "node ids", "102.5"),
+    ("       7       1     101     102     103    1e30", "node ids", "1e30"),
+    ("       7       1     101     102     103     nan", "node ids", "nan"),
+])
+def test_fractional_or_non_finite_integers_are_refused_naming_field_and_value(
+        tmp_path, card, field, value):
+    path = write(tmp_path, "frac.k", ["*NODE", *[node(*n) for n in SQUARE], "*ELEMENT_SHELL", card])
+    with pytest.raises(ParseError) as info:
+        load(path)
+    assert info.value.line == 8
+    assert field in info.value.message and repr(value) in info.value.message
+
+
+def test_fractional_section_integer_is_refused_naming_it(tmp_path):
+    path = write(tmp_path, "sec.k", ["*SECTION_SHELL", "8,2,0.0,4.5,0,0,0", "1.0,1.0,1.0,1.0",
+                                     "*NODE", *[node(*n) for n in SQUARE],
+                                     "*ELEMENT_SHELL", shell(1, 8, 101, 102, 103, 104)])
+    with pytest.raises(ParseError, match=r"expected an integer NIP, got '4.5'") as info:
+        load(path)
+    assert info.value.line == 2
+
+
+@pytest.mark.parametrize("card, line", [
+    ("      38_7             0.0             0.0             0.0", 3),  # fixed integer
+    ("     106         1_000.0             0.0             0.0", 3),  # fixed float
+    ("106,1_000.0,0.0,0.0", 3),  # comma float
+    ("10_6,1.0,0.0,0.0", 3),  # comma integer
+])
+def test_underscores_in_numbers_are_refused(tmp_path, card, line):
+    path = write(tmp_path, "under.k", ["*NODE", node(*SQUARE[0]), card,
+                                       *[node(*n) for n in SQUARE[1:]]])
+    with pytest.raises(ParseError) as info:
+        load(path)
+    assert info.value.line == line
+
+
+@given(st.integers(-2**40, 2**40), st.sampled_from(["{:d}", "{:.1f}", "{:.15E}", "{:.0f}.", "{:+.2f}"]))
+def test_integer_field_parser_takes_integral_values_in_any_notation(value, form):
+    from workbench.scene.keyword import _convert
+
+    text = form.format(value).encode()
+    assert _convert(text, "i") == value
+
+
+@given(st.floats(allow_nan=True, allow_infinity=True).filter(
+    lambda x: not (np.isfinite(x) and x == np.floor(x))))
+def test_integer_field_parser_refuses_fractional_and_non_finite(value):
+    from workbench.scene.keyword import _convert
+
+    with pytest.raises(ValueError):
+        _convert(repr(value).encode(), "i")

@@ -32,6 +32,7 @@ per-card Python path only runs for free-format cards and to locate an error.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from operator import itemgetter
@@ -176,14 +177,24 @@ def _card_fields(line: bytes, widths, fmt: str) -> list[bytes]:
 
 
 def _convert(text: bytes, kind: str):
-    """One field's value (blank = 0); ValueError when it is not a number of that kind."""
+    """One field's value (blank = 0); ValueError when it is not a number of that kind.
+
+    An integer field also takes an integral float in any notation (``0.000E+00``, ``8.``), as
+    LS-DYNA reads it; a fractional or non-finite one is refused. Underscores (which Python's
+    number parsing would accept as digit separators) are refused in every field."""
     text = text.strip()
     if not text:
         return 0 if kind == "i" else 0.0
+    if b"_" in text:
+        raise ValueError(text)
     if kind == "i":
-        if not text.lstrip(b"+-").isdigit():
-            raise ValueError(text)
-        value = int(text)
+        if text.lstrip(b"+-").isdigit():
+            value = int(text)
+        else:
+            number = float(text.replace(b"D", b"E").replace(b"d", b"e"))
+            if not math.isfinite(number) or number != math.floor(number):
+                raise ValueError(text)
+            value = int(number)
         if not -2**63 <= value < 2**63:
             raise ValueError(text)
         return value
@@ -209,13 +220,18 @@ def _diagnose(block: _Block, rows: np.ndarray, widths, fields: list[_Field]) -> 
 _BLANK_FIELD: dict[int, np.ndarray] = {}
 
 
-def _fixed_column(chars: np.ndarray, start: int, width: int, kind: str) -> np.ndarray:
+def _fixed_column(chars: np.ndarray, start: int, width: int, kind: str,
+                  underscores: bool = True) -> np.ndarray:
     """Convert columns ``start:start+width`` of the (n, W) byte array; ValueError when one fails.
 
     Blank fields (spaces, or NUL padding past the end of a short line) read as 0, a Fortran
-    ``D`` exponent as ``E``; both are only looked for when the plain conversion fails.
+    ``D`` exponent as ``E``, and an integer field takes an integral float (``0.000E+00``); all
+    three are only looked for when the plain conversion fails. Underscores are refused
+    (``underscores=False``: the caller knows there are none).
     """
     sub = np.ascontiguousarray(chars[:, start:start + width])
+    if underscores and (sub == ord("_")).any():
+        raise ValueError("underscore in a numeric field")
     text = sub.view(f"S{width}").ravel()
     dtype = np.int64 if kind == "i" else np.float64
     try:
@@ -227,10 +243,19 @@ def _fixed_column(chars: np.ndarray, start: int, width: int, kind: str) -> np.nd
         if width not in _BLANK_FIELD:
             _BLANK_FIELD[width] = np.frombuffer(b" " * (width - 1) + b"0", np.uint8)
         sub[blank] = _BLANK_FIELD[width]
+    exponent = (sub == ord("D")) | (sub == ord("d"))
+    if exponent.any():
+        sub[exponent] = ord("E")
     if kind == "f":
-        fortran_exponent = (sub == ord("D")) | (sub == ord("d"))
-        sub[fortran_exponent] = ord("E")
-    return text.astype(dtype)  # ``text`` views ``sub``: the repairs show through
+        return text.astype(dtype)  # ``text`` views ``sub``: the repairs show through
+    try:
+        return text.astype(dtype)
+    except ValueError:
+        number = text.astype(np.float64)  # integral floats, as LS-DYNA reads them
+    if not (np.isfinite(number).all() and (number == np.floor(number)).all()
+            and (np.abs(number) < 2.0**63).all()):
+        raise ValueError("an integer field holds a fractional or non-finite number")
+    return number.astype(np.int64)
 
 
 def _table(block: _Block, rows: np.ndarray, widths, fields: list[_Field],
@@ -256,19 +281,23 @@ def _table(block: _Block, rows: np.ndarray, widths, fields: list[_Field],
     out = [np.zeros(len(rows), np.int64 if f.kind == "i" else np.float64) for f in fields]
     if len(rows) == 0:
         return rows, out
-    if chars.tobytes().find(b",") < 0:  # memchr: cheaper than a per-row test when none
+    raw = chars.tobytes()
+    if raw.find(b",") < 0:  # memchr: cheaper than a per-row test when none
         free = np.zeros(len(rows), bool)
     else:
         free = (chars == ord(",")).any(axis=1)
     fixed = ~free
+    underscores = raw.find(b"_") >= 0
     try:
         if fixed.all():
             for f, values in zip(fields, out):
-                values[:] = _fixed_column(chars, starts[f.index], cols[f.index], f.kind)
+                values[:] = _fixed_column(chars, starts[f.index], cols[f.index], f.kind,
+                                          underscores)
         elif fixed.any():
             subset = chars[fixed]
             for f, values in zip(fields, out):
-                values[fixed] = _fixed_column(subset, starts[f.index], cols[f.index], f.kind)
+                values[fixed] = _fixed_column(subset, starts[f.index], cols[f.index], f.kind,
+                                              underscores)
         for i in np.flatnonzero(free).tolist():
             texts = _card_fields(lines[i], widths, block.fmt)
             for f, values in zip(fields, out):
@@ -482,10 +511,14 @@ class _Deck:
                                   int(rows[min(at, len(rows) - 1)]))
             first, second = int(rows[at]), int(rows[at + 1])
             texts = _card_fields(block.src.lines[first], _TEN, block.fmt)
-            try:
-                elform, nip, icomp = (_convert(texts[i], "i") for i in (1, 3, 6))
-            except ValueError:
-                raise block.error("expected integers ELFORM, NIP and ICOMP", first) from None
+            values = []
+            for i, name in ((1, "ELFORM"), (3, "NIP"), (6, "ICOMP")):
+                try:
+                    values.append(_convert(texts[i], "i"))
+                except ValueError:
+                    raise block.error(f"expected an integer {name}, got {_shown(texts[i])!r}",
+                                      first) from None
+            elform, nip, icomp = values
             thickness = _card_fields(block.src.lines[second], _TEN, block.fmt)[:4]
             self.sections[_section_key(texts[0])] = _Section(thickness, block.src, second)
             at += 2
@@ -659,8 +692,12 @@ def _keyword_format(options: str, current: str) -> str:
 
 
 def _section_key(text: bytes):
-    text = text.strip().decode("utf-8", "replace")
-    return int(text) if text.lstrip("+-").isdigit() else text.upper()
+    """A section id as a part and a section card name it: an integer (integral floats
+    included, so ``8`` and ``8.000E+00`` name one section), else the upper-cased label."""
+    try:
+        return _convert(text, "i") if text.strip() else ""
+    except ValueError:
+        return text.strip().decode("utf-8", "replace").upper()
 
 
 def _file_names(block: _Block, with_rows: bool = False):
