@@ -231,3 +231,39 @@ def test_render_refuses_mismatches_in_one_line(args, message, tmp_path, capsys):
     assert main(["render", *args, "-o", str(tmp_path / "x.png")]) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
+
+
+FAR_DECK = """*KEYWORD
+*NODE
+1,1e20,0.0,0.0
+2,1.00000000000001e20,0.0,0.0
+3,1e20,100.0,0.0
+*ELEMENT_SHELL
+1,1,1,2,3,3
+*END
+"""
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--size", "20000x10"], "at most"),
+    (["--samples", "3"], "3 MSAA samples asked; this driver allows 0, 1"),
+    (["--samples", "-1"], "-1 MSAA samples asked"),
+    (["--view", "nan,nan"], "expected two finite numbers"),
+    (["--view", "inf,0"], "expected two finite numbers"),
+])
+def test_render_refuses_what_the_driver_cannot_draw(args, message, tmp_path):
+    """Each bad request ends in one line on stderr and exit status 2, never a traceback."""
+    result = subprocess.run([sys.executable, "-m", "workbench.cli", "render", "semicylinders:2",
+                             *args, "-o", str(tmp_path / "x.png")], capture_output=True, text=True)
+    assert result.returncode == 2
+    err = result.stderr.strip()
+    assert message in err and len(err.splitlines()) == 1 and "Traceback" not in err
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_render_refuses_coordinates_too_far_to_resolve(tmp_path, capsys):
+    deck = tmp_path / "far.k"
+    deck.write_text(FAR_DECK)
+    assert main(["render", str(deck), "-o", str(tmp_path / "x.png")]) == 2
+    err = capsys.readouterr().err
+    assert "magnitude 1e+20" in err and "translate it nearer the origin" in err

@@ -7,6 +7,7 @@ unknown name) ends with a one-line message on stderr and exit status 2, never a 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from importlib import metadata
@@ -18,11 +19,15 @@ VERSIONED = ("numpy", "scipy", "moderngl", "trimesh", "meshio", "lasso-python", 
 
 
 def _pair(text: str, sep: str, kind=float) -> tuple:
+    """Two finite numbers separated by ``sep``."""
     try:
         a, b = text.lower().split(sep)
-        return kind(a), kind(b)
+        pair = kind(a), kind(b)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected two numbers separated by {sep!r}, got {text!r}")
+    if not all(math.isfinite(v) for v in pair):
+        raise argparse.ArgumentTypeError(f"expected two finite numbers, got {text!r}")
+    return pair
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -233,8 +238,16 @@ def cmd_reproduce(args) -> int:
     return 0
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose refusals are one line (``PROG: error: …``) and exit status 2,
+    without the usage block (``--help`` shows it)."""
+
+    def error(self, message: str):
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="workbench",
         description="Comparable OpenGL render paths for finite-element visualization, measured "
                     "side by side for run time and error on a headless (EGL) context.")

@@ -59,6 +59,23 @@ def scene_name(scene) -> str:
     return type(scene).__name__
 
 
+def check_resolvable(lo, hi) -> None:
+    """Refuse (ValueError) a bounding box ``lo``–``hi`` (float64, model units) that cannot be
+    drawn: not finite, of zero extent, or so far from the origin that float64 coordinates
+    cannot tell its points apart to 1/10 000 of its extent (they would draw as one point)."""
+    lo, hi = np.asarray(lo, np.float64), np.asarray(hi, np.float64)
+    if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
+        raise ValueError("the scene's coordinates are not finite")
+    extent = float(np.max(hi - lo))
+    magnitude = float(np.max(np.abs(np.concatenate([lo, hi]))))
+    if extent <= 0:
+        raise ValueError("the scene has zero extent: every point lies at one place")
+    if np.spacing(magnitude) > 1e-4 * extent:
+        raise ValueError(f"coordinates of magnitude {magnitude:.3g} are resolved to "
+                         f"{np.spacing(magnitude):.3g} in float64, too coarse for a scene "
+                         f"{extent:.3g} wide: translate it nearer the origin")
+
+
 def default_camera(scene, size: tuple[int, int], view: tuple[float, float] = (30.0, 25.0),
                    projection: str = "orthographic", up: str = "z", style=None) -> Camera:
     """A camera showing all of ``scene`` at ``size`` (W, H): for an FE mesh or a textured
@@ -78,6 +95,7 @@ def default_camera(scene, size: tuple[int, int], view: tuple[float, float] = (30
         lo, hi = scene.bounds(all_steps=True)
     else:  # a TexturedSurface
         lo, hi = scene.positions.min(axis=0), scene.positions.max(axis=0)
+    check_resolvable(lo, hi)
     return Camera.fit_box(lo, hi, azimuth=view[0], elevation=view[1], projection=projection,
                           aspect=aspect, up=up)
 

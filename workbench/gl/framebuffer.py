@@ -10,6 +10,16 @@ from .context import raw_gl
 DEPTH_BITS = (24, 32)
 
 
+def sample_counts(ctx: moderngl.Context) -> tuple[int, ...]:
+    """The MSAA sample counts a framebuffer may ask for: 0 (none) and the powers of two up to
+    the driver's maximum."""
+    counts, n = [0], 1
+    while n <= ctx.max_samples:
+        counts.append(n)
+        n *= 2
+    return tuple(counts)
+
+
 class Framebuffer:
     """An offscreen RGBA8 + depth target of ``size = (width, height)`` pixels.
 
@@ -24,8 +34,15 @@ class Framebuffer:
         width, height = (int(s) for s in size)
         if width <= 0 or height <= 0:
             raise ValueError(f"framebuffer size must be positive, got {size}")
-        if samples and samples > ctx.max_samples:
-            raise ValueError(f"{samples} samples asked, the driver allows {ctx.max_samples}")
+        limit = min(int(ctx.info["GL_MAX_RENDERBUFFER_SIZE"]),
+                    *(int(v) for v in ctx.info["GL_MAX_VIEWPORT_DIMS"]))
+        if width > limit or height > limit:
+            raise ValueError(f"framebuffer {width}x{height} is larger than this driver allows: "
+                             f"at most {limit} pixels a side")
+        allowed = sample_counts(ctx)
+        if int(samples) != samples or samples not in allowed:
+            raise ValueError(f"{samples} MSAA samples asked; this driver allows "
+                             f"{', '.join(str(n) for n in allowed)}")
         if depth_bits not in DEPTH_BITS:
             raise ValueError(f"depth_bits must be one of {DEPTH_BITS}, got {depth_bits}")
         self.ctx, self.size, self.samples = ctx, (width, height), int(samples)
