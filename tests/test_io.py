@@ -362,8 +362,8 @@ coordinates = st.floats(-1e6, 1e6, allow_nan=False).map(lambda v: float(f"{v:.7g
 @given(data=st.data())
 def test_random_decks_read_back(tmp_path, data):
     n = data.draw(st.integers(3, 12))
-    node_ids = data.draw(st.lists(st.integers(-(10**7) + 1, 10**8 - 1), min_size=n, max_size=n,
-                                  unique=True))
+    ids = st.integers(-(10**7) + 1, 10**8 - 1).filter(bool)  # a node id 0 is refused
+    node_ids = data.draw(st.lists(ids, min_size=n, max_size=n, unique=True))
     xyz = data.draw(st.lists(st.tuples(coordinates, coordinates, coordinates), min_size=n,
                              max_size=n))
     free = data.draw(st.lists(st.booleans(), min_size=2 * n, max_size=2 * n))
@@ -672,3 +672,65 @@ def test_integer_field_parser_refuses_fractional_and_non_finite(value):
 
     with pytest.raises(ValueError):
         _convert(repr(value).encode(), "i")
+
+
+# --------------------------------------------------------------------------- damaged decks
+@pytest.mark.skipif(shared_file(CAR_DECK) is None, reason="shared car deck absent")
+def test_deck_cut_off_inside_its_last_card_is_refused(tmp_path):
+    """``head -c`` through the last node card: the missing fields must not read as 0."""
+    data = shared_file(CAR_DECK).read_bytes()
+    start = data.index(b"*NODE")
+    end = data.index(b"\n*", start + 1)  # the end of the node block's last card
+    cut = tmp_path / "cut.k"
+    cut.write_bytes(data[:end - 20])
+    with pytest.raises(ParseError, match="the file ends inside this card") as info:
+        load(cut)
+    assert info.value.line == data[:end].count(b"\n") + 1
+
+
+def test_a_whole_last_card_without_a_final_line_end_reads(tmp_path):
+    lines = two_element_deck()[:-1]  # ends with the last element card, no *END
+    path = tmp_path / "open.k"
+    path.write_bytes("\n".join(lines).encode())
+    mesh = load(path)
+    assert ids_of(mesh).tolist() == [[101, 102, 103, 104], [102, 105, 103, 103]]
+
+
+def test_free_format_card_cut_off_at_the_end_of_the_file(tmp_path):
+    path = tmp_path / "cut.k"
+    path.write_bytes(b"*NODE\n1,0.0,0.0,0.0\n2,10.0,0.0,0.0\n3,10.0,10.0,0.0\n*ELEMENT_SHELL\n"
+                     b"1,1,1,2,3,3\n*NODE\n4,5.0,5.0")
+    with pytest.raises(ParseError, match="ends inside this card") as info:
+        load(path)
+    assert info.value.line == 8
+
+
+def test_stray_carriage_return_and_blank_ids_are_refused(tmp_path):
+    body = [node(*n) for n in SQUARE]
+    path = tmp_path / "cr.k"
+    lines = ["*NODE", *body, "*ELEMENT_SHELL", shell(7, 3, 101, 102, 103, 104)]
+    text = "\n".join(lines) + "\n"
+    path.write_bytes(text.replace(body[2], body[2][:30] + "\r" + body[2][30:]).encode())
+    with pytest.raises(ParseError, match="carriage return inside a line") as info:
+        load(path)
+    assert info.value.line == 4
+    blank = write(tmp_path, "blank.k", ["*NODE", *body, "        " + body[0][8:],
+                                        "*ELEMENT_SHELL", shell(7, 3, 101, 102, 103, 104)])
+    with pytest.raises(ParseError, match="expected a node id, got a blank or 0") as info:
+        load(blank)
+    assert info.value.line == 7
+    zero = write(tmp_path, "zero.k", ["*NODE", *body, "*ELEMENT_SHELL", "0,3,101,102,103,104"])
+    with pytest.raises(ParseError, match="expected an element id") as info:
+        load(zero)
+    assert info.value.line == 8
+
+
+@pytest.mark.parametrize("line_end", [b"\r\n", b"\r"])
+def test_other_systems_line_ends_read_the_identical_mesh(tmp_path, line_end):
+    lines = two_element_deck()
+    plain = load(write(tmp_path, "plain.k", lines))
+    other = tmp_path / "other.k"
+    other.write_bytes(line_end.join(line.encode() for line in lines) + line_end)
+    mesh = load(other)
+    assert np.array_equal(mesh.nodes, plain.nodes) and np.array_equal(mesh.elements, plain.elements)
+    assert mesh.node_ids.tolist() == plain.node_ids.tolist()

@@ -95,7 +95,17 @@ class _Source:
         except OSError as exc:
             raise ParseError(path, f"cannot read: {exc.strerror or exc}") from exc
         if b"\r" in data:
-            data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+            if b"\n" not in data:  # classic Mac line ends
+                data = data.replace(b"\r", b"\n")
+            data = data.replace(b"\r\n", b"\n")
+            stray = data.find(b"\r")
+            if stray >= 0:
+                line = data.count(b"\n", 0, stray) + 1
+                raise ParseError(path, "a carriage return inside a line (a line end of another "
+                                 "system, or a damaged file)", line=line)
+        # a file that does not end with a line end may have been cut off: _table checks its
+        # last card
+        self.unterminated = bool(data) and not data.endswith(b"\n")
         self.lines = data.split(b"\n")
         if len(self.lines) > 1 and not self.lines[-1]:
             self.lines.pop()  # what follows the final newline is no line
@@ -281,6 +291,8 @@ def _table(block: _Block, rows: np.ndarray, widths, fields: list[_Field],
     out = [np.zeros(len(rows), np.int64 if f.kind == "i" else np.float64) for f in fields]
     if len(rows) == 0:
         return rows, out
+    if block.src.unterminated and int(rows[-1]) == len(block.src.lines) - 1:
+        _check_complete(block, int(rows[-1]), widths, fields, span)
     raw = chars.tobytes()
     if raw.find(b",") < 0:  # memchr: cheaper than a per-row test when none
         free = np.zeros(len(rows), bool)
@@ -305,6 +317,19 @@ def _table(block: _Block, rows: np.ndarray, widths, fields: list[_Field],
     except (ValueError, OverflowError):
         raise _diagnose(block, rows, widths, fields) from None
     return rows, out
+
+
+def _check_complete(block: _Block, row: int, widths, fields: list[_Field], span: int) -> None:
+    """Refuse the file's last card when the file ends inside it: no line end after it, and
+    fewer columns (or comma-separated fields) than the fields read from it."""
+    line = block.src.lines[row].rstrip()
+    if b"," in line:
+        complete = len(line.split(b",")) > max(f.index for f in fields)
+    else:
+        complete = len(line) >= span
+    if not complete:
+        raise block.error("the file ends inside this card (no line end after it): "
+                          "it was cut off", row)
 
 
 # --------------------------------------------------------------------------- the deck
@@ -430,6 +455,8 @@ class _Deck:
         rows, (ids, x, y, z) = _table(block, block.rows, _NODE, [
             _Field(0, "i", "an integer node id"), _Field(1, "f", "3 coordinates"),
             _Field(2, "f", "3 coordinates"), _Field(3, "f", "3 coordinates")], drop_blank=True)
+        if not ids.all():
+            raise block.error("expected a node id, got a blank or 0", int(rows[np.argmin(ids != 0)]))
         xyz = np.column_stack([x, y, z])
         bad = ~np.isfinite(xyz).all(axis=1)
         if bad.any():
@@ -457,6 +484,9 @@ class _Deck:
             *[_Field(i, "i", "4 integer node ids") for i in range(2, 6)]],
             drop_blank=per_element == 1)
         ids, pids = values[0], values[1]
+        if not ids.all():
+            raise block.error("expected an element id, got a blank or 0",
+                              int(cards[np.argmin(ids != 0)]))
         nodes = np.column_stack(values[2:6])
         thickness = np.full((len(cards), 4), np.nan)
         if has_thickness:
