@@ -238,8 +238,8 @@ def test_comments_case_unknown_keywords_and_end(tmp_path):
         *[node(*n) for n in SQUARE[:4]],
         "$ comment inside a block",
         node(*SQUARE[4]),
-        "*ELEMENT_SOLID",
-        "       1       1       1       2       3       4       5       5       5       5",
+        "*ELEMENT_BEAM",
+        "       1       1       1       2       3",
         "*element_shell",
         shell(1, 1, 101, 102, 103, 104),
         "",
@@ -457,7 +457,7 @@ def test_duplicate_ids(tmp_path):
 
 
 def test_empty_decks(tmp_path):
-    with pytest.raises(ParseError, match="no shell elements"):
+    with pytest.raises(ParseError, match="no shell or solid elements"):
         load(write(tmp_path, "empty.k", ["*KEYWORD", "*END"]))
     with pytest.raises(ParseError, match=r"\*ELEMENT_SOLID"):
         load(write(tmp_path, "solid.k", [
@@ -734,3 +734,79 @@ def test_other_systems_line_ends_read_the_identical_mesh(tmp_path, line_end):
     mesh = load(other)
     assert np.array_equal(mesh.nodes, plain.nodes) and np.array_equal(mesh.elements, plain.elements)
     assert mesh.node_ids.tolist() == plain.node_ids.tolist()
+
+
+# --------------------------------------------------------------------------- solid elements
+def solid_block_deck(n: int = 3, two_cards: bool = False, tets: bool = False) -> list[str]:
+    """An n×n×n block of 10 mm hexahedra (or each cut into 6 tetrahedra), node ids from 1."""
+    g = np.arange(n + 1)
+    nid = lambda i, j, k: 1 + i + (n + 1) * (j + (n + 1) * k)  # noqa: E731
+    lines = ["*KEYWORD", "*NODE"]
+    for k in g:
+        for j in g:
+            for i in g:
+                lines.append(node(nid(i, j, k), 10.0 * i, 10.0 * j, 10.0 * k))
+    lines.append("*ELEMENT_SOLID")
+    eid = 0
+    for k in range(n):
+        for j in range(n):
+            for i in range(n):
+                c = [nid(i, j, k), nid(i + 1, j, k), nid(i + 1, j + 1, k), nid(i, j + 1, k),
+                     nid(i, j, k + 1), nid(i + 1, j, k + 1), nid(i + 1, j + 1, k + 1),
+                     nid(i, j + 1, k + 1)]
+                cells = [c]
+                if tets:  # the 6 tetrahedra around the diagonal c0-c6
+                    cells = [[c[0], c[1], c[2], c[6]], [c[0], c[2], c[3], c[6]],
+                             [c[0], c[3], c[7], c[6]], [c[0], c[7], c[4], c[6]],
+                             [c[0], c[4], c[5], c[6]], [c[0], c[5], c[1], c[6]]]
+                    cells = [t + [t[3]] * 4 for t in cells]
+                for cell in cells:
+                    eid += 1
+                    if two_cards:
+                        lines += [shell(eid, 5), "".join(f"{v:8d}" for v in cell)]
+                    else:
+                        lines.append(shell(eid, 5, *cell))
+    return lines + ["*END"]
+
+
+@pytest.mark.parametrize("two_cards", [False, True])
+def test_solid_hexahedra_are_drawn_by_their_boundary_faces(tmp_path, two_cards):
+    mesh = load(write(tmp_path, "block.k", solid_block_deck(3, two_cards)))
+    assert mesh.n_elements == 6 * 3 * 3 == mesh.n_quads  # the outer quads only
+    assert set(mesh.parts.tolist()) == {5}
+    assert set(mesh.element_ids.tolist()) <= set(range(1, 28)) and 14 not in mesh.element_ids
+    centre = mesh.nodes.mean(axis=0)
+    e = mesh.nodes[mesh.elements]
+    normal = np.cross(e[:, 1] - e[:, 0], e[:, 2] - e[:, 0])
+    assert (np.einsum("ij,ij->i", normal, e.mean(axis=1) - centre) > 0).all()  # outward
+    every = load(write(tmp_path, "block_all.k", solid_block_deck(3, two_cards)), all_faces=True)
+    assert every.n_elements == 6 * 27
+
+
+def test_solid_tetrahedra_give_the_outer_triangles_and_render(tmp_path):
+    path = write(tmp_path, "tets.k", solid_block_deck(2, tets=True))
+    mesh = load(path)
+    assert mesh.n_elements == 6 * 2 * 2 * 2 and mesh.n_quads == 0
+    area = 0.5 * np.linalg.norm(np.cross(*(mesh.nodes[mesh.elements[:, [1, 2]]].transpose(1, 0, 2)
+                                         - mesh.nodes[mesh.elements[:, 0]])), axis=1)
+    assert area.sum() == pytest.approx(6 * 20.0 * 20.0)
+    from workbench.cli import main
+
+    out = tmp_path / "tets.png"
+    assert main(["render", str(path), "--size", "64x48", "-o", str(out)]) == 0
+
+
+def test_solid_refusals_name_the_card(tmp_path):
+    lines = solid_block_deck(1)
+    bad = [*lines[:-2], shell(2, 5, 1, 2, 3, 4, 5, 6, 7, 99), "*END"]
+    with pytest.raises(ParseError, match=r"undefined node ids; first \(element id, node id\): "
+                                         r"\(2, 99\)") as info:
+        load(write(tmp_path, "undefined.k", bad))
+    assert info.value.line == len(bad) - 1
+    pyramid = [*lines[:-2], shell(2, 5, 1, 2, 4, 3, 5, 5, 5, 5), "*END"]
+    with pytest.raises(ParseError, match="a node pattern LS-DYNA does not define") as info:
+        load(write(tmp_path, "pyramid.k", pyramid))
+    assert info.value.line == len(pyramid) - 1
+    ortho = [line.replace("*ELEMENT_SOLID", "*ELEMENT_SOLID_ORTHO") for line in lines]
+    with pytest.raises(ParseError, match="not supported"):
+        load(write(tmp_path, "ortho.k", ortho))

@@ -104,7 +104,7 @@ def cmd_render(args) -> int:
     from .scene.builtin import load_scene
     from .scene.mesh import FEMesh
 
-    scene = load_scene(args.mesh)
+    scene = load_scene(args.mesh, all_faces=args.all_faces)
     is_mesh = isinstance(scene, FEMesh)
     if is_mesh:
         fields = [*scene.node_fields, *scene.element_fields]
@@ -281,6 +281,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-O", "--option", type=_option, action="append", metavar="KEY=VALUE",
                    help="any style option of the path (repeatable)")
     p.add_argument("--wireframe", action="store_true", help="overdraw element edges")
+    p.add_argument("--all-faces", action="store_true",
+                   help="draw every face of solid elements, not only the boundary faces")
     p.add_argument("--strips", choices=("none", "triangle", "quad"), default="none",
                    help="draw a triangle list (default), meshoptimizer triangle strips or quad strips")
     p.add_argument("--fepatch", default="A", metavar="SET",

@@ -13,7 +13,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..data import CAR_DECK, D3PLOT, shared_file
-from .mesh import FEMesh
 
 BUILTIN = ("car", "d3plot", "semicylinders", "panels", "spacetime:radial", "spacetime:bar")
 SIZED = ("semicylinders", "panels", "spacetime:radial", "spacetime:bar")  # take ":size"
@@ -65,12 +64,13 @@ def parse_scene_spec(spec: str) -> tuple[str, int | None] | None:
     return (name, size) if name in BUILTIN else None
 
 
-def load_scene(spec: str, quick: bool = False):
+def load_scene(spec: str, quick: bool = False, all_faces: bool = False):
     """A built-in scene by name (see :func:`parse_scene_spec`), else a mesh file read by
-    :func:`workbench.scene.io.load`; an existing file wins over a built-in name."""
+    :func:`workbench.scene.io.load` (``all_faces``: every face of its solids, not only their
+    boundary); an existing file wins over a built-in name."""
     parsed = parse_scene_spec(spec)
     if parsed is not None and not Path(spec).exists():
         return builtin_scene(parsed[0], quick, parsed[1])
     from .io import load
 
-    return load(spec)
+    return load(spec, all_faces=all_faces)

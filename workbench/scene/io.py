@@ -70,11 +70,14 @@ def detect_format(path) -> str:
                            f"supported: {supported_formats()}")
 
 
-def load(path, *, format: str | None = None, units: str = "mm") -> FEMesh:
+def load(path, *, format: str | None = None, units: str = "mm",
+         all_faces: bool = False) -> FEMesh:
     """Read the shell mesh in ``path`` (a str or Path) into an :class:`FEMesh`.
 
     ``format`` forces a reader ("keyword", "d3plot", "meshio", "trimesh"); by default it is
     chosen by :func:`detect_format`. ``units`` labels the coordinates (they are not scaled).
+    Solid elements of a keyword deck are drawn by their boundary faces, or by every face with
+    ``all_faces``.
     Raises FileNotFoundError when the file does not exist and :class:`ParseError` for anything
     that cannot be read; nothing partially read is returned.
     """
@@ -85,7 +88,7 @@ def load(path, *, format: str | None = None, units: str = "mm") -> FEMesh:
         raise ParseError(path, "not a file")
     fmt = detect_format(path) if format is None else format
     if fmt == "keyword":
-        return read_keyword(path, units=units)
+        return read_keyword(path, units=units, all_faces=all_faces)
     if fmt == "d3plot":
         return read_d3plot(path, units=units)
     if fmt == "meshio":

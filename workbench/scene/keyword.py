@@ -8,6 +8,11 @@ What is read:
   repeats its third node (``n3 == n4``, or n4 left blank); its nodes n5..n8 (8-node shells) are
   not kept. The mean nodal thickness (thickness cards, else the part's ``*SECTION_SHELL`` T1..T4)
   becomes the element field ``"thickness"`` (NaN where neither gives one);
+* ``*ELEMENT_SOLID``: element id, part id and n1..n8 on one card, or (the two-card layout of
+  newer decks) element id and part id, then n1..n8 on the next card; tetrahedra, pentahedra and
+  hexahedra by LS-DYNA's repeated-node conventions. Solids are drawn by their boundary faces
+  (faces used by one solid only; every face with ``all_faces``), each face keeping its solid's
+  id in ``element_ids`` and its part (:mod:`workbench.scene.solids`); their thickness is NaN;
 * ``*PART`` (title line, then the card with pid and secid; several parts per keyword), the
   part-definition options (``_CONTACT``, ``_PRINT``, ...), titles becoming ``part_names``;
 * ``*SECTION_SHELL`` (and ``_TITLE``) T1..T4, with ``&name`` references to ``*PARAMETER`` values;
@@ -24,7 +29,7 @@ and mapped to indices. Coordinates are taken as they are (millimetres by default
 
 Refused with :class:`~workbench.scene.parse.ParseError` (file, 1-based line, card text and what was
 expected): a malformed card, an element that names an undefined node, duplicate node or element
-ids, a deck without shell elements, an undefined parameter, a missing or cyclic include, and
+ids, a deck without shell or solid elements, an undefined parameter, a missing or cyclic include, and
 the variants that would change the geometry if ignored (``*INCLUDE_TRANSFORM``,
 ``*ELEMENT_SHELL_COMPOSITE``, ...). Large blocks are converted column by column with numpy; the
 per-card Python path only runs for free-format cards and to locate an error.
@@ -60,15 +65,16 @@ _KEYWORD_LINE = re.compile(r"\*\s*([A-Za-z0-9_]+)\s*([%+-])?(.*)$")
 _SUFFIX_FORMAT = {"%": "i10", "+": "long", "-": "small"}
 
 
-def read_keyword(path, units: str = "mm") -> FEMesh:
+def read_keyword(path, units: str = "mm", all_faces: bool = False) -> FEMesh:
     """Read the LS-DYNA keyword deck ``path`` (with its includes) into an :class:`FEMesh`.
 
     See the module notes for what is read and what is refused. ``units`` labels the
-    coordinates (they are not scaled).
+    coordinates (they are not scaled); ``all_faces`` draws every face of the solids instead
+    of their boundary.
     """
     deck = _Deck(Path(path))
     deck.read_file(Path(path), None)
-    return deck.build(units)
+    return deck.build(units, all_faces)
 
 
 def field_width(width: int, fmt: str) -> int:
@@ -366,6 +372,10 @@ class _Deck:
     shell_nodes: list[np.ndarray] = field(default_factory=list)
     shell_thickness: list[np.ndarray] = field(default_factory=list)
     shell_chunks: list[_Chunk] = field(default_factory=list)
+    solid_ids: list[np.ndarray] = field(default_factory=list)
+    solid_parts: list[np.ndarray] = field(default_factory=list)
+    solid_nodes: list[np.ndarray] = field(default_factory=list)
+    solid_chunks: list[_Chunk] = field(default_factory=list)
     parts: dict[int, _Part] = field(default_factory=dict)
     sections: dict[object, _Section] = field(default_factory=dict)
     parameters: dict[str, object] = field(default_factory=dict)
@@ -405,6 +415,10 @@ class _Deck:
             self._nodes(block)
         elif name.startswith("ELEMENT_SHELL"):
             self._shells(block)
+        elif name == "ELEMENT_SOLID":
+            self._solids(block)
+        elif name.startswith("ELEMENT_SOLID"):
+            raise block.error(f"*{name} is not supported (read is *ELEMENT_SOLID)")
         elif name.startswith("ELEMENT_"):
             self.skipped[name] = self.skipped.get(name, 0) + 1
         elif name == "PART" or name.startswith("PART_"):
@@ -464,6 +478,35 @@ class _Deck:
         self.node_ids.append(ids)
         self.node_xyz.append(xyz)
         self.node_chunks.append(_Chunk(block.src, rows))
+
+    def _solids(self, block: _Block) -> None:
+        """*ELEMENT_SOLID: one card (eid, pid, n1..n8) or two (eid, pid; n1..n8) per solid,
+        the layout told by the first card (nodes on it or not)."""
+        rows = np.array([r for r in block.rows.tolist() if not block.blank(r)], np.int64)
+        if len(rows) == 0:
+            return
+        first = _card_fields(block.src.lines[int(rows[0])], _SHELL, block.fmt)
+        two_cards = not any(t.strip() for t in first[2:])
+        ids_fields = [_Field(0, "i", "an integer element id"), _Field(1, "i", "an integer part id")]
+        if two_cards:
+            if len(rows) % 2:
+                raise block.error("expected two cards per solid (eid pid; n1..n8), the block "
+                                  "ends after one", int(rows[-1]))
+            cards, values = _table(block, rows[0::2], _SHELL, ids_fields)
+            _, nodes = _table(block, rows[1::2], (8,) * 8,
+                              [_Field(i, "i", "8 integer node ids") for i in range(8)])
+        else:
+            cards, values = _table(block, rows, _SHELL, [
+                *ids_fields, *[_Field(i, "i", "8 integer node ids") for i in range(2, 10)]])
+            values, nodes = values[:2], values[2:]
+        ids = values[0]
+        if not ids.all():
+            raise block.error("expected an element id, got a blank or 0",
+                              int(cards[np.argmin(ids != 0)]))
+        self.solid_ids.append(ids)
+        self.solid_parts.append(values[1])
+        self.solid_nodes.append(np.column_stack(nodes))
+        self.solid_chunks.append(_Chunk(block.src, cards))
 
     def _shells(self, block: _Block) -> None:
         options = set(filter(None, block.keyword[len("ELEMENT_SHELL"):].split("_")))
@@ -615,45 +658,57 @@ class _Deck:
                             "SECTION_SHELL") from None
 
     # ------------------------------------------------------------- assembly
-    def build(self, units: str) -> FEMesh:
-        if sum(len(ids) for ids in self.shell_ids) == 0:
+    def build(self, units: str, all_faces: bool = False) -> FEMesh:
+        n_shells = sum(len(ids) for ids in self.shell_ids)
+        if n_shells + sum(len(ids) for ids in self.solid_ids) == 0:
             others = ", ".join(f"*{k}" for k in sorted(self.skipped))
-            raise ParseError(self.master, "no shell elements (*ELEMENT_SHELL) in the deck"
+            raise ParseError(self.master, "no shell or solid elements (*ELEMENT_SHELL, "
+                             "*ELEMENT_SOLID) in the deck"
                              + (f"; it has {others}, which are not read" if others else ""))
         node_ids = np.concatenate(self.node_ids) if self.node_ids else np.zeros(0, np.int64)
         xyz = np.concatenate(self.node_xyz) if self.node_xyz else np.zeros((0, 3))
-        shell_ids = np.concatenate(self.shell_ids)
-        pids = np.concatenate(self.shell_parts)
-        refs = np.concatenate(self.shell_nodes)
         order, sorted_ids = _unique_or_raise(node_ids, self.node_chunks, "node")
-        _unique_or_raise(shell_ids, self.shell_chunks, "element")
+        element_ids = np.concatenate([*self.shell_ids, *self.solid_ids])
+        # shells and solids number their elements apart, as LS-DYNA's element types do
+        _unique_or_raise(element_ids[:n_shells], self.shell_chunks, "element")
+        _unique_or_raise(element_ids[n_shells:], self.solid_chunks, "solid element")
 
+        shell_ids = element_ids[:n_shells]
+        pids = np.concatenate(self.shell_parts) if n_shells else np.zeros(0, np.int64)
+        refs = np.concatenate(self.shell_nodes) if n_shells else np.zeros((0, 4), np.int64)
         if not (node_ids == 0).any():  # n4 left blank on a triangle
             blank4 = refs[:, 3] == 0
             refs[blank4, 3] = refs[blank4, 2]
-        if len(sorted_ids):
-            pos = np.searchsorted(sorted_ids, refs).clip(max=len(sorted_ids) - 1)
-            found = sorted_ids[pos] == refs
-            elements = order[pos]
-        else:
-            found = np.zeros(refs.shape, bool)
-            elements = np.zeros(refs.shape, np.int64)
-        if not found.all():
-            bad = np.flatnonzero(~found.all(axis=1))
-            pairs = [(int(shell_ids[e]), int(refs[e][~found[e]][0])) for e in bad[:5]]
-            src, row = _locate(self.shell_chunks, int(bad[0]))
-            listed = ", ".join(f"({e}, {n})" for e, n in pairs)
-            raise src.error(f"{len(bad)} element(s) reference undefined node ids; first "
-                            f"(element id, node id): {listed}", row, "ELEMENT_SHELL")
-        limits = np.iinfo(np.int32)
-        too_big = (pids < limits.min) | (pids > limits.max)
-        if too_big.any():  # FEMesh keeps part ids as int32
-            src, row = _locate(self.shell_chunks, int(np.argmax(too_big)))
-            raise src.error(f"part id {int(pids[too_big][0])} does not fit in 32 bits", row,
-                            "ELEMENT_SHELL")
+        elements = _node_indices(refs, order, sorted_ids, shell_ids, self.shell_chunks,
+                                 "ELEMENT_SHELL")
+        _check_part_ids(pids, self.shell_chunks, "ELEMENT_SHELL")
+        thickness = self._thickness(pids, elements) if n_shells else np.zeros(0)
+        if self.solid_ids:
+            from .solids import boundary_surface, solid_kinds
+
+            solid_ids = element_ids[n_shells:]
+            solid_pids = np.concatenate(self.solid_parts)
+            _check_part_ids(solid_pids, self.solid_chunks, "ELEMENT_SOLID")
+            node_refs = np.concatenate(self.solid_nodes)
+            solids = _node_indices(node_refs, order, sorted_ids, solid_ids, self.solid_chunks,
+                                   "ELEMENT_SOLID")
+            unknown = np.flatnonzero(solid_kinds(solids) == 0)
+            if len(unknown):
+                src, row = _locate(self.solid_chunks, int(unknown[0]))
+                raise src.error(f"{len(unknown)} solid(s) of a node pattern LS-DYNA does not "
+                                f"define; expected a hexahedron (n1..n8 distinct), pentahedron "
+                                f"(n1 n2 n3 n4 n5 n5 n6 n6) or tetrahedron (n1 n2 n3 n4 n4 n4 "
+                                f"n4 n4)", row, "ELEMENT_SOLID")
+            try:
+                faces, face_pids, face_of = boundary_surface(solids, xyz, solid_pids, all_faces)
+            except ValueError as exc:
+                raise ParseError(self.master, f"*ELEMENT_SOLID: {exc}") from None
+            elements = np.concatenate([elements, faces])
+            pids = np.concatenate([pids, face_pids])
+            shell_ids = np.concatenate([shell_ids, solid_ids[face_of]])
+            thickness = np.concatenate([thickness, np.full(len(faces), np.nan)])
 
         element_fields = {}
-        thickness = self._thickness(pids, elements)
         if np.isfinite(thickness).any():
             element_fields["thickness"] = thickness
         used_parts = set(np.unique(pids).tolist())
@@ -758,6 +813,36 @@ def _locate(chunks: list[_Chunk], index: int) -> tuple[_Source, int]:
     raise IndexError(index)
 
 
+def _node_indices(refs: np.ndarray, order: np.ndarray, sorted_ids: np.ndarray,
+                  element_ids: np.ndarray, chunks: list[_Chunk], keyword: str) -> np.ndarray:
+    """The node indices of the node ids ``refs`` (E, k); ParseError at the first element that
+    names an undefined node, listing up to five (element id, node id) pairs."""
+    if len(sorted_ids):
+        pos = np.searchsorted(sorted_ids, refs).clip(max=len(sorted_ids) - 1)
+        found = sorted_ids[pos] == refs
+        indices = order[pos]
+    else:
+        found = np.zeros(refs.shape, bool)
+        indices = np.zeros(refs.shape, np.int64)
+    if not found.all():
+        bad = np.flatnonzero(~found.all(axis=1))
+        pairs = [(int(element_ids[e]), int(refs[e][~found[e]][0])) for e in bad[:5]]
+        src, row = _locate(chunks, int(bad[0]))
+        listed = ", ".join(f"({e}, {n})" for e, n in pairs)
+        raise src.error(f"{len(bad)} element(s) reference undefined node ids; first "
+                        f"(element id, node id): {listed}", row, keyword)
+    return indices
+
+
+def _check_part_ids(pids: np.ndarray, chunks: list[_Chunk], keyword: str) -> None:
+    """ParseError at the first part id that does not fit in 32 bits (FEMesh keeps int32)."""
+    limits = np.iinfo(np.int32)
+    too_big = (pids < limits.min) | (pids > limits.max)
+    if too_big.any():
+        src, row = _locate(chunks, int(np.argmax(too_big)))
+        raise src.error(f"part id {int(pids[too_big][0])} does not fit in 32 bits", row, keyword)
+
+
 def _unique_or_raise(ids: np.ndarray, chunks: list[_Chunk], what: str):
     """(order, sorted ids) of ``ids``; a repeated id raises ParseError at its second definition."""
     order = np.argsort(ids, kind="stable")
@@ -769,7 +854,7 @@ def _unique_or_raise(ids: np.ndarray, chunks: list[_Chunk], what: str):
         first = int(order[np.searchsorted(sorted_ids, ids[second])])
         src0, row0 = _locate(chunks, first)
         src, row = _locate(chunks, second)
-        keyword = "NODE" if what == "node" else "ELEMENT_SHELL"
+        keyword = {"node": "NODE", "element": "ELEMENT_SHELL"}.get(what, "ELEMENT_SOLID")
         raise src.error(f"{what} id {int(ids[second])} is defined twice (first at "
                         f"{src0.path.name}:{row0 + 1}); {len(repeated)} repeated id(s)", row,
                         keyword)
