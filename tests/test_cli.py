@@ -267,3 +267,17 @@ def test_render_refuses_coordinates_too_far_to_resolve(tmp_path, capsys):
     assert main(["render", str(deck), "-o", str(tmp_path / "x.png")]) == 2
     err = capsys.readouterr().err
     assert "magnitude 1e+20" in err and "translate it nearer the origin" in err
+
+
+def test_a_missing_parameter_is_one_warning_line_and_the_part_still_renders(tmp_path):
+    deck = tmp_path / "part.k"
+    deck.write_text(DECK.replace("*NODE", "*PART\np\n         1         1\n*SECTION_SHELL\n"
+                                          "         1\n&t\n*NODE"))
+    out = tmp_path / "part.png"
+    result = subprocess.run([sys.executable, "-m", "workbench.cli", "render", str(deck),
+                             "--field", "thickness", "--size", "40x30", "-o", str(out)],
+                            capture_output=True, text=True)
+    assert result.returncode == 0 and out.exists()
+    assert result.stderr.strip().splitlines() == [
+        f"workbench: warning: {deck}:7: *SECTION_SHELL: parameter 't' is not defined by "
+        f"*PARAMETER in this deck or its includes: the thickness is missing"]

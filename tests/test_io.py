@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from workbench.data import CAR_DECK, D3PLOT, shared_file
 from workbench.scene.d3plot import mid_surface, von_mises
 from workbench.scene.io import MESHIO_SUFFIXES, ParseError, detect_format, load
+from workbench.scene.parse import ParseWarning
 
 
 # --------------------------------------------------------------------------- writing small decks
@@ -479,12 +480,13 @@ def test_include_errors(tmp_path):
 def test_unsupported_variants_and_parameters(tmp_path):
     with pytest.raises(ParseError, match="ELEMENT_SHELL_COMPOSITE"):
         load(write(tmp_path, "c.k", ["*ELEMENT_SHELL_COMPOSITE", shell(1, 1, 1, 2, 3, 4)]))
-    with pytest.raises(ParseError, match="'tmissing' is not defined") as info:
-        load(write(tmp_path, "p.k", [
+    with pytest.warns(ParseWarning, match="'tmissing' is not defined") as record:
+        mesh = load(write(tmp_path, "p.k", [
             "*PART", "p", "         1         1", "*SECTION_SHELL", "         1",
             "&tmissing", "*NODE", *[node(*n) for n in SQUARE], "*ELEMENT_SHELL",
             shell(1, 1, 101, 102, 103, 104)]))
-    assert info.value.line == 6
+    assert record[0].message.line == 6
+    assert np.isnan(mesh.element_fields["thickness"]).all()  # missing, the geometry drawn
 
 
 def test_unknown_suffix_and_missing_file(tmp_path):
@@ -810,3 +812,77 @@ def test_solid_refusals_name_the_card(tmp_path):
     ortho = [line.replace("*ELEMENT_SOLID", "*ELEMENT_SOLID_ORTHO") for line in lines]
     with pytest.raises(ParseError, match="not supported"):
         load(write(tmp_path, "ortho.k", ortho))
+
+
+# --------------------------------------------------------------------------- parameters
+def _sectioned_part(thickness_card: str) -> list[str]:
+    return ["*PART", "p", "         1         1", "*SECTION_SHELL", "         1",
+            thickness_card]
+
+
+def test_include_uses_the_parameters_of_the_including_deck(tmp_path):
+    """An included file's ``&t`` is defined by the deck that includes it: read through that
+    deck the thickness is there; read alone the geometry still draws, thickness NaN, with one
+    warning naming file, line and parameter."""
+    part = write(tmp_path, "part.k", [*_sectioned_part("&t"), "*NODE",
+                                      *[node(*n) for n in SQUARE], "*ELEMENT_SHELL",
+                                      shell(1, 1, 101, 102, 103, 104)])
+    master = write(tmp_path, "master.k", ["*KEYWORD", "*PARAMETER", "R t       1.25",
+                                          "*INCLUDE", "part.k", "*END"])
+    mesh = load(master)
+    assert mesh.element_fields["thickness"].tolist() == [1.25]
+    with pytest.warns(ParseWarning) as record:
+        alone = load(part)
+    assert [str(w.message) for w in record] == [
+        f"{part}:6: *SECTION_SHELL: parameter 't' is not defined by *PARAMETER in this deck or "
+        f"its includes: the thickness is missing"]
+    assert np.array_equal(alone.nodes, mesh.nodes) and np.isnan(alone.element_fields["thickness"]).all()
+
+
+def test_rendering_a_missing_thickness_draws_the_base_colour(tmp_path):
+    from workbench.experiment.measure import measure
+    from workbench.gl import create_context
+    from workbench.paths import Style, make_path
+
+    part = write(tmp_path, "part.k", [*_sectioned_part("&t"), "*NODE",
+                                      *[node(*n) for n in SQUARE], "*ELEMENT_SHELL",
+                                      shell(1, 1, 101, 102, 103, 104)])
+    with pytest.warns(ParseWarning):
+        mesh = load(part)
+    ctx = create_context()
+    path = make_path("element_color", Style(field="thickness", value_range=(0.0, 1.0)))
+    m = measure(ctx, mesh, path, size=(32, 32), timed=False)
+    assert path.missing_values == 1
+    drawn = m.image[(m.image[..., :3] != 255).any(axis=-1)][:, :3].astype(float)
+    base = np.array(Style().base_color) * 255
+    # the lit base colour (a grey-blue times the headlight), no colour of the scale
+    light = drawn.sum(axis=1, keepdims=True) / base.sum()
+    assert len(drawn) and (np.abs(drawn - light * base) <= 1.5).all()
+
+
+@pytest.mark.parametrize("lines, expected", [
+    (["*PARAMETER", "R a       2.0", "*PARAMETER_EXPRESSION", "R t       2*a+0.5"], 4.5),
+    (["*PARAMETER_EXPRESSION", "R t,sqrt(&a)*max(1.0,a)", "*PARAMETER", "R a       4.0"], 8.0),
+    (["*PARAMETER", "R a       3.0", "*PARAMETER_EXPRESSION", "R t       a^2/(a-1)"], 4.5),
+    (["*PARAMETER", "R a       -1.5", "*PARAMETER_EXPRESSION", "R t       -a"], 1.5),
+])
+def test_parameter_expressions_are_evaluated(tmp_path, lines, expected):
+    path = write(tmp_path, "expr.k", [*lines, *_sectioned_part("&t"), "*NODE",
+                                      *[node(*n) for n in SQUARE], "*ELEMENT_SHELL",
+                                      shell(1, 1, 101, 102, 103, 104)])
+    assert load(path).element_fields["thickness"][0] == pytest.approx(expected)
+
+
+def test_negated_parameter_and_bad_expressions(tmp_path):
+    body = ["*NODE", *[node(*n) for n in SQUARE], "*ELEMENT_SHELL", shell(1, 1, 101, 102, 103, 104)]
+    mesh = load(write(tmp_path, "neg.k", ["*PARAMETER", "R t       -2.0", *_sectioned_part("-&t"),
+                                          *body]))
+    assert mesh.element_fields["thickness"][0] == 2.0
+    with pytest.raises(ParseError, match="defined through itself") as info:
+        load(write(tmp_path, "cycle.k", ["*PARAMETER_EXPRESSION", "R t       u+1",
+                                         "R u       t*2", *_sectioned_part("&t"), *body]))
+    assert info.value.line in (2, 3)
+    with pytest.raises(ParseError, match="cannot evaluate") as info:
+        load(write(tmp_path, "call.k", ["*PARAMETER_EXPRESSION", "R t       __import__(1)",
+                                        *_sectioned_part("&t"), *body]))
+    assert info.value.line == 2

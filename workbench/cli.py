@@ -10,6 +10,7 @@ import argparse
 import math
 import os
 import sys
+import warnings
 from importlib import metadata
 from pathlib import Path
 
@@ -343,10 +344,19 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A reader's warning as one line on stderr (what was read as missing, and where)."""
+    print(f"workbench: warning: {message}", file=sys.stderr if file is None else file)
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     from .gl.context import GLUnavailable
     from .scene.mesh import MeshError
+    from .scene.parse import ParseWarning
+
+    warnings.simplefilter("always", ParseWarning)  # every missing value, not the first only
+    warnings.showwarning = _show_warning
 
     try:
         return args.func(args)

@@ -37,8 +37,11 @@ per-card Python path only runs for free-format cards and to locate an error.
 
 from __future__ import annotations
 
+import ast
 import math
+import operator
 import re
+import warnings
 from dataclasses import dataclass, field
 from operator import itemgetter
 from pathlib import Path
@@ -46,7 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from .mesh import FEMesh
-from .parse import ParseError, build_mesh
+from .parse import ParseError, ParseWarning, build_mesh
 
 # Card layouts in standard-format column widths; I10 widens fields under 10 to 10, long to 20.
 _NODE = (8, 16, 16, 16, 8, 8)
@@ -338,6 +341,63 @@ def _check_complete(block: _Block, row: int, widths, fields: list[_Field], span:
                           "it was cut off", row)
 
 
+class _Undefined(LookupError):
+    """A parameter that no *PARAMETER of the deck defines (its name in ``args[0]``)."""
+
+
+_FUNCTIONS = {"sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin,
+              "acos": math.acos, "atan": math.atan, "atan2": math.atan2, "sqrt": math.sqrt,
+              "exp": math.exp, "log": math.log, "log10": math.log10, "abs": abs, "min": min,
+              "max": max, "mod": math.fmod, "int": lambda x: float(math.trunc(x)),
+              "nint": lambda x: float(round(x)), "sign": math.copysign,
+              "sinh": math.sinh, "cosh": math.cosh, "tanh": math.tanh}
+_OPERATORS = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+              ast.Div: operator.truediv, ast.Pow: operator.pow, ast.USub: operator.neg,
+              ast.UAdd: operator.pos}
+
+
+@dataclass
+class _Expression:
+    """A ``*PARAMETER_EXPRESSION`` right-hand side: arithmetic (+ − * / ** or ^) of numbers,
+    other parameters (by name, or ``&name``) and the functions of :data:`_FUNCTIONS`."""
+
+    text: str
+    src: "_Source"
+    row: int
+
+    def evaluate(self, lookup) -> float:
+        """The float value, names resolved by ``lookup(name)``; ParseError for anything else
+        (unknown functions, text, division by zero), naming the expression's line."""
+        source = self.text.replace("&", "").replace("^", "**")
+        try:
+            tree = ast.parse(source, mode="eval")
+            return float(self._value(tree.body, lookup))
+        except _Undefined:
+            raise
+        except ParseError:
+            raise
+        except (SyntaxError, ValueError, TypeError, ZeroDivisionError, OverflowError) as exc:
+            raise self.src.error(f"cannot evaluate the expression {self.text!r}: {exc}",
+                                 self.row, "PARAMETER_EXPRESSION") from None
+
+    def _value(self, node, lookup):
+        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)):
+            return node.value
+        if isinstance(node, ast.Name):
+            if node.id.lower() == "pi":
+                return math.pi
+            return lookup(node.id)
+        if isinstance(node, ast.BinOp) and type(node.op) in _OPERATORS:
+            return _OPERATORS[type(node.op)](self._value(node.left, lookup),
+                                             self._value(node.right, lookup))
+        if isinstance(node, ast.UnaryOp) and type(node.op) in _OPERATORS:
+            return _OPERATORS[type(node.op)](self._value(node.operand, lookup))
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
+                and node.func.id.lower() in _FUNCTIONS and not node.keywords:
+            return _FUNCTIONS[node.func.id.lower()](*(self._value(a, lookup) for a in node.args))
+        raise ValueError(f"{ast.unparse(node)!r} is not arithmetic of numbers and parameters")
+
+
 # --------------------------------------------------------------------------- the deck
 @dataclass
 class _Chunk:
@@ -380,6 +440,7 @@ class _Deck:
     sections: dict[object, _Section] = field(default_factory=dict)
     parameters: dict[str, object] = field(default_factory=dict)
     skipped: dict[str, int] = field(default_factory=dict)
+    sections_used: bool = False  # a part's *SECTION_SHELL gave the thickness of its shells
 
     # ------------------------------------------------------------- files and blocks
     def read_file(self, path: Path, fmt: str | None) -> None:
@@ -605,10 +666,15 @@ class _Deck:
             line = block.src.lines[row]
             if not line.strip():
                 continue
-            if expressions:  # the name only: the expression itself may hold commas
-                head = line[:field_width(10, block.fmt)]
-                names = [head.split(b",")[0] if b"," in head else head]
-                values = [None]
+            if expressions:  # a name, then the expression (which may hold commas itself)
+                if b"," in line[:field_width(10, block.fmt)]:
+                    head, expression = line.split(b",", 1)
+                else:
+                    width = field_width(10, block.fmt)
+                    head, expression = line[:width], line[width:]
+                names = [head]
+                values = [_Expression(expression.decode("utf-8", "replace").strip(),
+                                      block.src, row)]
             else:
                 texts = _card_fields(line, _TEN, block.fmt)
                 names, values = texts[0::2], texts[1::2]
@@ -621,8 +687,8 @@ class _Deck:
                     name = name[1:].strip()
                 else:
                     kind = "R"
-                if value is None:
-                    self.parameters[name] = None  # expression: not evaluated here
+                if isinstance(value, _Expression):
+                    self.parameters[name] = value  # evaluated when used
                 elif kind == "C":
                     self.parameters[name] = value.decode("utf-8", "replace").strip()
                 else:
@@ -633,29 +699,49 @@ class _Deck:
                                           f"{_shown(value)!r}", row) from None
 
     def _parameter(self, text: bytes, src: _Source, row: int) -> float:
-        """A section thickness field: a number or a (signed) ``&name`` reference; NaN when the
-        parameter is defined by an expression."""
+        """A section thickness field: a number or a (signed) ``&name`` reference, evaluated
+        when its parameter is an expression. A parameter defined nowhere (an include read on its
+        own, whose including deck defines it) is NaN with a :class:`ParseWarning` naming file,
+        line and parameter: the geometry is still drawn, the thickness is missing."""
         text = text.strip()
         sign = -1.0 if text.startswith(b"-") else 1.0
         if text.lstrip(b"+-").startswith(b"&"):
             name = text.lstrip(b"+-")[1:].decode("utf-8", "replace").strip()
-            if name not in self.parameters:
-                folded = {k.lower(): k for k in self.parameters}
-                if name.lower() not in folded:
-                    raise src.error(f"parameter {name!r} is not defined by *PARAMETER", row,
-                                    "SECTION_SHELL")
-                name = folded[name.lower()]
-            value = self.parameters[name]
-            if value is None:
+            try:
+                value = self._parameter_value(name, src, row, ())
+            except _Undefined as undefined:
+                warnings.warn(ParseWarning(src.path, f"parameter {undefined.args[0]!r} is not "
+                                           f"defined by *PARAMETER in this deck or its includes: "
+                                           f"the thickness is missing", row + 1,
+                                           "SECTION_SHELL"), stacklevel=2)
                 return float("nan")
-            if not isinstance(value, float):
-                raise src.error(f"parameter {name!r} is not a number", row, "SECTION_SHELL")
             return sign * value
         try:
             return _convert(text, "f")
         except ValueError:
             raise src.error(f"expected a thickness, got {_shown(text)!r}", row,
                             "SECTION_SHELL") from None
+
+    def _parameter_value(self, name: str, src: _Source, row: int, chain: tuple) -> float:
+        """The number parameter ``name`` stands for (names are case-insensitive), evaluating
+        ``*PARAMETER_EXPRESSION`` arithmetic; _Undefined for a name defined nowhere, ParseError
+        for a text parameter, a bad expression or a cycle."""
+        if name not in self.parameters:
+            folded = {k.lower(): k for k in self.parameters}
+            if name.lower() not in folded:
+                raise _Undefined(name)
+            name = folded[name.lower()]
+        value = self.parameters[name]
+        if isinstance(value, _Expression):
+            if name in chain:
+                raise value.src.error(f"parameter {name!r} is defined through itself: "
+                                      f"{' -> '.join((*chain, name))}", value.row,
+                                      "PARAMETER_EXPRESSION")
+            value = value.evaluate(lambda n: self._parameter_value(n, src, row, (*chain, name)))
+            self.parameters[name] = value
+        if not isinstance(value, float):
+            raise src.error(f"parameter {name!r} is not a number", row, "SECTION_SHELL")
+        return value
 
     # ------------------------------------------------------------- assembly
     def build(self, units: str, all_faces: bool = False) -> FEMesh:
@@ -709,8 +795,8 @@ class _Deck:
             thickness = np.concatenate([thickness, np.full(len(faces), np.nan)])
 
         element_fields = {}
-        if np.isfinite(thickness).any():
-            element_fields["thickness"] = thickness
+        if np.isfinite(thickness).any() or self.sections_used:  # a section gave no number:
+            element_fields["thickness"] = thickness  # missing (NaN), not absent
         used_parts = set(np.unique(pids).tolist())
         part_names = {pid: part.title for pid, part in self.parts.items()
                       if part.title and pid in used_parts}
@@ -733,6 +819,7 @@ class _Deck:
                           for text in section.thickness])
             t[1:][t[1:] == 0] = t[0]  # T2..T4 default to T1
             section_of_part[pid] = t
+        self.sections_used = bool(section_of_part)
         fallback = np.full((len(pids), 4), np.nan)
         if section_of_part:
             table = np.array([section_of_part.get(p, [np.nan] * 4) for p in unique.tolist()])

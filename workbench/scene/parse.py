@@ -1,4 +1,5 @@
-"""What every mesh reader shares: the :class:`ParseError` refusal and :func:`build_mesh`.
+"""What every mesh reader shares: the :class:`ParseError` refusal, the :class:`ParseWarning`
+for what a reader reads as missing, and :func:`build_mesh`.
 
 The readers (:mod:`workbench.scene.keyword`, :mod:`workbench.scene.d3plot` and the meshio and
 trimesh readers in :mod:`workbench.scene.io`) import from here, and :mod:`workbench.scene.io`
@@ -41,6 +42,17 @@ class ParseError(ValueError):
 
     def __reduce__(self):
         return (type(self), (self.path, self.message, self.line, self.card, self.keyword))
+
+
+class ParseWarning(UserWarning):
+    """Something a reader could not read and kept as missing (NaN) instead of refusing the
+    file: ``str()`` reads ``"file.k:12: *SECTION_SHELL: parameter 't1' is not defined ..."``.
+    Issued with :func:`warnings.warn`; ``workbench`` prints each as one line on stderr."""
+
+    def __init__(self, path, message: str, line: int | None = None, keyword: str | None = None):
+        self.path, self.message, self.line, self.keyword = Path(path), message, line, keyword
+        where = str(self.path) if line is None else f"{self.path}:{line}"
+        super().__init__(f"{where}: " + (f"*{keyword}: " if keyword else "") + message)
 
 
 def build_mesh(path, **kwargs) -> FEMesh:
