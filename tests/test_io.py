@@ -886,3 +886,22 @@ def test_negated_parameter_and_bad_expressions(tmp_path):
         load(write(tmp_path, "call.k", ["*PARAMETER_EXPRESSION", "R t       __import__(1)",
                                         *_sectioned_part("&t"), *body]))
     assert info.value.line == 2
+
+
+def test_missing_or_extra_card_in_a_thickness_block_is_reported_where_it_breaks(tmp_path):
+    elements = []
+    for eid in range(1, 41):
+        elements += [shell(eid, 1, 101, 102, 103, 104),
+                     "             1.0             1.0             1.0             1.0"]
+    missing = elements[:9] + elements[10:]  # element 5 lost its thickness card (line 9 + 5)
+    path = write(tmp_path, "missing.k", ["*NODE", *[node(*n) for n in SQUARE],
+                                         "*ELEMENT_SHELL_THICKNESS", *missing])
+    with pytest.raises(ParseError, match="a card is missing or extra before this line") as info:
+        load(path)
+    assert info.value.line == 7 + 10  # element 6's card, where the thickness card belongs
+    extra = elements[:20] + [elements[1]] + elements[20:]
+    path = write(tmp_path, "extra.k", ["*NODE", *[node(*n) for n in SQUARE],
+                                       "*ELEMENT_SHELL_THICKNESS", *extra])
+    with pytest.raises(ParseError, match="an element card") as info:
+        load(path)
+    assert info.value.line == 7 + 21

@@ -579,6 +579,11 @@ class _Deck:
         per_element = 1 + has_thickness + ("OFFSET" in options)
         rows = block.trimmed(per_element) if per_element > 1 else block.rows
         if len(rows) % per_element:
+            broken = _first_break(block, rows, per_element)
+            if broken is not None:
+                row, expected = broken
+                raise block.error(f"expected {expected}: a card is missing or extra before this "
+                                  f"line ({per_element} cards per element)", row)
             start = int(rows[len(rows) - len(rows) % per_element])
             raise block.error(f"expected {per_element} cards per element, the block ends "
                               f"after {len(rows) % per_element}", start)
@@ -828,6 +833,20 @@ class _Deck:
         nodal = np.where(use_section, fallback, nodal)
         triangle = elements[:, 3] == elements[:, 2]
         return np.where(triangle, nodal[:, :3].mean(axis=1), nodal.mean(axis=1))
+
+
+def _first_break(block: _Block, rows: np.ndarray, per_element: int) -> tuple[int, str] | None:
+    """(line, what was expected) of the first card of a multi-card element block whose kind
+    breaks the record layout — an element card (integer element and part ids) where a
+    following card belongs, or the reverse — or None when every card looks right."""
+    for k, row in enumerate(rows.tolist()):
+        texts = _card_fields(block.src.lines[row], _SHELL, block.fmt)[:2]
+        element_like = all(t.strip().lstrip(b"+-").isdigit() and int(t) != 0 for t in texts)
+        if k % per_element == 0 and not element_like:
+            return row, "an element card (element id, part id, n1..n4)"
+        if k % per_element and element_like:
+            return row, "the element's next card (thicknesses or offset), not an element card"
+    return None
 
 
 def _eight_node(block: _Block, cards: np.ndarray) -> int | None:
