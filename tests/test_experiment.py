@@ -13,6 +13,7 @@ from workbench.experiment import (EXPERIMENTS, PyrenderReference, Timing, atomic
                                   markdown_table, read_table, run_experiment, save_field_figure,
                                   save_image_grid, save_png, time_call, time_draw, write_table)
 from workbench.experiment import tables as tables_module
+from workbench.experiment.registry import clean_dead_runs
 from workbench.experiment.figures import MIN_PANEL_HEIGHT
 from workbench.experiment.measure import measure
 from workbench.gl import Camera, Framebuffer, create_context
@@ -320,7 +321,10 @@ def test_run_experiment_writes_table(tmp_path):
                                        progress=messages.append)
     finally:
         del EXPERIMENTS["dummy-harness-check"]
-    assert out_dir == tmp_path / "figures" / "dummy-harness-check" == seen["out_dir"]
+    assert out_dir == tmp_path / "figures" / "dummy-harness-check"
+    # the experiment wrote into a staging folder beside it, swapped in whole afterwards
+    assert seen["out_dir"].parent == out_dir.parent and not seen["out_dir"].exists()
+    assert sorted(p.name for p in out_dir.parent.iterdir()) == ["dummy-harness-check"]
     assert seen["quick"] is True and messages == ["halfway"]
     assert read_table(out_dir / "table.csv") == [{"case": "a", "ms": 1.5, "extra": None},
                                                  {"case": "b", "ms": 2.5, "extra": 3}]
@@ -538,3 +542,40 @@ def test_tables_are_written_with_ordinary_permissions(tmp_path):
         os.umask(mask)
     for path in (csv_path, md_path):
         assert stat.S_IMODE(path.stat().st_mode) == 0o644
+
+
+def test_experiment_outputs_are_replaced_as_a_set(tmp_path):
+    """A run that fails leaves the previous outputs whole; a killed run's leftovers (staging
+    folder, the previous folder set aside, temporary files) are cleaned by the next run."""
+    calls = []
+
+    @experiment("dummy-set", "outputs as a set")
+    def run(out_dir, quick, progress):
+        calls.append(out_dir)
+        (out_dir / "figure.txt").write_text(f"run {len(calls)}")
+        if len(calls) == 2:
+            raise RuntimeError("failed halfway")
+        return [{"run": len(calls)}]
+
+    root = tmp_path / "figures"
+    try:
+        _, out_dir = run_experiment("dummy-set", root)
+        with pytest.raises(RuntimeError):
+            run_experiment("dummy-set", root)
+        assert (out_dir / "figure.txt").read_text() == "run 1"  # the previous set, whole
+        assert read_table(out_dir / "table.csv") == [{"run": 1}]
+        assert sorted(p.name for p in root.iterdir()) == ["dummy-set"]
+        # leftovers of a run killed between the two renames: the output folder set aside
+        dead = 2**22 + 12345  # no such process
+        (root / "dummy-set").rename(root / f".dummy-set.{dead}.old")
+        (root / f".dummy-set.abc.{dead}.partial").mkdir()
+        assert {p.name for p in clean_dead_runs(root, "dummy-set")} == {
+            f".dummy-set.{dead}.old", f".dummy-set.abc.{dead}.partial"}
+        assert (root / "dummy-set" / "figure.txt").read_text() == "run 1"  # put back
+        (root / "dummy-set" / ".table.csv.x1y2.tmp").write_text("half")
+        rows, out_dir = run_experiment("dummy-set", root)
+        assert rows == [{"run": 3}] and (out_dir / "figure.txt").read_text() == "run 3"
+        assert sorted(p.name for p in out_dir.iterdir()) == ["figure.txt", "table.csv", "table.md"]
+        assert sorted(p.name for p in root.iterdir()) == ["dummy-set"]
+    finally:
+        del EXPERIMENTS["dummy-set"]

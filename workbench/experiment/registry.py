@@ -8,9 +8,13 @@ An experiment script in the top-level ``experiments/`` folder (the package
 
 from __future__ import annotations
 
+import glob
 import importlib
+import os
 import pkgutil
 import re
+import shutil
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -94,22 +98,84 @@ def run_experiment(name: str, figures_root: Path = Path("figures"), quick: bool 
                    progress: Progress | None = None) -> tuple[list[dict], Path]:
     """Run experiment ``name`` into ``figures_root/<name>/`` and write its table there.
 
-    Creates the folder, calls the experiment's function, writes ``table.csv`` and ``table.md``
-    (atomically, titled with the name and description) and returns ``(rows, out_dir)``.
+    The experiment writes into a fresh staging folder beside the output folder
+    (``.<name>.<random>.<pid>.partial``); its ``table.csv`` and ``table.md`` (titled with the
+    name and description) go there too, and only then does the staging folder replace the
+    output folder, so a run's outputs change as a set: a run that fails or is killed leaves the
+    previous outputs whole. What killed runs left behind (staging folders, a previous output
+    folder set aside, temporary files) is cleaned up first. Returns ``(rows, out_dir)``.
     Unknown names raise KeyError listing the known ones; rows that are not dicts raise TypeError.
     """
     exp = get_experiment(name)
-    out_dir = Path(figures_root) / exp.name
-    out_dir.mkdir(parents=True, exist_ok=True)
-    rows = exp.function(out_dir, bool(quick), progress)
-    if rows is None:
-        raise TypeError(f"experiment {name!r} returned None instead of a list of rows")
-    rows = list(rows)
-    bad = [type(r).__name__ for r in rows if not isinstance(r, dict)]
-    if bad:
-        raise TypeError(f"experiment {name!r} returned rows that are not dicts: {bad[:3]}")
-    write_table(rows, out_dir, "table", title=f"{exp.name}: {exp.description}")
+    root = Path(figures_root)
+    root.mkdir(parents=True, exist_ok=True)
+    out_dir = root / exp.name
+    clean_dead_runs(root, exp.name)
+    staging = Path(tempfile.mkdtemp(dir=root, prefix=f".{exp.name}.",
+                                    suffix=f".{os.getpid()}.partial"))
+    try:
+        rows = exp.function(staging, bool(quick), progress)
+        if rows is None:
+            raise TypeError(f"experiment {name!r} returned None instead of a list of rows")
+        rows = list(rows)
+        bad = [type(r).__name__ for r in rows if not isinstance(r, dict)]
+        if bad:
+            raise TypeError(f"experiment {name!r} returned rows that are not dicts: {bad[:3]}")
+        write_table(rows, staging, "table", title=f"{exp.name}: {exp.description}")
+        _swap_in(staging, out_dir)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
     return rows, out_dir
+
+
+def _swap_in(staging: Path, out_dir: Path) -> None:
+    """Put ``staging`` in the place of ``out_dir``: the previous folder is set aside as
+    ``.<name>.<pid>.old`` first and removed last (a kill in between leaves it for
+    :func:`clean_dead_runs` to put back)."""
+    if not out_dir.exists():
+        os.replace(staging, out_dir)
+        return
+    old = out_dir.with_name(f".{out_dir.name}.{os.getpid()}.old")
+    shutil.rmtree(old, ignore_errors=True)
+    os.replace(out_dir, old)
+    os.replace(staging, out_dir)
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def clean_dead_runs(root: Path, name: str) -> list[Path]:
+    """Remove what runs of experiment ``name`` that died left in ``root``: their staging
+    folders, temporary files in the output folder, and a previous output folder set aside (put
+    back when the output folder is missing, i.e. the run died between the two renames).
+    Folders of runs still alive are left alone. Returns what was removed or restored."""
+    done = []
+    out_dir = root / name
+    for entry in sorted(root.glob(f".{glob.escape(name)}.*")):
+        parts = entry.name.rsplit(".", 2)
+        if len(parts) != 3 or parts[2] not in ("partial", "old") or not parts[1].isdigit():
+            continue
+        if _alive(int(parts[1])) and int(parts[1]) != os.getpid():
+            continue
+        if parts[2] == "old" and not out_dir.exists():
+            os.replace(entry, out_dir)
+        else:
+            shutil.rmtree(entry, ignore_errors=True)
+        done.append(entry)
+    if out_dir.is_dir():
+        for tmp in out_dir.glob(".*.tmp"):
+            tmp.unlink(missing_ok=True)
+            done.append(tmp)
+    return done
 
 
 def main(name: str, description: str, argv: list[str] | None = None) -> int:
