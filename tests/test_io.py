@@ -905,3 +905,30 @@ def test_missing_or_extra_card_in_a_thickness_block_is_reported_where_it_breaks(
     with pytest.raises(ParseError, match="an element card") as info:
         load(path)
     assert info.value.line == 7 + 21
+
+
+@pytest.mark.skipif(shared_file(D3PLOT) is None, reason="shared d3plot absent")
+@pytest.mark.parametrize("fraction, status", [(0.5, 2), (0.8, 0)])
+def test_damaged_d3plot_says_what_is_missing_in_one_line_each(tmp_path, fraction, status):
+    """lasso-python logs tracebacks for the sections it gives up on; the workbench reports each
+    as one line (a warning when the mesh is still read, within the error otherwise)."""
+    import subprocess
+    import sys
+
+    data = shared_file(D3PLOT).read_bytes()
+    damaged = tmp_path / "d3plot"
+    damaged.write_bytes(data[:int(len(data) * fraction)])
+    result = subprocess.run([sys.executable, "-m", "workbench.cli", "render", str(damaged),
+                             "--size", "40x30", "-o", str(tmp_path / "x.png")],
+                            capture_output=True, text=True)
+    assert result.returncode == status
+    lines = result.stderr.strip().splitlines()
+    assert "Traceback" not in result.stderr and lines
+    assert all(line.startswith("workbench: warning: " if status == 0 else "workbench: error: ")
+               for line in lines)
+    assert all("lasso-python could not read" in line for line in lines)
+    if status == 0:
+        with pytest.warns(ParseWarning, match="lasso-python could not read") as record:
+            mesh = load(damaged)
+        assert any("_read_user_ids" in str(w.message) for w in record)
+        assert mesh.element_ids is None  # the ids were in the section that failed

@@ -26,11 +26,12 @@ from __future__ import annotations
 import logging
 import re
 from pathlib import Path
+from warnings import warn as _warn
 
 import numpy as np
 
 from .mesh import FEMesh
-from .parse import ParseError, build_mesh
+from .parse import ParseError, ParseWarning, build_mesh
 
 RIGID_MATERIAL_TYPE = 20
 
@@ -83,6 +84,7 @@ def read_d3plot(path, units: str = "mm") -> FEMesh:
     warnings = _LassoWarnings()
     logger = logging.getLogger("lasso")
     logger.addHandler(warnings)
+    propagate, logger.propagate = logger.propagate, False  # its tracebacks are ours to report
     try:
         plot = D3plot(str(path))
     except Exception as exc:  # lasso raises many types; all mean "cannot read this file"
@@ -90,6 +92,7 @@ def read_d3plot(path, units: str = "mm") -> FEMesh:
                                f"{str(exc).strip()}") from exc
     finally:
         logger.removeHandler(warnings)
+        logger.propagate = propagate
     arrays = plot.arrays
 
     def need(key):
@@ -148,12 +151,16 @@ def read_d3plot(path, units: str = "mm") -> FEMesh:
 
     node_ids = arrays.get(ArrayType.node_ids)
     element_ids = arrays.get(ArrayType.element_shell_ids)
-    return build_mesh(
+    mesh = build_mesh(
         path, nodes=nodes, elements=np.asarray(connectivity, dtype=np.int64), parts=parts,
         steps=steps, times=times, element_fields=fields, part_names=part_names,
         node_ids=None if node_ids is None else np.asarray(node_ids, dtype=np.int64),
         element_ids=None if element_ids is None else np.asarray(element_ids, dtype=np.int64),
         name=path.name, units=units)
+    for failure in warnings.failures:  # read, but with sections missing: say which
+        _warn(ParseWarning(path, f"lasso-python could not read {failure}: what it holds is "
+                                 f"missing"), stacklevel=2)
+    return mesh
 
 
 def _part_ids(arrays, part_index: np.ndarray, ArrayType) -> tuple[np.ndarray, dict[int, str]]:
@@ -187,10 +194,26 @@ class _LassoWarnings(logging.Handler):
 
     def __init__(self):
         super().__init__(logging.WARNING)
-        self.messages: list[str] = []
+        self.records: list[logging.LogRecord] = []
 
     def emit(self, record: logging.LogRecord) -> None:
-        self.messages.append(record.getMessage().splitlines()[0])
+        self.records.append(record)
+
+    @property
+    def failures(self) -> list[str]:
+        """One phrase per section lasso-python gave up on: what it was reading and why (the
+        last line of the traceback it logged)."""
+        out = []
+        for record in self.records:
+            text = record.getMessage()
+            if record.exc_info and record.exc_info[1] is not None:
+                text += f"\n{type(record.exc_info[1]).__name__}: {record.exc_info[1]}"
+            lines = [line.strip() for line in text.splitlines() if line.strip()]
+            what = re.sub(r"^A failure in (.*?) was caught:?$", r"\1", lines[0])
+            why = lines[-1] if len(lines) > 1 else ""
+            out.append(f"{what} ({why})" if why else what)
+        return out
 
     def summary(self) -> str:
-        return f" (lasso-python: {'; '.join(self.messages[:3])})" if self.messages else ""
+        failures = self.failures
+        return f" (lasso-python could not read {'; '.join(failures[:3])})" if failures else ""
