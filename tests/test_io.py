@@ -932,3 +932,45 @@ def test_damaged_d3plot_says_what_is_missing_in_one_line_each(tmp_path, fraction
             mesh = load(damaged)
         assert any("_read_user_ids" in str(w.message) for w in record)
         assert mesh.element_ids is None  # the ids were in the section that failed
+
+
+def write_solid_d3plot(folder):
+    """Two 1 mm hexahedra side by side (part 3) and one shell on top of them (part 5)."""
+    from lasso.dyna import ArrayType, D3plot
+
+    plot = D3plot()
+    coords = np.array([[i, j, k] for k in (0, 1) for j in (0, 1) for i in (0, 1, 2)], np.float32)
+    plot.arrays[ArrayType.node_coordinates] = coords
+    n = lambda i, j, k: i + 3 * (j + 2 * k)  # noqa: E731
+    plot.arrays[ArrayType.element_solid_node_indexes] = np.array(
+        [[n(i, 0, 0), n(i + 1, 0, 0), n(i + 1, 1, 0), n(i, 1, 0),
+          n(i, 0, 1), n(i + 1, 0, 1), n(i + 1, 1, 1), n(i, 1, 1)] for i in (0, 1)], np.int32)
+    plot.arrays[ArrayType.element_solid_part_indexes] = np.array([0, 0], np.int32)
+    plot.arrays[ArrayType.element_solid_ids] = np.array([11, 12], np.int32)
+    plot.arrays[ArrayType.element_shell_node_indexes] = np.array(
+        [[n(0, 0, 1), n(1, 0, 1), n(1, 1, 1), n(0, 1, 1)]], np.int32)
+    plot.arrays[ArrayType.element_shell_part_indexes] = np.array([1], np.int32)
+    plot.arrays[ArrayType.element_shell_ids] = np.array([7], np.int32)
+    plot.arrays[ArrayType.part_ids] = np.array([3, 5], np.int32)
+    plot.arrays[ArrayType.global_timesteps] = np.array([0.0, 1.0], np.float32)
+    plot.arrays[ArrayType.node_displacement] = np.stack([coords, coords * 2]).astype(np.float32)
+    plot.arrays[ArrayType.element_shell_thickness] = np.full((2, 1), 0.5, np.float32)
+    path = folder / "d3plot"
+    plot.write_d3plot(str(path))
+    return path
+
+
+def test_d3plot_with_solids_reads_their_boundary_and_renders(tmp_path):
+    path = write_solid_d3plot(tmp_path)
+    mesh = load(path)
+    assert mesh.n_elements == 1 + 10  # the shell, and the 10 outer quads of the two hexes
+    assert mesh.parts.tolist() == [5] + [3] * 10
+    assert mesh.element_ids[0] == 7 and set(mesh.element_ids[1:].tolist()) == {11, 12}
+    thickness = mesh.element_fields["thickness"]
+    assert np.allclose(thickness[:, 0], 0.5) and np.isnan(thickness[:, 1:]).all()
+    assert mesh.steps.shape == (2, 12, 3)
+    assert load(path, all_faces=True).n_elements == 1 + 12
+    from workbench.cli import main
+
+    assert main(["render", str(path), "--field", "thickness", "--size", "48x36",
+                 "-o", str(tmp_path / "solid.png")]) == 0

@@ -68,11 +68,13 @@ def mid_surface(values: np.ndarray, layer_axis: int = 2) -> np.ndarray:
     return pair.mean(axis=layer_axis)
 
 
-def read_d3plot(path, units: str = "mm") -> FEMesh:
+def read_d3plot(path, units: str = "mm", all_faces: bool = False) -> FEMesh:
     """Read a d3plot family (``d3plot``, ``d3plot01``, ...) into an :class:`FEMesh` with steps.
 
     ``path`` is the first file of the family; a later member (``d3plot01``) is read from the
     first one beside it. See the module notes for the fields. ``units`` labels the coordinates.
+    Solid elements are drawn by their boundary faces (every face with ``all_faces``), each
+    keeping its solid's id and part; the shell fields are NaN on them.
     """
     from lasso.dyna import ArrayType, D3plot
 
@@ -101,12 +103,35 @@ def read_d3plot(path, units: str = "mm") -> FEMesh:
         return arrays[key]
 
     nodes = np.asarray(need(ArrayType.node_coordinates), dtype=np.float64)
-    connectivity = np.asarray(arrays.get(ArrayType.element_shell_node_indexes, np.zeros((0, 4))))
-    if len(connectivity) == 0:
-        raise ParseError(path, "no shell elements in the d3plot (beams, solids and thick "
+    connectivity = np.asarray(arrays.get(ArrayType.element_shell_node_indexes, np.zeros((0, 4))),
+                              dtype=np.int64)
+    solids = np.asarray(arrays.get(ArrayType.element_solid_node_indexes, np.zeros((0, 8))),
+                        dtype=np.int64)
+    if len(connectivity) == 0 and len(solids) == 0:
+        raise ParseError(path, "no shell or solid elements in the d3plot (beams and thick "
                                "shells are not read)" + warnings.summary())
     n_shells = len(connectivity)
-    part_index = np.asarray(need(ArrayType.element_shell_part_indexes), dtype=np.int64)
+    part_index = np.asarray(need(ArrayType.element_shell_part_indexes) if n_shells
+                            else np.zeros(0), dtype=np.int64)
+    element_ids = arrays.get(ArrayType.element_shell_ids)
+    element_ids = None if element_ids is None else np.asarray(element_ids, dtype=np.int64)
+    if len(solids):  # drawn by their boundary faces (every face with all_faces)
+        from .solids import boundary_surface
+
+        solid_part_index = np.asarray(need(ArrayType.element_solid_part_indexes), np.int64)
+        try:
+            faces, face_part_index, face_of = boundary_surface(solids, nodes, solid_part_index,
+                                                               all_faces)
+        except ValueError as exc:
+            raise ParseError(path, f"solid elements: {exc}") from None
+        connectivity = np.concatenate([connectivity, faces])
+        part_index = np.concatenate([part_index, face_part_index])
+        solid_ids = arrays.get(ArrayType.element_solid_ids)
+        if solid_ids is not None and (element_ids is not None or n_shells == 0):
+            shell_ids = element_ids if element_ids is not None else np.zeros(0, np.int64)
+            element_ids = np.concatenate([shell_ids, np.asarray(solid_ids, np.int64)[face_of]])
+        else:
+            element_ids = None
     parts, part_names = _part_ids(arrays, part_index, ArrayType)
 
     steps = times = None
@@ -120,18 +145,22 @@ def read_d3plot(path, units: str = "mm") -> FEMesh:
     deformable = np.ones(n_shells, bool)
     if ArrayType.part_material_type in arrays:
         material = np.asarray(arrays[ArrayType.part_material_type])
-        inside = part_index < len(material)
-        deformable[inside] = material[part_index[inside]] != RIGID_MATERIAL_TYPE
+        shell_part_index = part_index[:n_shells]
+        inside = shell_part_index < len(material)
+        deformable[inside] = material[shell_part_index[inside]] != RIGID_MATERIAL_TYPE
+
+    n_faces = len(connectivity) - n_shells  # solid faces carry no shell field: NaN
 
     def per_shell(values: np.ndarray) -> np.ndarray | None:
         values = np.asarray(values, dtype=np.float64)
         if values.ndim != 2 or len(values) != n_states:
             return None
+        full = np.full((n_states, n_shells + n_faces), np.nan)
         if values.shape[1] == n_shells:
-            return values
+            full[:, :n_shells] = values
+            return full
         if values.shape[1] == deformable.sum():
-            full = np.full((n_states, n_shells), np.nan)
-            full[:, deformable] = values
+            full[:, :n_shells][:, deformable] = values
             return full
         return None
 
@@ -150,13 +179,11 @@ def read_d3plot(path, units: str = "mm") -> FEMesh:
     fields = {k: v for k, v in fields.items() if v is not None}
 
     node_ids = arrays.get(ArrayType.node_ids)
-    element_ids = arrays.get(ArrayType.element_shell_ids)
     mesh = build_mesh(
-        path, nodes=nodes, elements=np.asarray(connectivity, dtype=np.int64), parts=parts,
+        path, nodes=nodes, elements=connectivity, parts=parts,
         steps=steps, times=times, element_fields=fields, part_names=part_names,
         node_ids=None if node_ids is None else np.asarray(node_ids, dtype=np.int64),
-        element_ids=None if element_ids is None else np.asarray(element_ids, dtype=np.int64),
-        name=path.name, units=units)
+        element_ids=element_ids, name=path.name, units=units)
     for failure in warnings.failures:  # read, but with sections missing: say which
         _warn(ParseWarning(path, f"lasso-python could not read {failure}: what it holds is "
                                  f"missing"), stacklevel=2)

@@ -90,7 +90,7 @@ def load(path, *, format: str | None = None, units: str = "mm",
     if fmt == "keyword":
         return read_keyword(path, units=units, all_faces=all_faces)
     if fmt == "d3plot":
-        return read_d3plot(path, units=units)
+        return read_d3plot(path, units=units, all_faces=all_faces)
     if fmt == "meshio":
         return read_meshio(path, units=units)
     if fmt == "trimesh":
