@@ -1,4 +1,5 @@
-"""The ``workbench`` command: info, render, hausdorff, simplify, list, run, reproduce and sweep.
+"""The ``workbench`` command: info, render, hausdorff, simplify, list, run, reproduce, sweep
+and stress.
 
 Bad input (an unreadable or malformed mesh file, an empty mesh, a missing OpenGL driver, an
 unknown name) ends with a one-line message on stderr and exit status 2, never a traceback (set WORKBENCH_DEBUG=1 to see one).
@@ -339,8 +340,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_reproduce)
 
     from .experiment.sweep import add_sweep_parser
+    from .stress import add_stress_parser
 
     add_sweep_parser(sub)
+    add_stress_parser(sub)
     return parser
 
 

@@ -103,6 +103,7 @@ class _Source:
             data = path.read_bytes()
         except OSError as exc:
             raise ParseError(path, f"cannot read: {exc.strerror or exc}") from exc
+        data = data.removeprefix(b"\xef\xbb\xbf")  # a UTF-8 byte order mark is no text
         if b"\r" in data:
             if b"\n" not in data:  # classic Mac line ends
                 data = data.replace(b"\r", b"\n")

@@ -1,0 +1,153 @@
+"""The reader reliability suite (workbench.stress): a bounded run, its checks, and the reader
+defects it found."""
+
+import argparse
+
+import numpy as np
+import pytest
+
+from workbench.scene.keyword import read_keyword
+from workbench.scene.parse import ParseError
+from workbench.stress import (
+    BENIGN,
+    BOM,
+    KINDS,
+    OUTCOMES,
+    _read,
+    add_stress_parser,
+    comma_deck,
+    default_decks,
+    fixed_deck,
+    mesh_problem,
+    mutated_deck,
+    run_reader_stress,
+    same_mesh,
+    strict_count,
+    thickness_deck,
+)
+
+
+@pytest.fixture(scope="module")
+def report():
+    return run_reader_stress(n=200, seed=0)
+
+
+def test_bounded_run_has_no_failures(report):
+    assert report.totals["wrong mesh"] == 0, "\n".join(map(str, report.failures))
+    assert report.totals["other exception"] == 0, "\n".join(map(str, report.failures))
+    assert report.totals["hang"] == 0, "\n".join(map(str, report.failures))
+    assert report.ok, "\n".join(map(str, report.failures))
+    assert sum(report.totals.values()) == 200
+
+
+def test_benign_variants_read_identically(report):
+    for kind in BENIGN:
+        row = report.counts[kind]
+        assert row["identical"] == sum(row.values()), (kind, row)
+
+
+def test_every_kind_is_drawn_and_tabled(report):
+    assert all(sum(report.counts[kind].values()) > 0 for kind in KINDS)
+    table = report.table()
+    assert all(kind in table for kind in KINDS) and all(o in table for o in OUTCOMES)
+
+
+@pytest.mark.parametrize("kind", BENIGN)
+@pytest.mark.parametrize("make", [fixed_deck, comma_deck, thickness_deck])
+def test_benign_kind_reads_the_same_mesh(tmp_path, make, kind):
+    decks = {"deck": make()}
+    index = next(i for i in range(500) if mutated_deck(i, 7, decks).kind == kind)
+    original, mutated = tmp_path / "a.k", tmp_path / "b.k"
+    original.write_bytes(decks["deck"])
+    mutated.write_bytes(mutated_deck(index, 7, decks).text)
+    assert same_mesh(read_keyword(original), read_keyword(mutated))
+
+
+def test_mutations_are_reproducible_from_seed_and_index():
+    decks = {"fixed": fixed_deck(), "comma": comma_deck()}
+    assert mutated_deck(42, 3, decks) == mutated_deck(42, 3, decks)
+    assert [mutated_deck(i, 3, decks).text for i in range(20)] != \
+        [mutated_deck(i, 4, decks).text for i in range(20)]
+
+
+def test_strict_count_of_the_generated_decks(tmp_path):
+    for make in (fixed_deck, comma_deck, thickness_deck):
+        path = tmp_path / "deck.k"
+        path.write_bytes(make())
+        mesh = read_keyword(path)
+        count = strict_count(make())
+        assert len(count.node_ids) == len(mesh.nodes)
+        assert len(count.element_ids) == len(mesh.elements)
+        assert mesh_problem(mesh, make()) == ""
+
+
+def test_wrong_mesh_is_detected(tmp_path):
+    path = tmp_path / "deck.k"
+    path.write_bytes(fixed_deck())
+    mesh = read_keyword(path)
+    lines = fixed_deck().split(b"\n")
+    one_element_less = b"\n".join(l for l in lines if not l.startswith(b"       9       1"))
+    assert "elements read" in mesh_problem(mesh, one_element_less)
+    garbled_node = fixed_deck().replace(b"            10.0             0.0",
+                                        b"            1x.0             0.0", 1)
+    assert "nodes read" in mesh_problem(mesh, garbled_node)
+
+
+def test_a_read_past_the_time_limit_is_a_hang(tmp_path):
+    path = tmp_path / "deck.k"
+    path.write_bytes(b"*NODE\n" + b"".join(b"%8d%16.1f%16.1f%16.1f\n" % (i, i, 0, 0)
+                                           for i in range(1, 200001))
+                     + b"*ELEMENT_SHELL\n       1       1       1       2       3       4\n")
+    mesh, outcome, _ = _read(path, 1e-3)
+    assert mesh is None and outcome == "hang"
+
+
+def test_other_exception_types_are_reported(tmp_path, monkeypatch):
+    from workbench.scene import keyword
+
+    def broken(path):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(keyword, "read_keyword", broken)
+    _mesh, outcome, message = _read(tmp_path / "x.k", 10.0)
+    assert outcome == "other exception" and "RuntimeError" in message
+
+
+def test_command_line(capsys):
+    parser = argparse.ArgumentParser(prog="workbench")
+    add_stress_parser(parser.add_subparsers(dest="command", required=True))
+    args = parser.parse_args(["stress", "readers", "--n", "24", "--seed", "5"])
+    assert args.func(args) == 0
+    out = capsys.readouterr().out
+    assert "24 mutations" in out and "OK" in out
+    with pytest.raises(SystemExit):
+        parser.parse_args(["stress", "render"])
+
+
+def test_default_decks_include_the_generated_ones():
+    assert {"fixed", "comma", "thickness"} <= set(default_decks())
+
+
+# --------------------------------------------------------------------------- regressions
+def test_regression_utf8_bom_before_the_first_keyword(tmp_path):
+    """A deck whose first line is a keyword lost that keyword behind a UTF-8 byte order mark
+    (its *NODE block was skipped, so every element named undefined nodes)."""
+    plain, marked = tmp_path / "plain.k", tmp_path / "marked.k"
+    plain.write_bytes(comma_deck())
+    marked.write_bytes(BOM + comma_deck())
+    assert same_mesh(read_keyword(plain), read_keyword(marked))
+    long_deck = b"*KEYWORD LONG=Y\n*NODE\n" + b"%20d%20.1f%20.1f%20.1f\n" * 3 % (
+        1, 0, 0, 0, 2, 1, 0, 0, 3, 1, 1, 0) + b"*ELEMENT_SHELL\n" + \
+        b"%20d%20d%20d%20d%20d%20d\n" % (1, 1, 1, 2, 3, 3)
+    plain.write_bytes(long_deck)
+    marked.write_bytes(BOM + long_deck)
+    assert same_mesh(read_keyword(plain), read_keyword(marked))
+    np.testing.assert_array_equal(read_keyword(marked).node_ids, [1, 2, 3])
+
+
+def test_regression_bom_keeps_line_numbers(tmp_path):
+    path = tmp_path / "bad.k"
+    path.write_bytes(BOM + b"*NODE\n       1     abc\n")
+    with pytest.raises(ParseError) as info:
+        read_keyword(path)
+    assert info.value.line == 2
