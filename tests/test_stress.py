@@ -121,7 +121,7 @@ def test_command_line(capsys):
     out = capsys.readouterr().out
     assert "24 mutations" in out and "OK" in out
     with pytest.raises(SystemExit):
-        parser.parse_args(["stress", "render"])
+        parser.parse_args(["stress", "renders"])
 
 
 def test_default_decks_include_the_generated_ones():

@@ -1,4 +1,5 @@
-"""Reliability suite for the mesh readers: ``workbench stress readers [--n N] [--seed S]``.
+"""Reliability suite for the mesh readers: ``workbench stress readers [--n N] [--seed S]``
+(``stress render`` runs :mod:`workbench.render_stress`, ``stress all`` both).
 
 Keyword decks (the shared car deck when present, and small generated decks in fixed and
 comma format, with ``*ELEMENT_SHELL_THICKNESS``, ``*PART`` and ``*SECTION_SHELL``) are
@@ -551,26 +552,45 @@ def run_reader_stress(n: int, seed: int, decks=None, timeout: float = TIMEOUT_S)
 
 # --------------------------------------------------------------------------- command line
 def cmd_stress(args) -> int:
-    """``workbench stress readers``: print the table and the failures; 1 when any read failed."""
-    report = run_reader_stress(args.n, args.seed)
-    print(f"reader stress: {report.n} mutations, seed {report.seed}, {report.seconds:.1f} s")
-    print(report.table())
-    for failure in report.failures:
-        print(failure)
-    print("OK" if report.ok else f"FAILED: {len(report.failures)} failing read(s)")
+    """``workbench stress readers|render|all``: print each suite's table and failures; 1 when
+    any check failed."""
+    ok = True
+    if args.suite in ("readers", "all"):
+        report = run_reader_stress(args.n, args.seed)
+        print(f"reader stress: {report.n} mutations, seed {report.seed}, {report.seconds:.1f} s")
+        print(report.table())
+        for failure in report.failures:
+            print(failure)
+        print("OK" if report.ok else f"FAILED: {len(report.failures)} failing read(s)")
+        ok &= report.ok
+    if args.suite in ("render", "all"):
+        from .render_stress import run_render_stress
+
+        render = run_render_stress(args.cycles)
+        print(f"render stress: far offset, {args.cycles} soak cycles, determinism, "
+              f"{render.seconds:.1f} s")
+        print(render.table())
+        for failure in render.failures:
+            print(failure)
+        print("OK" if render.ok else f"FAILED: {len(render.failures)} failing check(s)")
+        ok &= render.ok
     sys.stdout.flush()
-    return 0 if report.ok else 1
+    return 0 if ok else 1
 
 
 def add_stress_parser(subparsers) -> None:
     """Add the ``stress`` command to the ``workbench`` command's subparsers."""
     p = subparsers.add_parser(
-        "stress", help="reliability suites (readers: mutated keyword decks)",
-        description="Mutate keyword decks at random and check every read: identical for benign "
-                    "changes, else ParseError or a mesh consistent with the mutated text. "
-                    "Only the 'readers' suite exists; 'render' and 'all' are not implemented.")
-    p.add_argument("suite", choices=["readers"],
-                   help="readers: the keyword-deck reader (render and all: not implemented)")
-    p.add_argument("--n", type=int, default=200, help="number of mutations (default 200)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+        "stress", help="reliability suites: mutated decks for the readers, far-offset, soak and "
+                       "determinism checks for the render paths",
+        description="readers: mutate keyword decks at random and check every read (identical for "
+                    "benign changes, else ParseError or a mesh consistent with the mutated text). "
+                    "render: images 10^3 and 10^7 units from the origin equal to those at it, "
+                    "prepare/draw/release cycles that keep no GL object and no memory, the same "
+                    "image in other processes. all: both. Exit status 1 on any failure.")
+    p.add_argument("suite", choices=["readers", "render", "all"], help="which suite to run")
+    p.add_argument("--n", type=int, default=200, help="reader mutations (default 200)")
+    p.add_argument("--seed", type=int, default=0, help="random seed of the mutations (default 0)")
+    p.add_argument("--cycles", type=int, default=300,
+                   help="prepare/draw/release cycles of the render soak (default 300)")
     p.set_defaults(func=cmd_stress)
