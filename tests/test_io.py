@@ -955,6 +955,10 @@ def write_solid_d3plot(folder):
     plot.arrays[ArrayType.global_timesteps] = np.array([0.0, 1.0], np.float32)
     plot.arrays[ArrayType.node_displacement] = np.stack([coords, coords * 2]).astype(np.float32)
     plot.arrays[ArrayType.element_shell_thickness] = np.full((2, 1), 0.5, np.float32)
+    stress = np.zeros((2, 2, 1, 6), np.float32)
+    stress[:, 0, 0, 0] = 100.0  # solid 11: uniaxial 100
+    stress[:, 1, 0, 3] = 10.0  # solid 12: shear 10, von Mises 10·sqrt(3)
+    plot.arrays[ArrayType.element_solid_stress] = stress
     path = folder / "d3plot"
     plot.write_d3plot(str(path))
     return path
@@ -970,7 +974,47 @@ def test_d3plot_with_solids_reads_their_boundary_and_renders(tmp_path):
     assert np.allclose(thickness[:, 0], 0.5) and np.isnan(thickness[:, 1:]).all()
     assert mesh.steps.shape == (2, 12, 3)
     assert load(path, all_faces=True).n_elements == 1 + 12
+    vm = mesh.element_fields["von_mises"]  # the solids' own stress colours their faces
+    expected = np.where(mesh.element_ids[1:] == 11, 100.0, 10.0 * np.sqrt(3.0))
+    assert np.isnan(vm[:, 0]).all() and np.allclose(vm[:, 1:], expected, rtol=1e-5)
     from workbench.cli import main
 
     assert main(["render", str(path), "--field", "thickness", "--size", "48x36",
                  "-o", str(tmp_path / "solid.png")]) == 0
+
+
+# --------------------------------------------------------------------------- field parsers
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+def test_fixed_and_comma_node_cards_decode_every_value(tmp_path, data):
+    """Random node ids and coordinates written in fixed columns (plain, exponent, Fortran ``D``,
+    integral-float ids, blanks) or comma-separated decode to the values written."""
+    n = data.draw(st.integers(1, 30))
+    ids = data.draw(st.lists(st.integers(1, 10**7), min_size=n, max_size=n, unique=True))
+    values = data.draw(st.lists(st.floats(-1e6, 1e6, allow_nan=False).map(
+        lambda v: float(f"{v:.6g}")), min_size=3 * n, max_size=3 * n))
+    lines = ["*NODE"]
+    for k, nid in enumerate(ids):
+        x, y, z = values[3 * k:3 * k + 3]
+        style = data.draw(st.sampled_from(["fixed", "exponent", "fortran", "float_id", "comma",
+                                           "blank_z"]))
+        if style == "comma":
+            lines.append(f"{nid},{x!r},{y!r},{z!r}")
+            continue
+        if style == "blank_z":
+            z = 0.0
+        text = {"fixed": "{:16.6g}", "exponent": "{:16.8E}", "fortran": "{:16.8E}",
+                "float_id": "{:16.6g}", "blank_z": "{:16.6g}"}[style]
+        cells = [text.format(v) for v in (x, y, z)]
+        if style == "fortran":
+            cells = [c.replace("E", "D") for c in cells]
+        if style == "blank_z":
+            cells[2] = " " * 16
+        head = f"{float(nid):8.1f}" if style == "float_id" and nid < 10**6 else f"{nid:8d}"
+        lines.append(head + "".join(cells))
+    lines += ["*ELEMENT_SHELL", shell(1, 1, ids[0], ids[0], ids[0], ids[0])]
+    mesh = load(write(tmp_path, "nodes.k", lines))
+    assert mesh.node_ids.tolist() == ids
+    expected = np.array(values, float).reshape(n, 3)
+    expected[[i for i, line in enumerate(lines[1:n + 1]) if line.endswith(" " * 16)], 2] = 0.0
+    assert np.allclose(mesh.nodes, expected, rtol=1e-7, atol=0)

@@ -115,6 +115,7 @@ def read_d3plot(path, units: str = "mm", all_faces: bool = False) -> FEMesh:
                             else np.zeros(0), dtype=np.int64)
     element_ids = arrays.get(ArrayType.element_shell_ids)
     element_ids = None if element_ids is None else np.asarray(element_ids, dtype=np.int64)
+    face_of = np.zeros(0, np.int64)
     if len(solids):  # drawn by their boundary faces (every face with all_faces)
         from .solids import boundary_surface
 
@@ -177,6 +178,8 @@ def read_d3plot(path, units: str = "mm", all_faces: bool = False) -> FEMesh:
         if ArrayType.element_shell_is_alive in arrays:
             fields["alive"] = per_shell(arrays[ArrayType.element_shell_is_alive])
     fields = {k: v for k, v in fields.items() if v is not None}
+    if n_states and len(solids):
+        _solid_fields(fields, arrays, ArrayType, face_of, n_shells, n_states)
 
     node_ids = arrays.get(ArrayType.node_ids)
     mesh = build_mesh(
@@ -188,6 +191,31 @@ def read_d3plot(path, units: str = "mm", all_faces: bool = False) -> FEMesh:
         _warn(ParseWarning(path, f"lasso-python could not read {failure}: what it holds is "
                                  f"missing"), stacklevel=2)
     return mesh
+
+
+def _solid_fields(fields: dict, arrays, ArrayType, face_of: np.ndarray, n_shells: int,
+                  n_states: int) -> None:
+    """Give the solid faces (the columns after ``n_shells``) their solid's values: von Mises
+    of the solid's stress averaged over its integration points, the mean effective plastic
+    strain, and alive; a field the shells lack is NaN on them."""
+    n_faces = len(face_of)
+    solid_values = {}
+    if ArrayType.element_solid_stress in arrays:
+        stress = np.asarray(arrays[ArrayType.element_solid_stress], dtype=np.float64)
+        if stress.ndim == 4 and len(stress) == n_states:
+            solid_values["von_mises"] = von_mises(stress.mean(axis=2))
+    if ArrayType.element_solid_effective_plastic_strain in arrays:
+        strain = np.asarray(arrays[ArrayType.element_solid_effective_plastic_strain], np.float64)
+        if strain.ndim == 3 and len(strain) == n_states:
+            solid_values["plastic_strain"] = strain.mean(axis=2)
+    if ArrayType.element_solid_is_alive in arrays:
+        alive = np.asarray(arrays[ArrayType.element_solid_is_alive], dtype=np.float64)
+        if alive.ndim == 2 and len(alive) == n_states:
+            solid_values["alive"] = alive
+    for name, values in solid_values.items():
+        if name not in fields:
+            fields[name] = np.full((n_states, n_shells + n_faces), np.nan)
+        fields[name][:, n_shells:] = values[:, face_of]
 
 
 def _part_ids(arrays, part_index: np.ndarray, ArrayType) -> tuple[np.ndarray, dict[int, str]]:
