@@ -2,10 +2,12 @@
 defects it found."""
 
 import argparse
+import warnings
 
 import numpy as np
 import pytest
 
+from workbench.data import D3PLOT, shared_file
 from workbench.scene.keyword import read_keyword
 from workbench.scene.parse import ParseError
 from workbench.stress import (
@@ -151,3 +153,41 @@ def test_regression_bom_keeps_line_numbers(tmp_path):
     with pytest.raises(ParseError) as info:
         read_keyword(path)
     assert info.value.line == 2
+
+
+# --------------------------------------------------------------------------- damaged d3plots
+@pytest.mark.skipif(shared_file(D3PLOT) is None, reason="shared d3plot absent (set WORKBENCH_DATA)")
+def test_damaged_d3plots_are_read_or_refused_never_anything_else():
+    from workbench.stress import run_d3plot_stress
+
+    report = run_d3plot_stress(300, seed=0)
+    assert report.ok, report.failures
+    totals = {o: sum(c[o] for c in report.counts.values()) for o in ("read", "parse error")}
+    assert totals["read"] > 0 and totals["parse error"] > 0 and sum(totals.values()) == 300
+
+
+@pytest.mark.skipif(shared_file(D3PLOT) is None, reason="shared d3plot absent (set WORKBENCH_DATA)")
+def test_regression_garbled_part_index_is_a_parse_error(tmp_path):
+    """Damage 175 of seed 0 garbles a shell part index to -1.6e9: once an IndexError."""
+    from workbench.scene.d3plot import read_d3plot
+    from workbench.scene.parse import ParseError
+    from workbench.stress import damaged_d3plot
+
+    kind, data = damaged_d3plot(shared_file(D3PLOT).read_bytes(), 175, 0)
+    (tmp_path / "d3plot").write_bytes(data)
+    with pytest.raises(ParseError, match="part indexes out of range"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            read_d3plot(tmp_path / "d3plot")
+
+
+def test_regression_lasso_message_that_does_not_format():
+    """lasso-python once logged a '%d' message with a string argument: reporting it raised."""
+    import logging
+
+    from workbench.scene.d3plot import _LassoWarnings
+
+    handler = _LassoWarnings()
+    handler.emit(logging.LogRecord("lasso", logging.WARNING, "x", 1, "part %d is broken",
+                                   ("seven",), None))
+    assert handler.failures == ["part %d is broken ('seven',)"]

@@ -399,11 +399,13 @@ def _on_alarm(signum, frame):
     raise _Hang()
 
 
-def _read(path: Path, timeout: float):
-    """(mesh or None, outcome, message) of one read of ``path`` under a ``timeout`` (seconds;
-    enforced with SIGALRM where this runs in the main thread of a POSIX process)."""
+def _read(path: Path, timeout: float, reader=None):
+    """(mesh or None, outcome, message) of one read of ``path`` by ``reader`` (default the
+    keyword reader) under a ``timeout`` (seconds; enforced with SIGALRM where this runs in the
+    main thread of a POSIX process)."""
     from .scene.keyword import read_keyword
 
+    reader = reader or read_keyword
     timed = hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
     if timed:
         previous = signal.signal(signal.SIGALRM, _on_alarm)
@@ -411,7 +413,7 @@ def _read(path: Path, timeout: float):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return read_keyword(path), "read", ""
+            return reader(path), "read", ""
     except _Hang:
         return None, "hang", f"no answer within {timeout:g} s"
     except ParseError as exc:
@@ -550,6 +552,82 @@ def run_reader_stress(n: int, seed: int, decks=None, timeout: float = TIMEOUT_S)
     return StressReport(n, seed, counts, failures, time.perf_counter() - start)
 
 
+# --------------------------------------------------------------------------- d3plot files
+D3PLOT_KINDS = ("truncate", "garble", "zero block")
+
+
+@dataclass
+class D3plotStressReport:
+    """Outcomes of ``n`` damaged copies of a d3plot: ``counts`` (kind → outcome → count; the
+    outcomes are "read" — whole, or with the sections that failed named in warnings —, "parse
+    error", "other exception" and "hang"), ``failures`` (one line each, with the seed and
+    index that reproduce it) and ``seconds``."""
+
+    n: int
+    seed: int
+    counts: dict
+    failures: list
+    seconds: float
+
+    @property
+    def ok(self) -> bool:
+        return not self.failures
+
+    def table(self) -> str:
+        outcomes = ("read", "parse error", "other exception", "hang")
+        rows = [f"{'d3plot damage':<14}" + "".join(f"{o:>17}" for o in outcomes)]
+        rows.append("-" * len(rows[0]))
+        for kind in D3PLOT_KINDS:
+            rows.append(f"{kind:<14}" + "".join(f"{self.counts[kind][o]:>17}" for o in outcomes))
+        return "\n".join(rows)
+
+
+def damaged_d3plot(data: bytes, index: int, seed: int) -> tuple[str, bytes]:
+    """(kind, bytes) of damage ``index`` of ``seed`` to the d3plot ``data``: cut at a random
+    byte, 1–16 random bytes overwritten, or a block of up to 4 KiB zeroed."""
+    rng = random.Random(f"d3plot:{seed}:{index}")
+    kind = rng.choice(D3PLOT_KINDS)
+    damaged = bytearray(data)
+    if kind == "truncate":
+        del damaged[rng.randrange(64, len(damaged)):]
+    elif kind == "garble":
+        for _ in range(rng.randint(1, 16)):
+            damaged[rng.randrange(len(damaged))] = rng.randrange(256)
+    else:
+        start = rng.randrange(len(damaged))
+        end = min(len(damaged), start + rng.randint(1, 4096))
+        damaged[start:end] = bytes(end - start)
+    return kind, bytes(damaged)
+
+
+def run_d3plot_stress(n: int, seed: int, source=None,
+                      timeout: float = TIMEOUT_S) -> D3plotStressReport | None:
+    """Read ``n`` damaged copies of the d3plot ``source`` (default: the first file of the
+    shared d3plot; None when it is absent): each must be read or refused with ParseError,
+    never another exception, never past ``timeout`` seconds."""
+    from .data import D3PLOT, shared_file
+    from .scene.d3plot import read_d3plot
+
+    source = shared_file(D3PLOT) if source is None else Path(source)
+    if source is None:
+        return None
+    data = Path(source).read_bytes()
+    counts = {kind: dict.fromkeys(("read", "parse error", "other exception", "hang"), 0)
+              for kind in D3PLOT_KINDS}
+    failures = []
+    start = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="workbench-stress-") as folder:
+        target = Path(folder) / "d3plot"
+        for index in range(n):
+            kind, damaged = damaged_d3plot(data, index, seed)
+            target.write_bytes(damaged)
+            _, outcome, why = _read(target, timeout, read_d3plot)
+            counts[kind][outcome] += 1
+            if outcome in ("other exception", "hang"):
+                failures.append(f"d3plot seed {seed} index {index} ({kind}): {outcome}: {why}")
+    return D3plotStressReport(n, seed, counts, failures, time.perf_counter() - start)
+
+
 # --------------------------------------------------------------------------- command line
 def cmd_stress(args) -> int:
     """``workbench stress readers|render|all``: print each suite's table and failures; 1 when
@@ -563,6 +641,17 @@ def cmd_stress(args) -> int:
             print(failure)
         print("OK" if report.ok else f"FAILED: {len(report.failures)} failing read(s)")
         ok &= report.ok
+        damaged = run_d3plot_stress(args.n, args.seed)
+        if damaged is None:
+            print("d3plot stress: skipped (the shared d3plot is absent: set WORKBENCH_DATA)")
+        else:
+            print(f"d3plot stress: {damaged.n} damaged copies, seed {damaged.seed}, "
+                  f"{damaged.seconds:.1f} s")
+            print(damaged.table())
+            for failure in damaged.failures:
+                print(failure)
+            print("OK" if damaged.ok else f"FAILED: {len(damaged.failures)} failing read(s)")
+            ok &= damaged.ok
     if args.suite in ("render", "all"):
         from .render_stress import run_render_stress
 

@@ -133,7 +133,13 @@ def read_d3plot(path, units: str = "mm", all_faces: bool = False) -> FEMesh:
             element_ids = np.concatenate([shell_ids, np.asarray(solid_ids, np.int64)[face_of]])
         else:
             element_ids = None
-    parts, part_names = _part_ids(arrays, part_index, ArrayType)
+    try:
+        if len(part_index) and part_index.min() < 0:
+            raise ValueError(f"index {int(part_index.min())}")
+        parts, part_names = _part_ids(arrays, part_index, ArrayType)
+    except (IndexError, ValueError) as exc:
+        raise ParseError(path, f"element part indexes out of range ({exc}): the file is "
+                               f"damaged" + warnings.summary()) from None
 
     steps = times = None
     if ArrayType.node_displacement in arrays and len(arrays[ArrayType.node_displacement]):
@@ -260,7 +266,10 @@ class _LassoWarnings(logging.Handler):
         last line of the traceback it logged)."""
         out = []
         for record in self.records:
-            text = record.getMessage()
+            try:
+                text = record.getMessage()
+            except (TypeError, ValueError):  # lasso-python's own message may not format
+                text = f"{record.msg} {record.args}"
             if record.exc_info and record.exc_info[1] is not None:
                 text += f"\n{type(record.exc_info[1]).__name__}: {record.exc_info[1]}"
             lines = [line.strip() for line in text.splitlines() if line.strip()]
