@@ -1018,3 +1018,12 @@ def test_fixed_and_comma_node_cards_decode_every_value(tmp_path, data):
     expected = np.array(values, float).reshape(n, 3)
     expected[[i for i, line in enumerate(lines[1:n + 1]) if line.endswith(" " * 16)], 2] = 0.0
     assert np.allclose(mesh.nodes, expected, rtol=1e-7, atol=0)
+
+
+def test_tabs_as_blanks_in_comma_cards_read_the_identical_mesh(tmp_path):
+    plain = ["*NODE", *[f"{n[0]},{n[1]},{n[2]},{n[3]}" for n in SQUARE],
+             "*ELEMENT_SHELL", "7,3,101,102,103,104", "9,3,102,105,103,103"]
+    tabbed = [line.replace(",", ",\t") + ("\t" if i % 2 else "") for i, line in enumerate(plain)]
+    a, b = load(write(tmp_path, "plain.k", plain)), load(write(tmp_path, "tabs.k", tabbed))
+    assert np.array_equal(a.nodes, b.nodes) and np.array_equal(a.elements, b.elements)
+    assert a.node_ids.tolist() == b.node_ids.tolist()
