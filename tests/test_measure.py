@@ -12,6 +12,7 @@ from workbench.algo.spacetime.exact import colour_error, element_boundary, exact
 from workbench.algo.spacetime.fields import STEEL
 from workbench.algo.spacetime.raster import PixelGrid
 from workbench.experiment.measure import default_camera, measure
+from workbench.gl import renderer
 from workbench.paths import PATHS, Style, make_path, path_class, path_options
 from workbench.paths.base import GLPath
 from workbench.paths.colormap import colormap_lut
@@ -72,7 +73,7 @@ def test_spacetime_measure_times_and_releases(ctx, radial):
     row = result.row
     assert row["repeats"] == 5
     assert row["wall_ms_min"] <= row["wall_ms"] <= row["wall_ms_max"]
-    assert "llvmpipe" in row["renderer"] or row["renderer"]
+    assert row["renderer"] == renderer(ctx)
 
 
 def test_fe2003_paths_through_measure_draw_outlines_from_the_scene_model(ctx):

@@ -73,11 +73,6 @@ def _option(text: str) -> tuple[str, object]:
         return key.strip(), value
 
 
-# render flags that set Style fields of the mesh paths, with their defaults
-MESH_FLAGS = {"field": None, "step": 0, "bands": 0, "wireframe": False, "crease_deg": 30.0,
-              "strips": "none", "fepatch": "A"}
-
-
 def _render_options(args, kind: str) -> dict:
     """The path options of ``workbench render``: the mesh flags (mesh paths only; set on a
     spacetime path they are refused), ``--colormap`` and every ``--option``."""
@@ -87,7 +82,10 @@ def _render_options(args, kind: str) -> dict:
     if kind == "mesh":
         options = dict(flags)
     else:
-        given = [k for k, v in flags.items() if v != MESH_FLAGS[k]]
+        from .paths import Style
+
+        default = Style()
+        given = [k for k, v in flags.items() if v != getattr(default, k)]
         if given:
             raise ValueError(f"--{given[0].replace('_deg', '').replace('_', '-')} applies to the "
                              f"mesh paths, not to a spacetime scene")

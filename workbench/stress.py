@@ -629,40 +629,36 @@ def run_d3plot_stress(n: int, seed: int, source=None,
 
 
 # --------------------------------------------------------------------------- command line
+def _print_report(title: str, report, unit: str) -> bool:
+    """Print a suite's title line, table and failures, then OK or FAILED; returns ``ok``."""
+    print(title)
+    print(report.table())
+    for failure in report.failures:
+        print(failure)
+    print("OK" if report.ok else f"FAILED: {len(report.failures)} failing {unit}")
+    return report.ok
+
+
 def cmd_stress(args) -> int:
     """``workbench stress readers|render|all``: print each suite's table and failures; 1 when
     any check failed."""
     ok = True
     if args.suite in ("readers", "all"):
         report = run_reader_stress(args.n, args.seed)
-        print(f"reader stress: {report.n} mutations, seed {report.seed}, {report.seconds:.1f} s")
-        print(report.table())
-        for failure in report.failures:
-            print(failure)
-        print("OK" if report.ok else f"FAILED: {len(report.failures)} failing read(s)")
-        ok &= report.ok
+        ok &= _print_report(f"reader stress: {report.n} mutations, seed {report.seed}, "
+                            f"{report.seconds:.1f} s", report, "read(s)")
         damaged = run_d3plot_stress(args.n, args.seed)
         if damaged is None:
             print("d3plot stress: skipped (the shared d3plot is absent: set WORKBENCH_DATA)")
         else:
-            print(f"d3plot stress: {damaged.n} damaged copies, seed {damaged.seed}, "
-                  f"{damaged.seconds:.1f} s")
-            print(damaged.table())
-            for failure in damaged.failures:
-                print(failure)
-            print("OK" if damaged.ok else f"FAILED: {len(damaged.failures)} failing read(s)")
-            ok &= damaged.ok
+            ok &= _print_report(f"d3plot stress: {damaged.n} damaged copies, seed "
+                                f"{damaged.seed}, {damaged.seconds:.1f} s", damaged, "read(s)")
     if args.suite in ("render", "all"):
         from .render_stress import run_render_stress
 
         render = run_render_stress(args.cycles)
-        print(f"render stress: far offset, {args.cycles} soak cycles, determinism, "
-              f"{render.seconds:.1f} s")
-        print(render.table())
-        for failure in render.failures:
-            print(failure)
-        print("OK" if render.ok else f"FAILED: {len(render.failures)} failing check(s)")
-        ok &= render.ok
+        ok &= _print_report(f"render stress: far offset, {args.cycles} soak cycles, "
+                            f"determinism, {render.seconds:.1f} s", render, "check(s)")
     sys.stdout.flush()
     return 0 if ok else 1
 

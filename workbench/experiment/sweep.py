@@ -389,7 +389,8 @@ def point_sources(point: Point, glsl_dir=None) -> dict[str, str]:
     """The source files whose text decides ``point``'s row, name → sha256 of the text: the
     modules of its path and of the reference path, ``paths/base.py``, ``paths/colormap.py``,
     ``experiment/measure.py``, ``experiment/sweep_points.py``, ``experiment/compare.py`` with
-    a reference, the decimation, Hausdorff and simplifier modules with a simplifier, and the
+    a reference, the decimation, Hausdorff and simplifier modules with a simplifier, the
+    modules that make the scene and derive from it (:func:`_scene_modules`), and the
     shaders those path modules name, with their includes, from ``glsl_dir`` (default the
     workbench's glsl folder)."""
     from ..paths import path_class
@@ -406,10 +407,25 @@ def point_sources(point: Point, glsl_dir=None) -> dict[str, str]:
     if point.simplifier:
         modules |= {PACKAGE / "algo" / "simplify.py", PACKAGE / "algo" / "hausdorff.py",
                     PACKAGE / "experiment" / "simplifiers.py"}
+    modules |= _scene_modules(point.scene)
     sources = {f"workbench/{m.relative_to(PACKAGE).as_posix()}": _file_digest(m)
                for m in sorted(modules)}
     sources.update({f"glsl/{s.name}": _file_digest(s) for s in shaders})
     return sources
+
+
+def _scene_modules(spec: str) -> set[Path]:
+    """The modules that make scene ``spec`` and what the paths derive from it: the spacetime
+    builders, the generators or the readers, with the derived-data modules."""
+    scene = PACKAGE / "scene"
+    modules = {scene / "mesh.py", scene / "derived.py", scene / "derive.py"}
+    name = spec.split(":")[0]
+    if name == "spacetime" and not Path(spec).is_file():
+        return modules | {scene / "spacetime.py", *(PACKAGE / "algo" / "spacetime").glob("*.py")}
+    if name in ("semicylinders", "panels") and not Path(spec).is_file():
+        return modules | {scene / "generators.py"}
+    return modules | {scene / n for n in ("io.py", "parse.py", "keyword.py", "d3plot.py",
+                                          "solids.py")}
 
 
 def scene_digest(spec: str) -> str | None:

@@ -108,7 +108,8 @@ def fresh_scene(spec: str, quick: bool):
     """A scene nobody has drawn yet: derived data is computed (and counted) by this point.
 
     Loading is cached per worker; an FE mesh is handed out as a new instance sharing the
-    loaded arrays, without their derived caches."""
+    loaded arrays, without their derived caches. A spacetime scene derives nothing and no path
+    changes it, so the loaded one is handed out as it is."""
     import dataclasses
 
     from ..scene.mesh import FEMesh
@@ -117,9 +118,7 @@ def fresh_scene(spec: str, quick: bool):
     if isinstance(scene, FEMesh):
         return dataclasses.replace(scene, node_fields=dict(scene.node_fields),
                                    element_fields=dict(scene.element_fields))
-    from ..scene.builtin import load_scene
-
-    return load_scene(spec, quick)
+    return scene
 
 
 @lru_cache(maxsize=4)

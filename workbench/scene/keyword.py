@@ -329,6 +329,12 @@ def _table(block: _Block, rows: np.ndarray, widths, fields: list[_Field],
     return rows, out
 
 
+def _refuse_zero_ids(block: _Block, ids: np.ndarray, rows: np.ndarray, what: str) -> None:
+    """ParseError at the first card whose id is 0 (a blank field reads as 0)."""
+    if not ids.all():
+        raise block.error(f"expected {what}, got a blank or 0", int(rows[np.argmin(ids != 0)]))
+
+
 def _check_complete(block: _Block, row: int, widths, fields: list[_Field], span: int) -> None:
     """Refuse the file's last card when the file ends inside it: no line end after it, and
     fewer columns (or comma-separated fields) than the fields read from it."""
@@ -531,8 +537,7 @@ class _Deck:
         rows, (ids, x, y, z) = _table(block, block.rows, _NODE, [
             _Field(0, "i", "an integer node id"), _Field(1, "f", "3 coordinates"),
             _Field(2, "f", "3 coordinates"), _Field(3, "f", "3 coordinates")], drop_blank=True)
-        if not ids.all():
-            raise block.error("expected a node id, got a blank or 0", int(rows[np.argmin(ids != 0)]))
+        _refuse_zero_ids(block, ids, rows, "a node id")
         xyz = np.column_stack([x, y, z])
         bad = ~np.isfinite(xyz).all(axis=1)
         if bad.any():
@@ -562,9 +567,7 @@ class _Deck:
                 *ids_fields, *[_Field(i, "i", "8 integer node ids") for i in range(2, 10)]])
             values, nodes = values[:2], values[2:]
         ids = values[0]
-        if not ids.all():
-            raise block.error("expected an element id, got a blank or 0",
-                              int(cards[np.argmin(ids != 0)]))
+        _refuse_zero_ids(block, ids, cards, "an element id")
         self.solid_ids.append(ids)
         self.solid_parts.append(values[1])
         self.solid_nodes.append(np.column_stack(nodes))
@@ -594,9 +597,7 @@ class _Deck:
             *[_Field(i, "i", "4 integer node ids") for i in range(2, 6)]],
             drop_blank=per_element == 1)
         ids, pids = values[0], values[1]
-        if not ids.all():
-            raise block.error("expected an element id, got a blank or 0",
-                              int(cards[np.argmin(ids != 0)]))
+        _refuse_zero_ids(block, ids, cards, "an element id")
         nodes = np.column_stack(values[2:6])
         thickness = np.full((len(cards), 4), np.nan)
         if has_thickness:
