@@ -21,7 +21,7 @@ from ..gl import Camera, Framebuffer, renderer
 from ..paths.base import RenderPath, make_path
 from ..scene.derive import Derivation, derive, derived_items, needed_items
 from ..scene.mesh import FEMesh
-from .timing import MIN_REPEATS, time_draw
+from .timing import MIN_REPEATS, time_cpu_draw, time_draw
 
 WHITE = (1.0, 1.0, 1.0, 1.0)
 
@@ -139,13 +139,16 @@ def measure(ctx, scene, path, style=None, camera: Camera | None = None,
     if isinstance(scene, FEMesh):
         derivation = derive(scene, path.needs, path.style)
         held = derived_items(scene)
-    fb = Framebuffer(ctx, (width, height), samples=samples)
+    software = getattr(path, "rasterizer", "gl") == "software"
+    fb = path.make_target((width, height), samples) if software \
+        else Framebuffer(ctx, (width, height), samples=samples)
     timing = None
     try:
         with path:
             start = time.perf_counter()
             path.prepare(ctx, scene, camera)
-            ctx.finish()  # the uploads count as preparation
+            if not software:
+                ctx.finish()  # the uploads count as preparation
             prepare_ms = (time.perf_counter() - start) * 1e3
             if isinstance(scene, FEMesh):
                 undeclared = derived_items(scene) - held - needed_items(path.needs, path.style)
@@ -155,7 +158,10 @@ def measure(ctx, scene, path, style=None, camera: Camera | None = None,
             if step is not None:
                 path.set_step(step)
             fb.use()
-            if timed:
+            if timed and software:
+                timing = time_cpu_draw(fb, path.draw, warmup=warmup, repeat=repeats,
+                                       background=background)
+            elif timed:
                 timing = time_draw(ctx, fb, path.draw, warmup=warmup, repeat=repeats,
                                    background=background)
             else:
@@ -170,7 +176,7 @@ def measure(ctx, scene, path, style=None, camera: Camera | None = None,
         fb.release()
     back = np.round(np.asarray(background) * 255).astype(np.uint8)
     row = dict(scene=scene_name(scene), path=path.name, style=style_summary(path.style),
-               renderer=renderer(ctx), width=width, height=height, samples=samples,
+               renderer=path.renderer if software else renderer(ctx), width=width, height=height, samples=samples,
                triangles=path.triangles, vertices=path.vertices,
                vertices_sent=path.vertices_sent, strips=path.strips, edges=path.edges,
                bytes_uploaded=path.bytes_uploaded, bytes_per_step=path.bytes_per_step,

@@ -112,6 +112,34 @@ def time_draw(ctx, fb, draw: Callable[[], Any], warmup: int = 2, repeat: int = 7
     return Timing.from_samples(wall, gpu, readback)
 
 
+def time_cpu_draw(target, draw: Callable[[], Any], warmup: int = 2, repeat: int = 7,
+                  readback_repeat: int | None = None,
+                  background=(1.0, 1.0, 1.0, 1.0)) -> Timing:
+    """Time ``draw()`` of a CPU renderer into ``target`` (``clear``/``read`` as a framebuffer):
+    wall and read-back milliseconds, as :func:`time_draw` without a GPU (``gpu_ms`` None).
+
+    Each repetition clears ``target`` outside the clock; read-back is ``target.read()``, timed
+    apart. Refuses ``repeat`` < 5 and a negative ``warmup``.
+    """
+    check_counts(warmup, repeat)
+    readback_repeat = repeat if readback_repeat is None else readback_repeat
+    check_counts(0, readback_repeat)
+    wall: list[float] = []
+    for i in range(warmup + repeat):
+        target.clear(background)
+        start = time.perf_counter()
+        draw()
+        elapsed = (time.perf_counter() - start) * 1e3
+        if i >= warmup:
+            wall.append(elapsed)
+    readback = []
+    for _ in range(readback_repeat):
+        start = time.perf_counter()
+        target.read()
+        readback.append((time.perf_counter() - start) * 1e3)
+    return Timing.from_samples(wall, None, readback)
+
+
 def time_call(fn: Callable[[], Any], warmup: int = 1, repeat: int = 5) -> Timing:
     """Wall time (ms) of the CPU work ``fn()``; GPU and read-back times are None.
 

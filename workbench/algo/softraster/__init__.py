@@ -1,0 +1,14 @@
+"""The es2008 software rasterizer: GL-free, numpy + numba.
+
+:func:`render` draws triangles into a :class:`Frame` through the paper's steps
+(:mod:`.pipeline`), with fragments from the span look-up table (:mod:`.spantable`) or from
+half-space tests, under the pixel rule of :mod:`.rule`; :mod:`.composite` merges frames of
+domains by depth (sort-last).
+"""
+
+from .frame import CLEAR_DEPTH, NO_TRIANGLE, Frame
+from .pipeline import (GENERATORS, SHADINGS, STEPS, TABLE_SIZES, RasterOptions, RenderStats,
+                       Shading, render)
+
+__all__ = ["CLEAR_DEPTH", "NO_TRIANGLE", "Frame", "GENERATORS", "SHADINGS", "STEPS",
+           "TABLE_SIZES", "RasterOptions", "RenderStats", "Shading", "render"]

@@ -1,0 +1,374 @@
+"""The es2008 software rasterizer: triangles in, a :class:`~.frame.Frame` out, no GL.
+
+Kawai et al. render the contour and deformation plots of huge FE results without graphics
+hardware by running a classical pipeline as long loops over triangles or fragments. This
+module runs their steps (their Table 2) in that order, each a compiled kernel of
+:mod:`.kernels`, timed one by one:
+
+=====================  ===========  =========================================================
+step                   parallel     what
+=====================  ===========  =========================================================
+transform and light    vertices     float32 placement, snapping, per-vertex or flat lighting
+clip triangle          triangles    drop unplaced, zero-area, off-image, near/far, clipped
+depth gradient         triangles    depth plane over pixel centres
+scalar gradient        triangles    planes of the shading attributes and clip distances
+range and TC           triangles    box, vertices oriented (triangle coordinates)
+collect table-fit      triangles    which triangles the span table holds
+bin                    —            triangles into screen tiles, in order (extra step)
+generate fragment      tiles        span table or half-space (edge-function) tests
+interpolate z          tiles        depth per fragment, fragment-wise clipping
+interpolate color      tiles        colour through the 1-D texture, alpha test
+write fragment         tiles        depth-tested write
+=====================  ===========  =========================================================
+
+Triangles go through the steps in sessions of ``RasterOptions.session`` triangles (the
+paper's fragment pool), so memory stays bounded on a 16 M-triangle model. The two steps the
+paper keeps scalar run tile by tile — a tile is owned by one thread and its triangles are
+visited in index order — so the image does not depend on the thread count, and of two
+fragments at one depth the lower triangle index wins, as under GL's ``LESS`` test.
+
+Pixels follow :mod:`.rule` (llvmpipe's: 8 sub-pixel bits, pixel centres, top-left rule in
+its row order). The span table needs 0 sub-pixel bits (vertices on pixel centres): that
+choice, ``RasterOptions(generator="table", subpixel_bits=0)``, is the paper's renderer and
+deviates from GL's coverage by the snapping; the half-space generator runs with any bits.
+Only orthographic projections are drawn (the paper's; attributes are interpolated linearly in
+the image). Refused with ValueError: a perspective projection, a table generator with
+sub-pixel bits, arrays of the wrong shapes.
+"""
+
+from __future__ import annotations
+
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from types import SimpleNamespace
+
+import numba
+import numpy as np
+
+from . import kernels
+from .frame import Frame
+from .rule import GL_SUBPIXEL_BITS, check_bits
+
+SHADINGS = ("constant", "flat", "gouraud", "vertex_color", "pixel_color", "element_color")
+GENERATORS = ("halfspace", "table")
+TABLE_SIZES = (10, 15, 20)
+STEPS = (("transform and light", True), ("clip triangle", True), ("depth gradient", True),
+         ("scalar gradient", True), ("range and TC", True), ("collect table-fit", True),
+         ("bin", False), ("generate fragment", False), ("interpolate z", True),
+         ("interpolate color", True), ("write fragment", False))
+_ATTRS = {"constant": 0, "flat": 0, "gouraud": 1, "vertex_color": 4, "pixel_color": 2,
+          "element_color": 0}
+_KERNELS = ("transform", "light_vertices", "light_triangles", "clip_triangles",
+            "depth_gradient", "scalar_gradient", "range_and_tc", "collect_table_fit",
+            "bin_triangles", "generate_fragments", "interpolate_z", "interpolate_color",
+            "write_fragments")
+_HELPERS = ("texel_rgba", "unorm8", "pack", "headlight", "_plane")
+
+
+@dataclass(frozen=True)
+class Shading:
+    """How fragments are coloured, after the mesh render path of the same name.
+
+    ``kind``: "constant" (``base_color``), "flat" (face-normal headlight), "gouraud"
+    (per-vertex headlight), "vertex_color" (colour looked up per vertex, lit, interpolated),
+    "pixel_color" (texture coordinate and light interpolated, looked up per pixel),
+    "element_color" (one looked-up colour per triangle, flat lit). ``texels`` (n, 4) uint8 is
+    the 1-D colour texture with ``linear`` filtering or nearest, ``coord`` the (scale, offset)
+    from normalised value to texture coordinate, ``alpha_test`` discards α < ½,
+    ``missing_color`` draws the no-value sentinel. Colours RGB in [0, 1].
+    """
+
+    kind: str = "constant"
+    base_color: tuple = (0.75, 0.75, 0.78)
+    missing_color: tuple = (0.75, 0.75, 0.78)
+    texels: np.ndarray | None = None
+    linear: bool = False
+    coord: tuple = (1.0, 0.0)
+    alpha_test: bool = False
+
+    def __post_init__(self) -> None:
+        if self.kind not in SHADINGS:
+            raise ValueError(f"shading must be one of {SHADINGS}, got {self.kind!r}")
+        if self.kind in ("vertex_color", "pixel_color", "element_color"):
+            if self.texels is None or np.asarray(self.texels).ndim != 2 \
+                    or np.asarray(self.texels).shape[1] != 4 or not len(self.texels):
+                raise ValueError(f"shading {self.kind!r} needs texels of shape (n, 4)")
+
+
+@dataclass(frozen=True)
+class RasterOptions:
+    """``generator``: "halfspace" or "table" (the span table for table-fit triangles, the
+    half-space tests for the others); ``table_size``: the table's S in pixels;
+    ``subpixel_bits``: 8 as llvmpipe, 0 for the table; ``threads``: numba threads (None: all);
+    ``tile``: screen tile edge in pixels; ``session``: triangles per session;
+    ``early_depth``: skip generating fragments that already fail the depth test (the image
+    is the same; es2008 generates them all)."""
+
+    generator: str = "halfspace"
+    table_size: int = 10
+    subpixel_bits: int = GL_SUBPIXEL_BITS
+    threads: int | None = None
+    tile: int = 64
+    session: int = 1 << 16
+    early_depth: bool = True
+
+    def __post_init__(self) -> None:
+        if self.generator not in GENERATORS:
+            raise ValueError(f"generator must be one of {GENERATORS}, got {self.generator!r}")
+        check_bits(self.subpixel_bits)
+        if self.generator == "table" and self.subpixel_bits != 0:
+            raise ValueError("the span table indexes integer pixel offsets: the table generator "
+                             f"needs subpixel_bits=0, got {self.subpixel_bits}")
+        if int(self.table_size) != self.table_size or not 2 <= self.table_size <= 63:
+            raise ValueError(f"table_size must be an integer in 2..63, got {self.table_size}")
+        if self.threads is not None and (int(self.threads) != self.threads or self.threads < 1):
+            raise ValueError(f"threads must be a positive integer, got {self.threads}")
+        for name in ("tile", "session"):
+            value = getattr(self, name)
+            if int(value) != value or value < 1:
+                raise ValueError(f"{name} must be a positive integer, got {value}")
+
+
+@dataclass
+class RenderStats:
+    """What one render did: triangle counts (``triangles`` given, ``kept`` after clipping,
+    ``table_fit``), ``fragments`` generated, ``seconds`` per step (the order of
+    :data:`STEPS`), ``sessions``, ``threads``, ``table_bytes`` (0 without the table) and
+    ``fragment_bytes`` (the largest session's fragment pool)."""
+
+    triangles: int = 0
+    kept: int = 0
+    table_fit: int = 0
+    fragments: int = 0
+    seconds: dict = field(default_factory=lambda: {name: 0.0 for name, _ in STEPS})
+    sessions: int = 0
+    threads: int = 1
+    table_bytes: int = 0
+    fragment_bytes: int = 0
+
+    @property
+    def total_s(self) -> float:
+        return float(sum(self.seconds.values()))
+
+
+def _compiled() -> SimpleNamespace:
+    return SimpleNamespace(**{name: getattr(kernels, name) for name in _KERNELS})
+
+
+@contextmanager
+def _interpreted():
+    """The kernels as plain Python (``py_func``), their helpers too, for the block."""
+    saved = {name: getattr(kernels, name) for name in _HELPERS}
+    try:
+        for name in _HELPERS:
+            setattr(kernels, name, saved[name].py_func)
+        yield SimpleNamespace(**{name: getattr(kernels, name).py_func for name in _KERNELS})
+    finally:
+        for name, value in saved.items():
+            setattr(kernels, name, value)
+
+
+@contextmanager
+def _threads(count: int | None):
+    before = numba.get_num_threads()
+    numba.set_num_threads(min(count or numba.config.NUMBA_NUM_THREADS,
+                              numba.config.NUMBA_NUM_THREADS))
+    try:
+        yield numba.get_num_threads()
+    finally:
+        numba.set_num_threads(before)
+
+
+def _checked(positions, triangles, ids, normals, values, triangle_values, shading):
+    pos = np.asarray(positions, np.float64)
+    if pos.ndim != 2 or pos.shape[1] != 3:
+        raise ValueError(f"positions must be (V, 3), got {pos.shape}")
+    tris = np.ascontiguousarray(triangles, np.int64)
+    if tris.ndim != 2 or tris.shape[1] != 3:
+        raise ValueError(f"triangles must be (K, 3), got {tris.shape}")
+    if len(tris) and (tris.min() < 0 or tris.max() >= len(pos)):
+        raise ValueError(f"triangle indices must lie in 0..{len(pos) - 1}")
+    ids = np.arange(len(tris), dtype=np.int64) if ids is None else \
+        np.ascontiguousarray(ids, np.int64)
+    if ids.shape != (len(tris),):
+        raise ValueError(f"ids must be ({len(tris)},), got {ids.shape}")
+    kind = shading.kind
+    if kind in ("gouraud", "vertex_color", "pixel_color"):
+        if normals is None or np.shape(normals) != pos.shape:
+            raise ValueError(f"shading {kind!r} needs normals of shape {pos.shape}")
+    if kind in ("vertex_color", "pixel_color"):
+        if values is None or np.shape(values) != (len(pos),):
+            raise ValueError(f"shading {kind!r} needs values of shape ({len(pos)},)")
+    if kind == "element_color":
+        if triangle_values is None or np.shape(triangle_values) != (len(tris),):
+            raise ValueError(f"shading 'element_color' needs triangle_values of shape "
+                             f"({len(tris)},)")
+    return pos, tris, ids
+
+
+def check_orthographic(projection) -> np.ndarray:
+    """``projection`` (4, 4) float64, refused (ValueError) unless orthographic."""
+    proj = np.asarray(projection, np.float64)
+    if proj.shape != (4, 4):
+        raise ValueError(f"projection must be (4, 4), got {proj.shape}")
+    if not np.array_equal(proj[3], [0.0, 0.0, 0.0, 1.0]):
+        raise ValueError("the software rasterizer draws orthographic views only (es2008's "
+                         "projection); got a perspective projection")
+    return proj
+
+
+def render(positions, triangles, view, projection, size: tuple[int, int],
+           shading: Shading = Shading(), options: RasterOptions = RasterOptions(), *,
+           ids=None, normals=None, values=None, triangle_values=None, clip_planes=(),
+           background=(255, 255, 255, 255), frame: Frame | None = None,
+           vectorized: bool = True) -> tuple[Frame, RenderStats]:
+    """Draw ``triangles`` (K, 3) vertex indices of ``positions`` (V, 3) float64 model units,
+    relative to the camera's upload origin, with the ``view`` and orthographic ``projection``
+    (4, 4) float64 matrices into a ``size`` (W, H) frame cleared to ``background`` (RGBA
+    0–255), or on top of ``frame``.
+
+    ``ids`` (K,) int64 are the triangles' global indices (default 0..K−1): they break depth
+    ties and are written to ``Frame.triangle``. ``normals`` (V, 3), ``values`` (V,)
+    normalised field values and ``triangle_values`` (K,) are needed by the shadings that use
+    them (see :class:`Shading`); a non-finite or no-value entry
+    (:data:`workbench.paths.colormap.NO_VALUE`) draws the missing colour. ``clip_planes``
+    (P, 4) relative to the origin keep ``a·x + b·y + c·z + d ≥ 0``. ``vectorized=False`` runs
+    every step as plain Python (slow; for the step table on small cases). Degenerate,
+    non-finite and wholly clipped triangles draw nothing.
+    """
+    pos, tris, ids = _checked(positions, triangles, ids, normals, values, triangle_values, shading)
+    proj = check_orthographic(projection)
+    view = np.asarray(view, np.float64)
+    width, height = (int(v) for v in size)
+    if width < 1 or height < 1:
+        raise ValueError(f"size must be positive, got {size}")
+    planes = np.asarray(clip_planes, np.float64).reshape(-1, 4)
+    if frame is None:
+        frame = Frame.empty(width, height, background)
+    elif frame.size != (width, height):
+        raise ValueError(f"frame is {frame.size}, size is {(width, height)}")
+    color32 = frame.color.view(np.uint32).reshape(height, width)
+    stats = RenderStats(triangles=len(tris))
+    kind = shading.kind
+    code = SHADINGS.index(kind)
+    bits = options.subpixel_bits
+    table = None
+    if options.generator == "table":
+        from .spantable import span_table
+
+        table = span_table(options.table_size)
+        stats.table_bytes = table.nbytes
+        lo_table, hi_table, size_s = table.lo.reshape(-1), table.hi.reshape(-1), table.size
+    else:
+        lo_table = hi_table = np.full(1, -1, np.int8)
+        size_s = options.table_size
+    texels = np.ascontiguousarray(shading.texels if shading.texels is not None
+                                  else np.zeros((1, 4)), np.uint8)
+    base = np.asarray(shading.base_color, np.float32)
+    missing = np.asarray(shading.missing_color, np.float32)
+    seconds = stats.seconds
+
+    def clock(step: str, start: float) -> float:
+        now = time.perf_counter()
+        seconds[step] += now - start
+        return now
+
+    with _threads(options.threads if vectorized else 1) as threads, \
+            (_interpreted() if not vectorized else _null(_compiled())) as k:
+        stats.threads = threads
+        t0 = time.perf_counter()
+        # ---- transform and light (all vertices once)
+        rel32 = pos.astype(np.float32)
+        mvp32 = (proj @ view).astype(np.float32)
+        n_v = len(pos)
+        fx, fy = np.empty(n_v, np.int64), np.empty(n_v, np.int64)
+        fz, ok = np.empty(n_v, np.float32), np.empty(n_v, bool)
+        k.transform(rel32, mvp32, width, height, bits, fx, fy, fz, ok)
+        n_attr = _ATTRS[kind]
+        attr = np.zeros((n_v, n_attr), np.float32)
+        scale, offset = (np.float32(v) for v in shading.coord)
+        if kind in ("gouraud", "vertex_color", "pixel_color"):
+            s = np.zeros(n_v, np.float32)
+            if values is not None:
+                t = np.asarray(values, np.float64)
+                s = t.astype(np.float32) * scale + offset
+                s[~np.isfinite(t)] = np.float32(-1e30)
+            k.light_vertices(code, view[:3, :3].astype(np.float32),
+                             np.asarray(normals, np.float64).astype(np.float32), s, texels,
+                             shading.linear, missing, attr)
+        tri_light = np.zeros(len(tris) if kind in ("flat", "element_color") else 1, np.float32)
+        if kind in ("flat", "element_color"):
+            k.light_triangles(pos, tris, np.ascontiguousarray(view[:3, :3]), fx, fy, bits,
+                              tri_light)
+        tri_s = np.zeros(1, np.float32)
+        if kind == "element_color":
+            tv = np.asarray(triangle_values, np.float64)
+            tri_s = tv.astype(np.float32) * scale + offset
+            tri_s[~np.isfinite(tv)] = np.float32(-1e30)
+        clipd = np.zeros((n_v, len(planes)), np.float32)
+        if len(planes):
+            p32, w32 = planes[:, :3].astype(np.float32), planes[:, 3].astype(np.float32)
+            clipd = np.ascontiguousarray((rel32 @ p32.T) + w32, np.float32)
+        t0 = clock("transform and light", t0)
+
+        tiles_x = -(-width // options.tile)
+        n_tiles = tiles_x * (-(-height // options.tile))
+        for k0 in range(0, len(tris), options.session):
+            k1 = min(k0 + options.session, len(tris))
+            stats.sessions += 1
+            keep = np.empty(k1 - k0, bool)
+            k.clip_triangles(tris, k0, fx, fy, fz, ok, clipd, width, height, bits, keep)
+            kept = np.flatnonzero(keep) + k0
+            n = len(kept)
+            stats.kept += n
+            t0 = clock("clip triangle", t0)
+            if n == 0:
+                continue
+            zplane = np.empty((n, 1, 3))
+            k.depth_gradient(kept, tris, fx, fy, fz, bits, zplane)
+            t0 = clock("depth gradient", t0)
+            planes_m = np.empty((n, n_attr + len(planes), 3))
+            k.scalar_gradient(kept, tris, fx, fy, bits, attr, clipd, planes_m)
+            t0 = clock("scalar gradient", t0)
+            verts = np.empty((n, 6), np.int64)
+            box = np.empty((n, 4), np.int32)
+            k.range_and_tc(kept, tris, fx, fy, width, height, bits, verts, box)
+            t0 = clock("range and TC", t0)
+            fit = np.zeros(n, bool)
+            if table is not None:
+                k.collect_table_fit(verts, size_s, fit)
+                stats.table_fit += int(fit.sum())
+            t0 = clock("collect table-fit", t0)
+            start, members, frag_start = k.bin_triangles(box, options.tile, tiles_x, n_tiles,
+                                                         threads)
+            slots = int(frag_start[-1])
+            frag_tri = np.empty(slots, np.int32)
+            frag_i, frag_j = np.empty(slots, np.int32), np.empty(slots, np.int32)
+            frag_count = np.zeros(n_tiles, np.int64)
+            t0 = clock("bin", t0)
+            k.generate_fragments(start, members, frag_start, verts, box, fit, lo_table,
+                                 hi_table, size_s, options.tile, tiles_x, bits,
+                                 options.early_depth, zplane, frame.depth, frag_tri, frag_i,
+                                 frag_j, frag_count)
+            stats.fragments += int(frag_count.sum())
+            t0 = clock("generate fragment", t0)
+            frag_z = np.empty(slots, np.float32)
+            k.interpolate_z(frag_start, frag_count, frag_tri, frag_i, frag_j, zplane, planes_m,
+                            n_attr, frag_z)
+            t0 = clock("interpolate z", t0)
+            frag_rgba = np.empty(slots, np.uint32)
+            k.interpolate_color(code, frag_start, frag_count, frag_tri, frag_i, frag_j,
+                                planes_m, kept, tri_light, tri_s, base, missing, texels,
+                                shading.linear, shading.alpha_test, frag_z, frag_rgba)
+            t0 = clock("interpolate color", t0)
+            k.write_fragments(frag_start, frag_count, frag_tri, frag_i, frag_j, frag_z,
+                              frag_rgba, kept, ids, frame.depth, color32, frame.triangle)
+            t0 = clock("write fragment", t0)
+            stats.fragment_bytes = max(stats.fragment_bytes, slots * 20)
+    return frame, stats
+
+
+@contextmanager
+def _null(value):
+    yield value

@@ -1,0 +1,183 @@
+"""Any mesh render path drawn by the es2008 software rasterizer instead of GL.
+
+:class:`SoftwarePath` takes the name of a mesh path (``position``, ``flat``, ``gouraud``,
+``vertex_color``, ``pixel_color``, ``element_color``) and its :class:`~.base.Style`, and draws
+the same image on the CPU with :func:`workbench.algo.softraster.render`: the same triangles
+(the GL path's own topology and quad diagonals), the same deformation plot, normals, colour
+texture, transfer-function alpha test and clip planes, the same pixel rule as llvmpipe. It
+follows the path protocol (prepare, set_camera, set_step, draw, release) so that
+:func:`workbench.experiment.measure` times it like any path; it draws into its own
+:class:`SoftwareTarget` instead of a GL framebuffer, and needs no GL context.
+
+Refused with ValueError: a path that is not a mesh path, a wire frame (a GL line pass),
+strips (a GL index layout; the triangles are the same without), a perspective camera (the
+rasterizer is orthographic, as es2008's), MSAA samples.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..algo.softraster import Frame, RasterOptions, Shading, render
+from .base import MeshPath, RenderPath, path_class
+from .colormap import NO_VALUE
+
+SHADING_OF = {"position": "constant", "flat": "flat", "gouraud": "gouraud",
+              "vertex_color": "vertex_color", "pixel_color": "pixel_color",
+              "element_color": "element_color"}
+
+
+class SoftwareTarget:
+    """The software path's framebuffer: a :class:`Frame` with the GL framebuffer's
+    ``use`` / ``clear`` / ``read`` / ``release`` calls (colours in [0, 1] as GL clears)."""
+
+    def __init__(self, size: tuple[int, int]) -> None:
+        width, height = (int(v) for v in size)
+        if width <= 0 or height <= 0:
+            raise ValueError(f"framebuffer size must be positive, got {size}")
+        self.size = (width, height)
+        self.frame = Frame.empty(width, height)
+
+    def use(self) -> None:
+        """Nothing to bind: the path draws into ``frame``."""
+
+    def clear(self, color=(1.0, 1.0, 1.0, 1.0), depth: float = 1.0) -> None:
+        rgba = np.rint(np.clip(np.asarray(color, np.float64), 0, 1) * 255).astype(np.uint8)
+        self.frame.color[...] = rgba
+        self.frame.depth[...] = depth
+        self.frame.triangle[...] = -1
+
+    def read(self) -> np.ndarray:
+        """(H, W, 4) uint8 RGBA copy, row 0 at the top."""
+        return self.frame.color.copy()
+
+    def release(self) -> None:
+        """Nothing to free."""
+
+
+class SoftwarePath(RenderPath):
+    """The image of mesh path ``name`` with ``style``, rasterized on the CPU with ``options``."""
+
+    rasterizer = "software"
+
+    def __init__(self, name: str = "pixel_color", style=None,
+                 options: RasterOptions = RasterOptions()) -> None:
+        cls = path_class(name)
+        if name not in SHADING_OF:
+            raise ValueError(f"the software rasterizer draws the mesh paths "
+                             f"{', '.join(SHADING_OF)}; not {name!r}")
+        self.name, self.needs, self.style_class = name, cls.needs, cls.style_class
+        super().__init__(style)
+        self.options = options
+        self._gl: MeshPath = cls(self.style)
+        self.target: SoftwareTarget | None = None
+        self.stats = None
+        self.mesh = None
+
+    @property
+    def renderer(self) -> str:
+        """The renderer named in measurement rows."""
+        o = self.options
+        generator = f"span table S={o.table_size}" if o.generator == "table" else "half-space"
+        threads = self.stats.threads if self.stats is not None else (o.threads or "all")
+        return (f"software rasterizer ({generator}, {o.subpixel_bits} sub-pixel bits, "
+                f"{threads} threads)")
+
+    def make_target(self, size: tuple[int, int], samples: int = 0) -> SoftwareTarget:
+        """The framebuffer this path draws into (and ``measure`` reads), ``size`` (W, H)."""
+        if samples:
+            raise ValueError("the software rasterizer draws without MSAA: samples must be 0")
+        self.target = SoftwareTarget(size)
+        return self.target
+
+    # ------------------------------------------------------------------ prepare
+    def prepare(self, ctx, mesh, camera) -> None:
+        style = self.style
+        if style.wireframe:
+            raise ValueError("the software rasterizer draws no wire frame (a GL line pass); "
+                             "drop the wire frame")
+        if style.strips != "none":
+            raise ValueError("strips are a GL index layout; the software rasterizer draws the "
+                             "same triangles from the list: use strips='none'")
+        if camera.projection != "orthographic":
+            raise ValueError("the software rasterizer draws orthographic views only")
+        gl = self._gl
+        gl._check_scene(mesh)
+        self.scale = gl.scale
+        vertex_node, triangles = gl.topology(mesh)
+        n_vertices = mesh.n_nodes if vertex_node is None else len(vertex_node)
+        self._triangles = np.ascontiguousarray(gl.layout(mesh, triangles, n_vertices), np.int64)
+        self._vertex_node = None if vertex_node is None else np.asarray(vertex_node, np.int64)
+        self.triangles, self.vertices = len(self._triangles), n_vertices
+        self.vertices_sent = self._triangles.size
+        self.mesh, self.origin = mesh, np.array(camera.origin, np.float64)
+        kind = SHADING_OF[self.name]
+        scale = self.scale
+        self._shading = Shading(
+            kind=kind, base_color=style.base_color, missing_color=style.base_color,
+            texels=None if scale is None else scale.texture_data(),
+            linear=False if scale is None else scale.linear,
+            coord=(1.0, 0.0) if scale is None else scale.coord_transform,
+            alpha_test=scale is not None and style.hide_range is not None)
+        planes = np.array(style.clip_planes, np.float64).reshape(-1, 4)
+        planes[:, 3] += planes[:, :3] @ self.origin  # moved to the upload origin in float64
+        self._planes = planes
+        self.set_camera(camera)
+        self.set_step(style.step)
+
+    def set_camera(self, camera) -> None:
+        if self.mesh is None:
+            raise RuntimeError(f"software path {self.name!r} is not prepared")
+        if not np.array_equal(np.asarray(camera.origin, np.float64), self.origin):
+            raise ValueError(f"camera origin {camera.origin} differs from the prepared origin "
+                             f"{self.origin}: prepare the path again for a new origin")
+        if camera.projection != "orthographic":
+            raise ValueError("the software rasterizer draws orthographic views only")
+        self._view, self._projection = camera.view_matrix(), camera.projection_matrix()
+
+    def shown_coordinates(self, step: int) -> np.ndarray:
+        """(N, 3) float64 node positions drawn for ``step`` (deformation plot applied)."""
+        return MeshPath.shown_coordinates(self, step)
+
+    def set_step(self, step: int) -> int:
+        mesh = self.mesh
+        if mesh is None:
+            raise RuntimeError(f"software path {self.name!r} is not prepared")
+        if int(step) != step or not 0 <= step < mesh.n_steps:
+            raise ValueError(f"step {step} out of range: {mesh.name} has {mesh.n_steps} steps")
+        step = int(step)
+        shown = self.shown_coordinates(step)
+        node = self._vertex_node
+        self._positions = (shown if node is None else shown[node]) - self.origin
+        self._normals = self._values = self._triangle_values = None
+        if self._gl.split:
+            self._normals = self._gl._gouraud.normals(shown)
+        field = self.style.field
+        if self._gl.field_per == "node":
+            t = self.scale.normalise(mesh.node_field(field, step))
+            self._values = t if node is None else t[node]
+            self.missing_values = int((~np.isfinite(t)).sum())
+        elif self._gl.field_per == "element":
+            t = self.scale.normalise(mesh.element_field(field, step))
+            self._triangle_values = t[mesh.triangulation.element_of]
+            self.missing_values = int((~np.isfinite(t)).sum())
+        for name in ("_values", "_triangle_values"):
+            values = getattr(self, name)
+            if values is not None:
+                setattr(self, name, np.where(np.isfinite(values), values, NO_VALUE))
+        self.step = step
+        return 0
+
+    def draw(self) -> None:
+        """Rasterize into the target made by :meth:`make_target` (on top of what it holds)."""
+        if self.mesh is None or self.target is None:
+            raise RuntimeError(f"software path {self.name!r} needs prepare and make_target")
+        _, self.stats = render(
+            self._positions, self._triangles, self._view, self._projection, self.target.size,
+            self._shading, self.options, normals=self._normals, values=self._values,
+            triangle_values=self._triangle_values, clip_planes=self._planes,
+            frame=self.target.frame)
+
+    def release(self) -> None:
+        self.mesh = None
+        self.target = None
