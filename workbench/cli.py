@@ -126,7 +126,19 @@ def cmd_render(args) -> int:
         raise ValueError(f"path {path_name!r} draws {kind} scenes; {args.mesh!r} is "
                          f"{'an FE mesh' if is_mesh else 'a spacetime scene'}")
     path = make_path(path_name, **_render_options(args, kind))
-    ctx = create_context()
+    ctx = None
+    if args.rasterizer == "software":
+        from .algo.softraster import RasterOptions
+        from .paths.software import SoftwarePath
+
+        bits = args.subpixel_bits
+        if bits is None:
+            bits = 0 if args.generator == "table" else 8
+        options = RasterOptions(generator=args.generator, table_size=args.table_size,
+                                subpixel_bits=bits, threads=args.threads)
+        path = SoftwarePath(path_name, path.style, options)
+    else:
+        ctx = create_context()
     size = args.size
     camera = default_camera(scene, size, view=args.view, projection=args.projection, up=args.up,
                             style=path.style)
@@ -143,7 +155,8 @@ def cmd_render(args) -> int:
         save_png(out, result.image)
     strips = f", {path.strips} strip{'s' * (path.strips != 1)}" if path.strips else ""
     print(f"{out}: {result.row['scene']}, {path.triangles} triangles, {path.vertices_sent} "
-          f"vertices sent{strips}, path {path_name}")
+          f"vertices sent{strips}, path {path_name}"
+          + (f", {result.row['renderer']}" if args.rasterizer == "software" else ""))
     return 0
 
 
@@ -301,6 +314,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--samples", type=int, default=0, help="MSAA samples (0: none)")
     p.add_argument("--units", default="", help="units of the field, for the colour bar label")
     p.add_argument("--raw", action="store_true", help="write the bare image without a colour bar")
+    p.add_argument("--rasterizer", choices=("gl", "software"), default="gl",
+                   help="draw through the headless GL context (default) or with the es2008 "
+                        "software rasterizer on the CPU (mesh paths, orthographic views)")
+    p.add_argument("--generator", choices=("halfspace", "table"), default="halfspace",
+                   help="software fragment generator: half-space tests (default) or the span "
+                        "look-up table (needs --subpixel-bits 0, its default)")
+    p.add_argument("--table-size", type=int, default=10, metavar="S",
+                   help="span table size S in pixels (default 10; 15 and 20 as in es2008)")
+    p.add_argument("--subpixel-bits", type=int, metavar="B",
+                   help="software vertex snapping: 8 as llvmpipe (default), 0 for the table")
+    p.add_argument("--threads", type=int, help="software rasterizer threads (default: all cores)")
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("hausdorff", help="certified Hausdorff distance between two meshes",

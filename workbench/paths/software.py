@@ -59,6 +59,7 @@ class SoftwarePath(RenderPath):
     """The image of mesh path ``name`` with ``style``, rasterized on the CPU with ``options``."""
 
     rasterizer = "software"
+    needs = frozenset({"triangles"})  # replaced by the wrapped path's
 
     def __init__(self, name: str = "pixel_color", style=None,
                  options: RasterOptions = RasterOptions()) -> None:
@@ -66,8 +67,15 @@ class SoftwarePath(RenderPath):
         if name not in SHADING_OF:
             raise ValueError(f"the software rasterizer draws the mesh paths "
                              f"{', '.join(SHADING_OF)}; not {name!r}")
-        self.name, self.needs, self.style_class = name, cls.needs, cls.style_class
+        if style is not None and getattr(style, "wireframe", False):
+            raise ValueError("the software rasterizer draws no wire frame (a GL line pass); "
+                             "drop the wire frame")
+        if style is not None and getattr(style, "strips", "none") != "none":
+            raise ValueError("strips are a GL index layout; the software rasterizer draws the "
+                             "same triangles from the list: use strips='none'")
+        self.name, self.style_class = name, cls.style_class
         super().__init__(style)
+        self.needs = cls.needs
         self.options = options
         self._gl: MeshPath = cls(self.style)
         self.target: SoftwareTarget | None = None
@@ -93,12 +101,6 @@ class SoftwarePath(RenderPath):
     # ------------------------------------------------------------------ prepare
     def prepare(self, ctx, mesh, camera) -> None:
         style = self.style
-        if style.wireframe:
-            raise ValueError("the software rasterizer draws no wire frame (a GL line pass); "
-                             "drop the wire frame")
-        if style.strips != "none":
-            raise ValueError("strips are a GL index layout; the software rasterizer draws the "
-                             "same triangles from the list: use strips='none'")
         if camera.projection != "orthographic":
             raise ValueError("the software rasterizer draws orthographic views only")
         gl = self._gl

@@ -1,0 +1,139 @@
+"""Sort-last rendering on a real 2-process LocalCluster: domains of a synthetic scene (axis-aligned
+rectangles drawn in index order with a strict ``<`` depth test) rendered on the workers and
+composited there must give the one-process image exactly; the transfer count must match what
+the schedule sends between ranks on different workers."""
+
+from __future__ import annotations
+
+import logging
+import sys
+
+import cloudpickle
+import dask
+import numpy as np
+import pytest
+from distributed import Client, LocalCluster
+
+from workbench.algo.softraster.composite import binary_swap, binary_tree, swap_plan, tree_plan
+from workbench.algo.softraster.frame import Frame
+from workbench.experiment.sortlast import SortLastStats, render_sortlast
+
+# the workers cannot import this test module: ship its functions by value
+cloudpickle.register_pickle_by_value(sys.modules[__name__])
+
+WIDTH, HEIGHT, COUNT = 21, 15, 48
+_rng = np.random.default_rng(7)
+RECTS = np.c_[np.sort(_rng.integers(0, WIDTH + 1, (COUNT, 2)), axis=1),
+              np.sort(_rng.integers(0, HEIGHT + 1, (COUNT, 2)), axis=1)]
+DEPTH = _rng.choice(np.float32([0.25, 0.5, 0.75]), COUNT)  # many ties across domains
+COLOR = _rng.integers(0, 256, (COUNT, 4)).astype(np.uint8)
+PIXEL_BYTES = 4 + 4 + 8
+
+
+def render_rects(indices: np.ndarray) -> Frame:
+    """The rectangles ``indices`` drawn in index order with the LESS depth test, on a
+    background set by the lowest index (interleaved domains each get their own; where every
+    frame is empty the composite must show domain 0's, which is the one-pass render's)."""
+    first = int(min(indices, default=0))
+    frame = Frame.empty(WIDTH, HEIGHT, background=(40 * first % 256, 200, 100, 255))
+    for i in sorted(int(i) for i in indices):
+        x0, x1, y0, y1 = RECTS[i]
+        window = (slice(y0, y1), slice(x0, x1))
+        passed = DEPTH[i] < frame.depth[window]
+        frame.color[window][passed] = COLOR[i]
+        frame.depth[window][passed] = DEPTH[i]
+        frame.triangle[window][passed] = i
+    return frame
+
+
+def render_wrong_size(indices: np.ndarray) -> Frame:
+    return Frame.empty(4 + len(indices), 3)
+
+
+def render_failing(indices: np.ndarray) -> Frame:
+    if 1 in indices:
+        raise RuntimeError("domain with rectangle 1 cannot be drawn")
+    return render_rects(indices)
+
+
+def interleaved(domains: int) -> list[np.ndarray]:
+    return [np.arange(d, COUNT, domains, dtype=np.int64) for d in range(domains)]
+
+
+@pytest.fixture(scope="module")
+def client():
+    with dask.config.set({"distributed.worker.profile.enabled": False}):
+        cluster = LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
+                               dashboard_address=None, silence_logs=logging.CRITICAL)
+    client = Client(cluster)
+    yield client
+    client.close()
+    cluster.close()
+
+
+def cross_worker_bytes(method: str, domains: int, workers: int = 2) -> int:
+    """What the schedule sends between ranks on different workers, domain i rendered on worker
+    i mod ``workers`` (the placement :func:`render_sortlast` asks for)."""
+    frame_pixels = WIDTH * HEIGHT
+    on = [d % workers for d in range(domains)]
+    if method == "tree":
+        pixels = sum(frame_pixels for pairs in tree_plan(domains).rounds
+                     for receiver, sender in pairs if on[receiver] != on[sender])
+        return pixels * PIXEL_BYTES
+    plan = swap_plan(domains, HEIGHT, WIDTH)
+    pixels = sum(frame_pixels for keeper, sender in plan.fold if on[keeper] != on[sender])
+    rank_on = [on[d] for d in plan.ranks]
+    pixels += sum(e.lower_keeps.pixels + e.upper_keeps.pixels for r in plan.rounds for e in r
+                  if rank_on[e.lower] != rank_on[e.upper])
+    pixels += sum(region.pixels for region, w in zip(plan.regions[1:], rank_on[1:])
+                  if w != rank_on[0])
+    return pixels * PIXEL_BYTES
+
+
+@pytest.mark.parametrize("domains", [1, 2, 4])
+@pytest.mark.parametrize("method", ["tree", "swap"])
+def test_sortlast_equals_one_process_render(client, method, domains):
+    whole = render_rects(np.arange(COUNT))
+    parts = interleaved(domains)
+    out, stats = render_sortlast(client, render_rects, parts, method=method)
+    for name in ("color", "depth", "triangle"):
+        got, want = getattr(out, name), getattr(whole, name)
+        assert got.dtype == want.dtype
+        np.testing.assert_array_equal(got, want, err_msg=name)
+    frames = [render_rects(p) for p in parts]
+
+    assert isinstance(stats, SortLastStats)
+    assert (stats.domains, stats.method) == (domains, method)
+    assert stats.render_s > 0 and stats.composite_s > 0
+    schedule = binary_tree if method == "tree" else binary_swap
+    assert stats.schedule_bytes == schedule(frames)[1].bytes_moved
+    if domains == 1:
+        assert stats.workers == 1 and stats.bytes_moved == 0 == stats.schedule_bytes
+    else:
+        assert stats.workers >= 2
+        assert stats.bytes_moved > 0
+        # honest count: exactly the schedule's traffic between ranks on different workers
+        assert stats.bytes_moved == cross_worker_bytes(method, domains)
+    if domains == 2:  # one rank per worker: everything the schedule sends crosses workers
+        assert stats.bytes_moved == stats.schedule_bytes
+
+
+def test_sortlast_three_domains_swap_folds(client):
+    whole = render_rects(np.arange(COUNT))
+    out, stats = render_sortlast(client, render_rects, interleaved(3), method="swap")
+    np.testing.assert_array_equal(out.triangle, whole.triangle)
+    np.testing.assert_array_equal(out.color, whole.color)
+    assert stats.bytes_moved == cross_worker_bytes("swap", 3)
+
+
+def test_sortlast_refusals(client):
+    with pytest.raises(ValueError, match="unknown compositing method 'ring'"):
+        render_sortlast(client, render_rects, interleaved(2), method="ring")
+    with pytest.raises(ValueError, match="at least one domain"):
+        render_sortlast(client, render_rects, [])
+    with pytest.raises(ValueError, match="domain 1 must be a 1-D array"):
+        render_sortlast(client, render_rects, [np.arange(3), np.zeros((2, 2), np.int64)])
+    with pytest.raises(ValueError, match="differ in size"):
+        render_sortlast(client, render_wrong_size, [np.arange(2), np.arange(3)])
+    with pytest.raises(RuntimeError, match="rectangle 1 cannot be drawn"):
+        render_sortlast(client, render_failing, interleaved(2), method="swap")

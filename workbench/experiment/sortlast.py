@@ -1,0 +1,227 @@
+"""Sort-last rendering on a Dask cluster (es2008, section 1): domains rendered on the workers,
+their frames composited by depth on the workers, the final image brought to the client.
+
+:func:`render_sortlast` submits one render task per domain, spread over the workers in turn
+(domain i to the i-th worker, in address order, modulo their number). Once every frame exists
+it composites them by the schedule of :mod:`workbench.algo.softraster.composite`, as Dask tasks
+that take futures, so that Dask itself moves the (sub-)images between workers. Each rank of
+the schedule is the worker holding that domain's frame, and each compositing task is placed on
+the worker of the rank that receives. Placements are preferences (``allow_other_workers``):
+Dask follows them while the worker is up and runs a task elsewhere rather than wait for a lost
+one; a task run elsewhere (also by work stealing) shows as extra ``bytes_moved``:
+
+* ``"tree"``: one ``composite`` task per pair and round; the result ends on rank 0's worker.
+* ``"swap"``: per pair and round, two crop tasks (each rank cuts out the half it gives up) and
+  two merge tasks (each rank composites the half it keeps with the half it receives), after a
+  fold of whole frames when the domain count is not a power of two; a final gather task on
+  rank 0's worker assembles the image from every rank's region.
+
+The two phases do not overlap: compositing starts once every frame exists, so that render and
+composite times are measured apart. The result equals ``functools.reduce(composite, frames)``
+exactly, whatever the placement.
+"""
+
+from __future__ import annotations
+
+import time
+import uuid
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from dask.sizeof import sizeof
+from distributed import Client, wait
+
+from ..algo.softraster.composite import (Region, assemble, bytes_per_pixel, composite, crop,
+                                         swap_plan, tree_plan)
+from ..algo.softraster.frame import Frame
+
+METHODS = ("tree", "swap")
+KEY_PREFIX = "sortlast"
+
+
+@sizeof.register(Frame)
+def _sizeof_frame(frame: Frame) -> int:
+    """A frame's size to Dask (memory accounting, placement, transfer logs): its array bytes."""
+    return int(frame.nbytes)
+
+
+@dataclass
+class SortLastStats:
+    """One sort-last run: ``domains`` frames composited by ``method`` (``"tree"`` or
+    ``"swap"``), rendered on ``workers`` distinct workers.
+
+    ``render_s``: wall seconds from submitting the render tasks until every domain frame
+    exists. ``composite_s``: wall seconds from then until the final frame is in the client
+    (frame-size check, compositing tasks, fetching the result).
+    ``bytes_moved``: bytes of compositing-task inputs that travelled from one worker to
+    another, summed from every worker's log of received dependencies
+    (``distributed.Worker.transfer_incoming_log``; a frame counts its colour + depth + triangle
+    array bytes). Inputs already on the worker that runs a task count nothing, so this is
+    below ``schedule_bytes`` when several ranks share a worker; the index arrays shipped with
+    the render tasks and the final frame fetched by the client are not worker-to-worker
+    transfers and do not count. A worker's log keeps its last
+    ``distributed.admin.low-level-log-length`` transfers (1000 by default), which bounds the
+    runs this can count. ``schedule_bytes``: what the schedule itself sends between
+    ranks (:class:`~workbench.algo.softraster.composite.CompositeStats`)."""
+
+    domains: int
+    method: str
+    workers: int
+    render_s: float
+    composite_s: float
+    bytes_moved: int
+    schedule_bytes: int
+
+
+def render_sortlast(client: Client, render_domain: Callable[[np.ndarray], Frame],
+                    domains: Sequence[np.ndarray], method: str = "tree",
+                    ) -> tuple[Frame, SortLastStats]:
+    """Render each domain with ``render_domain`` on the cluster of ``client`` and composite
+    the frames by ``method`` (``"tree"``: binary tree; ``"swap"``: binary swap) on the workers.
+
+    ``render_domain`` is a picklable callable taking one int64 array of triangle indices and
+    returning that domain's :class:`Frame` of the whole image; ``domains`` lists the arrays
+    (e.g. from :func:`workbench.scene.domains.split_domains`), frame i coming from domain i.
+    Returns the composite — exactly ``functools.reduce(composite, frames)`` — and its
+    :class:`SortLastStats`.
+
+    Refused (ValueError): an unknown ``method``; no domains; a domain that is not a 1-D array
+    of integers; domain frames of different sizes. An error raised by ``render_domain``
+    reaches the caller as raised.
+    """
+    if method not in METHODS:
+        raise ValueError(f"unknown compositing method {method!r}: expected one of "
+                         f"{', '.join(METHODS)}")
+    arrays = [_domain(d, i) for i, d in enumerate(domains)]
+    if not arrays:
+        raise ValueError("need at least one domain, got none")
+    addresses = sorted(client.scheduler_info(n_workers=-1)["workers"])
+    if not addresses:
+        raise ValueError("the cluster has no workers")
+    client.run(_ensure_sizeof)  # every worker sizes frames by their array bytes from now on
+    run = f"{KEY_PREFIX}-{uuid.uuid4().hex[:10]}"
+
+    start = time.perf_counter()
+    frames = [client.submit(render_domain, tris, key=f"{run}-render-d{i}", pure=False,
+                            workers=[addresses[i % len(addresses)]], allow_other_workers=True)
+              for i, tris in enumerate(arrays)]
+    wait(frames)
+    rendered = time.perf_counter()
+    for frame in frames:
+        if frame.status != "finished":
+            frame.result()  # raises the render error
+
+    holders = client.who_has(frames)
+    where = [min(holders[f.key]) for f in frames]
+    sizes = client.gather([client.submit(_frame_shape, f, key=f"{run}-shape-d{i}", pure=False,
+                                         workers=[where[i]], allow_other_workers=True)
+                           for i, f in enumerate(frames)])
+    if len(set(sizes)) > 1:
+        raise ValueError(f"domain frames differ in size: {sorted(set(sizes))} "
+                         f"(rows, columns, channels)")
+    height, width, _ = sizes[0]
+    schedule = _tree if method == "tree" else _swap
+    final, schedule_pixels = schedule(client, run, frames, where, height, width)
+    result = final.result()
+    done = time.perf_counter()
+
+    moved = client.run(_received_bytes, run)
+    stats = SortLastStats(len(arrays), method, len(set(where)), rendered - start, done - rendered,
+                          int(sum(moved.values())), schedule_pixels * bytes_per_pixel(result))
+    return result, stats
+
+
+def _domain(d, i: int) -> np.ndarray:
+    a = np.asarray(d)
+    if a.ndim != 1 or not (np.issubdtype(a.dtype, np.integer) or a.size == 0):
+        raise ValueError(f"domain {i} must be a 1-D array of triangle indices, got "
+                         f"shape {a.shape} dtype {a.dtype}")
+    return a.astype(np.int64)
+
+
+def _tree(client, run, frames, where, height, width):
+    """Binary-tree tasks; returns the final future and the schedule's pixels sent."""
+    plan = tree_plan(len(frames))
+    held = dict(enumerate(frames))
+    for k, pairs in enumerate(plan.rounds):
+        for receiver, sender in pairs:
+            held[receiver] = client.submit(
+                composite, held[receiver], held.pop(sender),
+                key=f"{run}-tree-round{k}-d{receiver}-d{sender}", pure=False,
+                workers=[where[receiver]], allow_other_workers=True)
+    return held[0], plan.bytes_moved(height, width, 1)
+
+
+def _swap(client, run, frames, where, height, width):
+    """Binary-swap tasks; returns the final future and the schedule's pixels sent."""
+    plan = swap_plan(len(frames), height, width)
+
+    def submit(fn, *args, key, rank_domain):
+        return client.submit(fn, *args, key=f"{run}-swap-{key}", pure=False,
+                             workers=[where[rank_domain]], allow_other_workers=True)
+
+    folded = {keeper: submit(composite, frames[keeper], frames[sender],
+                             key=f"fold-d{keeper}-d{sender}", rank_domain=keeper)
+              for keeper, sender in plan.fold}
+    held = [folded.get(d, frames[d]) for d in plan.ranks]
+    for k, exchanges in enumerate(plan.rounds):
+        for e in exchanges:
+            low_d, high_d = plan.ranks[e.lower], plan.ranks[e.upper]
+            low_part, high_part = e.lower_keeps.within(e.held), e.upper_keeps.within(e.held)
+            # each rank cuts out the half it gives up, on its own worker
+            to_low = submit(_cut, held[e.upper], low_part,
+                            key=f"round{k}-cut-d{high_d}-to-d{low_d}", rank_domain=high_d)
+            to_high = submit(_cut, held[e.lower], high_part,
+                             key=f"round{k}-cut-d{low_d}-to-d{high_d}", rank_domain=low_d)
+            # and composites the half it keeps with the half it receives, lower domain first
+            held[e.lower] = submit(_merge, held[e.lower], low_part, to_low, None,
+                                   key=f"round{k}-merge-d{low_d}", rank_domain=low_d)
+            held[e.upper] = submit(_merge, to_high, None, held[e.upper], high_part,
+                                   key=f"round{k}-merge-d{high_d}", rank_domain=high_d)
+    if len(held) == 1:
+        final = held[0]
+    else:
+        final = submit(_gather, height, width, plan.regions, *held, key="gather",
+                       rank_domain=plan.ranks[0])
+    return final, plan.bytes_moved(1)
+
+
+# ------------------------------------------------------------------------ worker-side tasks
+def _ensure_sizeof() -> None:
+    """Run on every worker: importing this module registers the frame size with Dask."""
+
+
+def _frame_shape(frame: Frame) -> tuple[int, int, int]:
+    return tuple(int(s) for s in frame.color.shape)
+
+
+def _cut(frame: Frame, region: Region) -> Frame:
+    """A compact copy of the sub-image ``region`` of ``frame`` (what one rank sends)."""
+    part = crop(frame, region)
+    return Frame(np.ascontiguousarray(part.color), np.ascontiguousarray(part.depth),
+                 np.ascontiguousarray(part.triangle))
+
+
+def _merge(lower: Frame, lower_region: Region | None, upper: Frame,
+           upper_region: Region | None) -> Frame:
+    """``composite`` of the lower rank's and the upper rank's sub-images of one region, each
+    cropped first where a region is given."""
+    if lower_region is not None:
+        lower = crop(lower, lower_region)
+    if upper_region is not None:
+        upper = crop(upper, upper_region)
+    return composite(lower, upper)
+
+
+def _gather(height: int, width: int, regions: tuple[Region, ...], *pieces: Frame) -> Frame:
+    return assemble(height, width, regions, pieces)
+
+
+def _received_bytes(run: str, dask_worker=None) -> int:
+    """Bytes of this run's keys the worker received from other workers (its transfer log)."""
+    total = 0
+    for entry in list(dask_worker.transfer_incoming_log):
+        total += sum(int(n or 0) for key, n in entry["keys"].items()
+                     if isinstance(key, str) and key.startswith(run + "-"))
+    return total
