@@ -27,17 +27,15 @@ GUARD = float(1 << 29)  # |fixed coordinate| limit: edge functions stay below 2^
 
 # ----------------------------------------------------------------------------- helpers
 @numba.njit(cache=True, inline="always")
-def texel_rgba(texels, linear, s):
+def texel_rgba(texels, texf, linear, s):
     """RGBA in [0, 1] (float32) of the one-row texture ``texels`` (n, 4) uint8 at coordinate
-    ``s``, clamp to edge, nearest or linear filtering (8-bit weights)."""
+    ``s``, clamp to edge, nearest or linear filtering (8-bit weights); ``texf`` is
+    ``texels / 255`` in float32."""
     n = texels.shape[0]
     if not linear:
         i = int(np.floor(s * np.float32(n)))
         i = min(max(i, 0), n - 1)
-        return (np.float32(texels[i, 0]) / np.float32(255.0),
-                np.float32(texels[i, 1]) / np.float32(255.0),
-                np.float32(texels[i, 2]) / np.float32(255.0),
-                np.float32(texels[i, 3]) / np.float32(255.0))
+        return texf[i, 0], texf[i, 1], texf[i, 2], texf[i, 3]
     # linear filtering as llvmpipe does it for 8-bit texels: the weight rounded to 1/256, the
     # blend rounded to 8 bits (checked against llvmpipe: identical over a 4096-pixel ramp)
     u = s * np.float32(n) - np.float32(0.5)
@@ -113,7 +111,7 @@ def transform(pos, mvp, width, height, bits, fx, fy, fz, ok):
 
 
 @numba.njit(cache=True, parallel=True)
-def light_vertices(kind, view, normals, s, texels, linear, missing, attr):
+def light_vertices(kind, view, normals, s, texels, texf, linear, missing, attr):
     """Per-vertex shading inputs ``attr`` (V, A) float32 for the Gouraud kinds: GOURAUD → the
     headlight of the crease-split normal; VERTEX_COLOR → lit colour RGB and transfer α;
     PIXEL_COLOR → texture coordinate and headlight. ``view`` (3, 3) float32, ``normals`` (V, 3)
@@ -132,7 +130,7 @@ def light_vertices(kind, view, normals, s, texels, linear, missing, attr):
             if s[v] < MISSING_S:
                 r, g, b, a = missing[0], missing[1], missing[2], np.float32(1.0)
             else:
-                r, g, b, a = texel_rgba(texels, linear, s[v])
+                r, g, b, a = texel_rgba(texels, texf, linear, s[v])
             attr[v, 0] = r * light
             attr[v, 1] = g * light
             attr[v, 2] = b * light
@@ -154,18 +152,21 @@ def light_triangles(pos, tris, view, fx, fy, bits, out):
         if det == 0:
             out[k] = np.float32(0.25)
             continue
-        gx = np.empty(3)
-        gy = np.empty(3)
-        for r in range(3):
-            e1 = view[r, 0] * (pos[b, 0] - pos[a, 0]) + view[r, 1] * (pos[b, 1] - pos[a, 1]) \
-                + view[r, 2] * (pos[b, 2] - pos[a, 2])
-            e2 = view[r, 0] * (pos[c, 0] - pos[a, 0]) + view[r, 1] * (pos[c, 1] - pos[a, 1]) \
-                + view[r, 2] * (pos[c, 2] - pos[a, 2])
-            gx[r] = (e1 * y2 - e2 * y1) / det
-            gy[r] = (e2 * x1 - e1 * x2) / det
-        nx = gx[1] * gy[2] - gx[2] * gy[1]
-        ny = gx[2] * gy[0] - gx[0] * gy[2]
-        nz = gx[0] * gy[1] - gx[1] * gy[0]
+        dp1x, dp1y, dp1z = pos[b, 0] - pos[a, 0], pos[b, 1] - pos[a, 1], pos[b, 2] - pos[a, 2]
+        dp2x, dp2y, dp2z = pos[c, 0] - pos[a, 0], pos[c, 1] - pos[a, 1], pos[c, 2] - pos[a, 2]
+        # eye-space differences along the two edges, then their gradients over the image
+        e1x = view[0, 0] * dp1x + view[0, 1] * dp1y + view[0, 2] * dp1z
+        e1y = view[1, 0] * dp1x + view[1, 1] * dp1y + view[1, 2] * dp1z
+        e1z = view[2, 0] * dp1x + view[2, 1] * dp1y + view[2, 2] * dp1z
+        e2x = view[0, 0] * dp2x + view[0, 1] * dp2y + view[0, 2] * dp2z
+        e2y = view[1, 0] * dp2x + view[1, 1] * dp2y + view[1, 2] * dp2z
+        e2z = view[2, 0] * dp2x + view[2, 1] * dp2y + view[2, 2] * dp2z
+        gxx, gyx = (e1x * y2 - e2x * y1) / det, (e2x * x1 - e1x * x2) / det
+        gxy, gyy = (e1y * y2 - e2y * y1) / det, (e2y * x1 - e1y * x2) / det
+        gxz, gyz = (e1z * y2 - e2z * y1) / det, (e2z * x1 - e1z * x2) / det
+        nx = gxy * gyz - gxz * gyy
+        ny = gxz * gyx - gxx * gyz
+        nz = gxx * gyy - gxy * gyx
         len2 = nx * nx + ny * ny + nz * nz
         out[k] = np.float32(0.25 + 0.75 * abs(nz) / np.sqrt(len2)) if len2 > 0 else np.float32(0.25)
 
@@ -280,20 +281,21 @@ def collect_table_fit(verts, size, fit):
 
 # ----------------------------------------------------------------------------- bin
 @numba.njit(cache=True, parallel=True)
-def bin_triangles(box, tile, tiles_x, n_tiles, chunks):
-    """Screen tiles of ``tile`` × ``tile`` pixels: each kept triangle listed in every tile its
+def bin_triangles(box, shift, tiles_x, n_tiles, chunks):
+    """Screen tiles of ``2^shift`` × ``2^shift`` pixels: each kept triangle listed in every tile its
     box meets, in triangle order. Returns ``(start, members, frag_start)``: tile t's triangles
     are ``members[start[t]:start[t + 1]]``; ``frag_start`` (n_tiles + 1) bounds each tile's
     fragment slots by the area of the boxes it clips. The triangles are counted and placed in
     ``chunks`` consecutive runs in parallel; the lists do not depend on ``chunks``."""
     n = box.shape[0]
+    tile = 1 << shift
     count = np.zeros((chunks, n_tiles), np.int64)
     slots = np.zeros((chunks, n_tiles), np.int64)
     for c in prange(chunks):
         for m in range(c * n // chunks, (c + 1) * n // chunks):
-            for ty in range(box[m, 2] // tile, box[m, 3] // tile + 1):
+            for ty in range(box[m, 2] >> shift, (box[m, 3] >> shift) + 1):
                 j0, j1 = max(box[m, 2], ty * tile), min(box[m, 3], ty * tile + tile - 1)
-                for tx in range(box[m, 0] // tile, box[m, 1] // tile + 1):
+                for tx in range(box[m, 0] >> shift, (box[m, 1] >> shift) + 1):
                     i0, i1 = max(box[m, 0], tx * tile), min(box[m, 1], tx * tile + tile - 1)
                     count[c, ty * tiles_x + tx] += 1
                     slots[c, ty * tiles_x + tx] += (i1 - i0 + 1) * (j1 - j0 + 1)
@@ -311,8 +313,8 @@ def bin_triangles(box, tile, tiles_x, n_tiles, chunks):
     members = np.empty(start[n_tiles], np.int32)
     for c in prange(chunks):
         for m in range(c * n // chunks, (c + 1) * n // chunks):
-            for ty in range(box[m, 2] // tile, box[m, 3] // tile + 1):
-                for tx in range(box[m, 0] // tile, box[m, 1] // tile + 1):
+            for ty in range(box[m, 2] >> shift, (box[m, 3] >> shift) + 1):
+                for tx in range(box[m, 0] >> shift, (box[m, 1] >> shift) + 1):
                     t = ty * tiles_x + tx
                     members[fill[c, t]] = m
                     fill[c, t] += 1
@@ -340,6 +342,7 @@ def generate_fragments(start, members, frag_start, verts, box, fit, lo_table, hi
             i0, i1 = max(box[m, 0], ti0), min(box[m, 1], ti0 + tile - 1)
             j0, j1 = max(box[m, 2], tj0), min(box[m, 3], tj0 + tile - 1)
             x0, y0 = verts[m, 0], verts[m, 1]
+            zc, za, zb = zplane[m, 0, 0], zplane[m, 0, 1], zplane[m, 0, 2]
             if fit[m]:
                 base = ((((verts[m, 2] - x0 + size) * span + verts[m, 3] - y0 + size) * span
                          + verts[m, 4] - x0 + size) * span + verts[m, 5] - y0 + size) * span
@@ -351,8 +354,7 @@ def generate_fragments(start, members, frag_start, verts, box, fit, lo_table, hi
                     a = max(x0 + first - size, i0)
                     b = min(x0 + hi_table[row] - size, i1)
                     for i in range(a, b + 1):
-                        if early and np.float32(zplane[m, 0, 0] + zplane[m, 0, 1] * i
-                                                + zplane[m, 0, 2] * j) > depth[j, i]:
+                        if early and np.float32(zc + za * i + zb * j) > depth[j, i]:
                             continue
                         frag_tri[pos] = m
                         frag_i[pos] = i
@@ -369,15 +371,16 @@ def generate_fragments(start, members, frag_start, verts, box, fit, lo_table, hi
             bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
             step0, step1, step2 = dy0 << bits, dy1 << bits, dy2 << bits
             px0 = i0 << bits
+            zc, za, zb = zplane[m, 0, 0], zplane[m, 0, 1], zplane[m, 0, 2]
             for j in range(j0, j1 + 1):
                 py = j << bits
                 e0 = dx0 * (py - y0) - dy0 * (px0 - x0) - bias0
                 e1 = dx1 * (py - y1) - dy1 * (px0 - x1) - bias1
                 e2 = dx2 * (py - y2) - dy2 * (px0 - x2) - bias2
                 for i in range(i0, i1 + 1):
-                    if e0 >= 0 and e1 >= 0 and e2 >= 0 and not (
-                            early and np.float32(zplane[m, 0, 0] + zplane[m, 0, 1] * i
-                                                 + zplane[m, 0, 2] * j) > depth[j, i]):
+                    # all three ≥ 0 ⇔ their bitwise or ≥ 0
+                    if (e0 | e1 | e2) >= 0 and not (
+                            early and np.float32(zc + za * i + zb * j) > depth[j, i]):
                         frag_tri[pos] = m
                         frag_i[pos] = i
                         frag_j[pos] = j
@@ -409,20 +412,44 @@ def interpolate_z(frag_start, frag_count, frag_tri, frag_i, frag_j, zplane, plan
 
 @numba.njit(cache=True, parallel=True)
 def interpolate_color(kind, frag_start, frag_count, frag_tri, frag_i, frag_j, planes, kept,
-                      tri_light, tri_s, base, missing, texels, linear, alpha_test, frag_z,
+                      tri_light, tri_s, base, missing, texels, texf, linear, alpha_test, frag_z,
                       frag_rgba):
     """Packed RGBA8 of every fragment not yet rejected, as the mesh path of ``kind`` shades it;
-    a fragment whose colour fails the alpha test (α < ½, with ``alpha_test``) is rejected."""
+    a fragment whose colour fails the alpha test (α < ½, with ``alpha_test``) is rejected.
+    The kinds whose colour is one per triangle (constant, flat, element colour) compute it
+    once per run of the triangle's fragments."""
+    per_triangle = kind == CONSTANT or kind == FLAT or kind == ELEMENT_COLOR
     for t in prange(frag_count.shape[0]):
+        last = -1
+        color = np.uint32(0)
+        visible = True
         for f in range(frag_start[t], frag_start[t] + frag_count[t]):
             if frag_z[f] == np.inf:
                 continue
             m, i, j = frag_tri[f], frag_i[f], frag_j[f]
-            if kind == CONSTANT:
-                frag_rgba[f] = pack(base[0], base[1], base[2])
-            elif kind == FLAT:
-                light = tri_light[kept[m]]
-                frag_rgba[f] = pack(base[0] * light, base[1] * light, base[2] * light)
+            if per_triangle:
+                if m != last:
+                    last = m
+                    visible = True
+                    if kind == CONSTANT:
+                        color = pack(base[0], base[1], base[2])
+                    elif kind == FLAT:
+                        light = tri_light[kept[m]]
+                        color = pack(base[0] * light, base[1] * light, base[2] * light)
+                    else:  # ELEMENT_COLOR
+                        s = tri_s[kept[m]]
+                        light = tri_light[kept[m]]
+                        if s < MISSING_S:
+                            color = pack(missing[0] * light, missing[1] * light,
+                                         missing[2] * light)
+                        else:
+                            r, g, b, a = texel_rgba(texels, texf, linear, s)
+                            visible = not (alpha_test and a < 0.5)
+                            color = pack(r * light, g * light, b * light)
+                if visible:
+                    frag_rgba[f] = color
+                else:
+                    frag_z[f] = np.float32(np.inf)
             elif kind == GOURAUD:
                 light = np.float32(planes[m, 0, 0] + planes[m, 0, 1] * i + planes[m, 0, 2] * j)
                 frag_rgba[f] = pack(base[0] * light, base[1] * light, base[2] * light)
@@ -435,19 +462,14 @@ def interpolate_color(kind, frag_start, frag_count, frag_tri, frag_i, frag_j, pl
                     frag_z[f] = np.float32(np.inf)
                 else:
                     frag_rgba[f] = pack(r, g, b)
-            else:
-                if kind == PIXEL_COLOR:
-                    s = np.float32(planes[m, 0, 0] + planes[m, 0, 1] * i + planes[m, 0, 2] * j)
-                    light = np.float32(planes[m, 1, 0] + planes[m, 1, 1] * i
-                                       + planes[m, 1, 2] * j)
-                else:  # ELEMENT_COLOR
-                    s = tri_s[kept[m]]
-                    light = tri_light[kept[m]]
+            else:  # PIXEL_COLOR
+                s = np.float32(planes[m, 0, 0] + planes[m, 0, 1] * i + planes[m, 0, 2] * j)
+                light = np.float32(planes[m, 1, 0] + planes[m, 1, 1] * i + planes[m, 1, 2] * j)
                 if s < MISSING_S:
                     frag_rgba[f] = pack(missing[0] * light, missing[1] * light,
                                         missing[2] * light)
                     continue
-                r, g, b, a = texel_rgba(texels, linear, s)
+                r, g, b, a = texel_rgba(texels, texf, linear, s)
                 if alpha_test and a < 0.5:
                     frag_z[f] = np.float32(np.inf)
                 else:

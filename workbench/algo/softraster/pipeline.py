@@ -101,7 +101,7 @@ class RasterOptions:
     """``generator``: "halfspace" or "table" (the span table for table-fit triangles, the
     half-space tests for the others); ``table_size``: the table's S in pixels;
     ``subpixel_bits``: 8 as llvmpipe, 0 for the table; ``threads``: numba threads (None: all);
-    ``tile``: screen tile edge in pixels; ``session``: triangles per session;
+    ``tile``: screen tile edge in pixels (a power of two); ``session``: triangles per session;
     ``early_depth``: skip generating fragments that already fail the depth test (the image
     is the same; es2008 generates them all)."""
 
@@ -124,10 +124,10 @@ class RasterOptions:
             raise ValueError(f"table_size must be an integer in 2..63, got {self.table_size}")
         if self.threads is not None and (int(self.threads) != self.threads or self.threads < 1):
             raise ValueError(f"threads must be a positive integer, got {self.threads}")
-        for name in ("tile", "session"):
-            value = getattr(self, name)
-            if int(value) != value or value < 1:
-                raise ValueError(f"{name} must be a positive integer, got {value}")
+        if int(self.session) != self.session or self.session < 1:
+            raise ValueError(f"session must be a positive integer, got {self.session}")
+        if int(self.tile) != self.tile or self.tile < 1 or self.tile & (self.tile - 1):
+            raise ValueError(f"tile must be a power of two, got {self.tile}")
 
 
 @dataclass
@@ -265,6 +265,7 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
         size_s = options.table_size
     texels = np.ascontiguousarray(shading.texels if shading.texels is not None
                                   else np.zeros((1, 4)), np.uint8)
+    texf = texels.astype(np.float32) / np.float32(255.0)
     base = np.asarray(shading.base_color, np.float32)
     missing = np.asarray(shading.missing_color, np.float32)
     seconds = stats.seconds
@@ -296,7 +297,7 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
                 s[~np.isfinite(t)] = np.float32(-1e30)
             k.light_vertices(code, view[:3, :3].astype(np.float32),
                              np.asarray(normals, np.float64).astype(np.float32), s, texels,
-                             shading.linear, missing, attr)
+                             texf, shading.linear, missing, attr)
         tri_light = np.zeros(len(tris) if kind in ("flat", "element_color") else 1, np.float32)
         if kind in ("flat", "element_color"):
             k.light_triangles(pos, tris, np.ascontiguousarray(view[:3, :3]), fx, fy, bits,
@@ -312,6 +313,7 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
             clipd = np.ascontiguousarray((rel32 @ p32.T) + w32, np.float32)
         t0 = clock("transform and light", t0)
 
+        shift = options.tile.bit_length() - 1
         tiles_x = -(-width // options.tile)
         n_tiles = tiles_x * (-(-height // options.tile))
         for k0 in range(0, len(tris), options.session):
@@ -340,8 +342,7 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
                 k.collect_table_fit(verts, size_s, fit)
                 stats.table_fit += int(fit.sum())
             t0 = clock("collect table-fit", t0)
-            start, members, frag_start = k.bin_triangles(box, options.tile, tiles_x, n_tiles,
-                                                         threads)
+            start, members, frag_start = k.bin_triangles(box, shift, tiles_x, n_tiles, threads)
             slots = int(frag_start[-1])
             frag_tri = np.empty(slots, np.int32)
             frag_i, frag_j = np.empty(slots, np.int32), np.empty(slots, np.int32)
@@ -359,7 +360,7 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
             t0 = clock("interpolate z", t0)
             frag_rgba = np.empty(slots, np.uint32)
             k.interpolate_color(code, frag_start, frag_count, frag_tri, frag_i, frag_j,
-                                planes_m, kept, tri_light, tri_s, base, missing, texels,
+                                planes_m, kept, tri_light, tri_s, base, missing, texels, texf,
                                 shading.linear, shading.alpha_test, frag_z, frag_rgba)
             t0 = clock("interpolate color", t0)
             k.write_fragments(frag_start, frag_count, frag_tri, frag_i, frag_j, frag_z,
