@@ -348,3 +348,30 @@ def test_quadrisection_sweep_brings_per_vertex_closer_to_per_pixel(tmp_path):
     """, name="mesh.toml")
     result = run_sweep(load_config(mesh_config), tmp_path / "mesh", workers=1, progress=False)
     assert result.failed == 1 and "spacetime" in result.rows[0]["error"]
+
+
+def test_a_point_drawn_by_the_software_rasterizer(ctx):
+    """``rasterizer = "software"`` draws the path on the CPU; its key and sources differ from
+    the GL point's, its image is compared with the GL reference path."""
+    from workbench.experiment.sweep import point_sources
+    from workbench.experiment.sweep_points import measured_columns
+
+    options = dict(field="distance", bands=6)
+    common = dict(index=0, scene="semicylinders:8", path="pixel_color", options=options,
+                  reference="pixel_color", reference_options=options, timed=False)
+    soft, gl = Point(**common, rasterizer="software"), Point(**common)
+    assert point_key(soft, "r") != point_key(gl, "r")
+    assert "workbench/algo/softraster/pipeline.py" in point_sources(soft)
+    assert "workbench/algo/softraster/pipeline.py" not in point_sources(gl)
+    row = measured_columns(soft, ctx)
+    assert row["renderer"].startswith("software rasterizer")
+    assert row["diff_share_differing"] <= 0.005
+    assert soft.columns()["rasterizer"] == "software" and "rasterizer" not in gl.columns()
+
+
+def test_es2008_views_config_is_valid():
+    root = Path(__file__).resolve().parents[1]
+    config = load_config(root / "sweeps" / "es2008_views.toml")
+    points = grid_points(config, quick=True)
+    assert {p.rasterizer for p in points} == {"software", "gl"}
+    assert len({p.view for p in points}) == 8 and len(points) == 16

@@ -17,7 +17,9 @@ A config::
 
 Grid keys: ``scene`` (a built-in scene name or a mesh file), ``path`` (registry names),
 ``size`` ("WxH" pixels, default 400x300), ``samples`` (MSAA), ``view`` ([azimuth, elevation]
-in degrees, default [30, 25]), ``simplifier``, ``tolerance`` and ``quadrisection`` (see below),
+in degrees, default [30, 25]), ``rasterizer`` ("gl", default, or "software": the es2008
+rasterizer on the CPU draws the mesh path, orthographic), ``simplifier``, ``tolerance`` and
+``quadrisection`` (see below),
 and any option of the grid's paths (the fields of their style class: ``bands``, ``field``,
 ``wireframe``, ``strips``, ``clip_planes``, ``fepatch``, ``edge_overdraw`` …). The sweep runs the Cartesian
 product in the order the keys are written, the last key varying fastest. A key that no path of
@@ -94,7 +96,8 @@ __all__ = ["SweepConfig", "SweepResult", "Point", "load_config", "grid_points", 
            "pareto_front", "save_pareto", "add_sweep_parser", "cmd_sweep"]
 
 TOP_KEYS = ("name", "repeats", "reference", "timed", "metric", "grid")
-SWEEP_KEYS = ("scene", "path", "size", "samples", "view")
+SWEEP_KEYS = ("scene", "path", "size", "samples", "view", "rasterizer")
+RASTERIZERS = ("gl", "software")
 SIMPLIFY_KEYS = ("simplifier", "tolerance", "quadrisection")  # preprocessing of the scene
 # how deeply nested one value of a sequence-valued key is (a list of numbers: 1)
 VALUE_DEPTH = {"view": 1, "value_range": 1, "hide_range": 1, "base_color": 1, "wire_color": 1,
@@ -187,6 +190,9 @@ def _check_sweep_values(key: str, values: list) -> list:
             if len(v) != 2 or not all(isinstance(a, (int, float)) for a in v):
                 raise ValueError(f"view must be [azimuth, elevation] in degrees, got {v!r}")
             v = (float(v[0]), float(v[1]))
+        elif key == "rasterizer":
+            if v not in RASTERIZERS:
+                raise ValueError(f"rasterizer must be one of {', '.join(RASTERIZERS)}, got {v!r}")
         elif key == "simplifier":
             if v not in simplifier_names():
                 raise ValueError(f"unknown simplifier {v!r}; known: "
@@ -332,7 +338,7 @@ def grid_points(config: SweepConfig, *, quick: bool = False,
                       tolerance=tolerance, quadrisection=values.get("quadrisection"),
                       reference=config.reference,
                       reference_options=reference_options, repeats=repeats, timed=timed,
-                      quick=quick)
+                      quick=quick, rasterizer=values.get("rasterizer", "gl"))
         identity = json.dumps(point.params(), sort_keys=True)
         if identity in seen:
             continue
@@ -407,6 +413,9 @@ def point_sources(point: Point, glsl_dir=None) -> dict[str, str]:
     if point.simplifier:
         modules |= {PACKAGE / "algo" / "simplify.py", PACKAGE / "algo" / "hausdorff.py",
                     PACKAGE / "experiment" / "simplifiers.py"}
+    if point.rasterizer == "software":
+        modules |= {PACKAGE / "paths" / "software.py",
+                    *(PACKAGE / "algo" / "softraster").glob("*.py")}
     modules |= _scene_modules(point.scene)
     sources = {f"workbench/{m.relative_to(PACKAGE).as_posix()}": _file_digest(m)
                for m in sorted(modules)}

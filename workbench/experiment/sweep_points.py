@@ -44,7 +44,9 @@ class Point:
     simplification), ``quadrisection`` (a spacetime scene's polygons split down to this fraction
     of their mean area, None: not split), ``reference`` (path name whose image gives the error, or None) with
     ``reference_options`` (the grid's options that path takes), ``repeats`` (timed draws),
-    ``timed`` and ``quick`` (smaller built-in scenes). ``index`` is the position in the grid.
+    ``timed`` and ``quick`` (smaller built-in scenes), ``rasterizer`` ("gl", or "software":
+    the es2008 rasterizer draws the path, :class:`~workbench.paths.software.SoftwarePath`).
+    ``index`` is the position in the grid.
     """
 
     index: int
@@ -62,10 +64,13 @@ class Point:
     repeats: int = 7
     timed: bool = True
     quick: bool = False
+    rasterizer: str = "gl"
 
     def params(self) -> dict:
-        """Everything that decides the point's result, as plain JSON values (lists, not tuples)."""
-        return json.loads(json.dumps(dict(
+        """Everything that decides the point's result, as plain JSON values (lists, not tuples);
+        ``rasterizer`` only when it is not GL (the keys of GL points predate it)."""
+        extra = {} if self.rasterizer == "gl" else {"rasterizer": self.rasterizer}
+        return json.loads(json.dumps(dict(**extra,
             scene=self.scene, path=self.path, options=self.options, size=list(self.size),
             samples=self.samples, view=list(self.view), simplifier=self.simplifier,
             tolerance=self.tolerance, quadrisection=self.quadrisection, reference=self.reference,
@@ -76,6 +81,8 @@ class Point:
         """The point's own table columns: index, scene, path, its options, size, and the
         simplifier and tolerance when it has them. Sequence values are written compactly."""
         row = dict(point=self.index, scene=self.scene, path=self.path)
+        if self.rasterizer != "gl":
+            row["rasterizer"] = self.rasterizer
         row.update({k: cell_value(v) for k, v in self.options.items()})
         row["size"] = f"{self.size[0]}x{self.size[1]}"
         if self.simplifier is not None:
@@ -229,6 +236,10 @@ def measured_columns(point: Point, ctx) -> dict:
 
     original = fresh_scene(point.scene, point.quick)
     path = make_path(point.path, **point.options)
+    if point.rasterizer == "software":
+        from ..paths.software import SoftwarePath
+
+        path = SoftwarePath(point.path, path.style)
     kind = scene_kind(original)
     if kind != path.scene_kind:
         raise ValueError(f"path {point.path!r} draws {path.scene_kind} scenes; "
