@@ -137,3 +137,30 @@ def test_sortlast_refusals(client):
         render_sortlast(client, render_wrong_size, [np.arange(2), np.arange(3)])
     with pytest.raises(RuntimeError, match="rectangle 1 cannot be drawn"):
         render_sortlast(client, render_failing, interleaved(2), method="swap")
+
+
+@pytest.mark.parametrize("by,domains", [("space", 2), ("space", 4), ("part", 4), ("space", 3)])
+@pytest.mark.parametrize("method", ["tree", "swap"])
+def test_software_domains_composite_to_the_one_process_image(client, by, domains, method):
+    """The es2008 scene split into domains, rendered by the software rasterizer on the
+    workers and composited there: the one-process frame, colour, depth and triangle."""
+    from workbench.experiment.measure import default_camera
+    from workbench.experiment.sortlast import SoftwareDomains
+    from workbench.paths.base import Style
+    from workbench.scene.domains import split_domains
+    from workbench.scene.generators import semicylinders
+
+    mesh = semicylinders(4, 12)
+    size = (160, 120)
+    camera = default_camera(mesh, size, view=(20.0, 10.0), up="y")
+    render_domain = SoftwareDomains("semicylinders:12", "pixel_color",
+                                    Style(field="distance", bands=6), camera, size)
+    assert render_domain.prepared().mesh.n_elements == 8 * 12 * 12  # the built-in has 8 sheets
+    everything = render_domain(np.arange(render_domain.prepared().triangles))
+    parts = split_domains(render_domain.prepared().mesh, domains, by=by)
+    frame, stats = render_sortlast(client, render_domain, parts, method=method)
+    assert (everything.triangle >= 0).sum() > 5000
+    assert np.array_equal(frame.color, everything.color)
+    assert np.array_equal(frame.depth, everything.depth)
+    assert np.array_equal(frame.triangle, everything.triangle)
+    assert stats.bytes_moved > 0 and stats.workers == 2

@@ -40,6 +40,49 @@ METHODS = ("tree", "swap")
 KEY_PREFIX = "sortlast"
 
 
+@dataclass(frozen=True)
+class SoftwareDomains:
+    """A picklable ``render_domain`` for :func:`render_sortlast`: the triangles of one domain
+    of ``scene`` (a built-in scene name or mesh file, loaded once per worker process) drawn by
+    the software rasterizer as mesh path ``path`` with ``style``, ``camera``, ``size`` (W, H)
+    and raster ``options``. Domains are index arrays into the path's triangle list (the
+    mesh's triangles: :func:`workbench.scene.domains.split_domains`)."""
+
+    scene: str
+    path: str
+    style: object
+    camera: object
+    size: tuple
+    options: object = None
+    quick: bool = False
+
+    def prepared(self):
+        """The prepared :class:`~workbench.paths.software.SoftwarePath` of this process."""
+        key = (self.scene, self.path, repr(self.style), repr(self.camera), tuple(self.size),
+               repr(self.options), self.quick)
+        path = _PREPARED.get(key)
+        if path is None:
+            from ..algo.softraster import RasterOptions
+            from ..paths.software import SoftwarePath
+            from ..scene.derive import derive
+            from .sweep_points import fresh_scene
+
+            mesh = fresh_scene(self.scene, self.quick)
+            path = SoftwarePath(self.path, self.style, self.options or RasterOptions())
+            derive(mesh, path.needs, path.style)
+            path.prepare(None, mesh, self.camera)
+            path.make_target(self.size)
+            _PREPARED.clear()  # one scene per process at a time: they can be large
+            _PREPARED[key] = path
+        return path
+
+    def __call__(self, ids: np.ndarray) -> Frame:
+        return self.prepared().render_triangles(ids)
+
+
+_PREPARED: dict = {}
+
+
 @sizeof.register(Frame)
 def _sizeof_frame(frame: Frame) -> int:
     """A frame's size to Dask (memory accounting, placement, transfer logs): its array bytes."""

@@ -180,6 +180,23 @@ class SoftwarePath(RenderPath):
             triangle_values=self._triangle_values, clip_planes=self._planes,
             frame=self.target.frame)
 
+    def render_triangles(self, ids, background=(255, 255, 255, 255)) -> Frame:
+        """A new frame of :attr:`target`'s size (``make_target`` first) with only the triangles
+        ``ids`` of the path's triangle list drawn, keeping their indices in that list as the
+        frame's triangle indices: the frame of one domain for sort-last compositing."""
+        if self.mesh is None or self.target is None:
+            raise RuntimeError(f"software path {self.name!r} needs prepare and make_target")
+        ids = np.asarray(ids, np.int64)
+        if ids.ndim != 1 or (len(ids) and (ids.min() < 0 or ids.max() >= self.triangles)):
+            raise ValueError(f"triangle ids must be a 1-D array of indices below "
+                             f"{self.triangles}")
+        tv = None if self._triangle_values is None else self._triangle_values[ids]
+        frame, _ = render(self._positions, self._triangles[ids], self._view, self._projection,
+                          self.target.size, self._shading, self.options, ids=ids,
+                          normals=self._normals, values=self._values, triangle_values=tv,
+                          clip_planes=self._planes, background=background)
+        return frame
+
     def release(self) -> None:
         self.mesh = None
         self.target = None
