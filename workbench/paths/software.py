@@ -170,15 +170,17 @@ class SoftwarePath(RenderPath):
         self.step = step
         return 0
 
-    def draw(self) -> None:
-        """Rasterize into the target made by :meth:`make_target` (on top of what it holds)."""
+    def draw(self, vectorized: bool = True) -> None:
+        """Rasterize into the target made by :meth:`make_target` (on top of what it holds);
+        ``vectorized=False`` runs every step as plain Python (small scenes only). ``stats``
+        then holds the draw's :class:`~workbench.algo.softraster.RenderStats`."""
         if self.mesh is None or self.target is None:
             raise RuntimeError(f"software path {self.name!r} needs prepare and make_target")
         _, self.stats = render(
             self._positions, self._triangles, self._view, self._projection, self.target.size,
             self._shading, self.options, normals=self._normals, values=self._values,
             triangle_values=self._triangle_values, clip_planes=self._planes,
-            frame=self.target.frame)
+            frame=self.target.frame, vectorized=vectorized)
 
     def render_triangles(self, ids, background=(255, 255, 255, 255)) -> Frame:
         """A new frame of :attr:`target`'s size (``make_target`` first) with only the triangles

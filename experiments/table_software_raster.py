@@ -1,0 +1,384 @@
+"""es2008 Tables 2 and 3: the vectorized software rasterizer with a span look-up table, against
+llvmpipe in the same run, and sort-last compositing of domains on Dask.
+
+**Main table** (``table.md``): the es2008 benchmark — 8 semi-cylindrical sheets of 250 × 250
+quads (1 M triangles) at 1000 × 1000, seen from the front as in the paper's Fig. 5 — and the
+same scene with 1024 × 1024 quads per sheet (16.8 M triangles, beyond the paper's 16.6 M), drawn
+by the EGL paths on the GL context (position-only, the floor; flat; per-pixel band contours)
+and by the software rasterizer (:mod:`workbench.algo.softraster`) with the same shading: with
+llvmpipe's pixel rule (half-space generator, 8 sub-pixel bits, with and without early depth
+rejection), with 0 sub-pixel bits, and with the span table for S = 10, 15, 20. Per row: wall
+time (median of the timed draws, through :func:`~workbench.experiment.measure.measure`),
+triangles/s, the speed against llvmpipe's position-only draw and against llvmpipe's draw of the
+same shading in this run, fragments, table-fit share, and the image against the EGL image of
+the same shading (share of differing pixels, largest difference). Quick runs: 125 × 125 quads
+per sheet at 500 × 500 (the paper's triangle size) and 250 × 250 at 1000 × 1000.
+
+**Steps** (``steps.md``, ``steps.png``): the paper's Table 2 columns for the paper's pipeline
+(span table S = 10, no early depth rejection): each step vectorised or not, its time with the
+kernels interpreted by Python (vectorisation off) and compiled (on) on a small case and their
+ratio, its time on both benchmark scenes, the paper's Table 2 and 3 beside.
+
+**Span table** (``span_table.md``): memory against the paper's 6.4 / 49 / 205 MB, build and
+cache-load time, table-fit share, and the draw against the half-space generator on the same
+0-bit rule (identical images required).
+
+**Compositing** (``composite.md``): the benchmark split into D = 1, 2, 4, 8 domains (by space
+and by part), rendered by the software rasterizer on a LocalCluster of 2 worker processes and
+composited by binary tree and binary swap: equality with the one-process image, bytes moved
+between workers, render and compositing seconds.
+
+Run: ``workbench run table_software_raster [--quick]`` or
+``python experiments/table_software_raster.py [--quick]``.
+"""
+
+from __future__ import annotations
+
+import resource
+import statistics
+import time
+import tracemalloc
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from workbench.algo.softraster import STEPS, RasterOptions
+from workbench.algo.softraster.spantable import PAPER_MB, build_span_table, forget_tables, span_table
+from workbench.experiment.compare import compare_images, difference_map
+from workbench.experiment.figures import save_image_grid
+from workbench.experiment.measure import default_camera, measure
+from workbench.experiment.registry import experiment, main
+from workbench.experiment.tables import atomic_open, write_table
+from workbench.gl import create_context, renderer
+from workbench.paths import Style
+from workbench.paths.software import SoftwarePath
+from workbench.scene.generators import semicylinders
+
+# es2008 Tables 2 (1 M triangles) and 3 (16.6 M): step → (vec-off s, vec-on s, ratio) each
+PAPER_STEPS = {
+    "transform and light": ((0.982, 0.043, 24), (10.712, 0.663, 17)),
+    "clip triangle": ((0.011, 0.003, 4), (0.187, 0.076, 3)),
+    "depth gradient": ((0.121, 0.010, 12), (2.154, 0.171, 13)),
+    "scalar gradient": ((0.172, 0.015, 12), (2.901, 0.216, 14)),
+    "range and TC": ((0.197, 0.008, 26), (2.615, 0.149, 18)),
+    "collect table-fit": ((0.314, 0.053, 13), (4.100, 0.798, 9)),
+    "generate fragment": ((0.289, 0.288, 1), (2.693, 2.687, 1)),
+    "interpolate z": ((0.427, 0.036, 12), (3.338, 0.259, 13)),
+    "interpolate color": ((0.617, 0.068, 9), (4.661, 0.581, 8)),
+    "write fragment": ((0.295, 0.296, 1), (1.513, 1.511, 1)),
+}
+PAPER_RUNS = (("es2008 1 M", 1.0e6, 0.82), ("es2008 16.6 M (Pantheon)", 16.6e6, 16.6 / 2.33))
+BANDS = dict(field="distance", bands=10)
+TABLE_SIZES = (10, 15, 20)
+
+
+@dataclass
+class Bench:
+    label: str
+    mesh: object
+    size: tuple[int, int]
+    main: bool  # the 1 M benchmark (the figures, the span-table rows and compositing use it)
+
+
+def benches(quick: bool):
+    n = 125 if quick else 250
+    yield Bench(f"benchmark 8x{n}x{n}", semicylinders(8, n),
+                (500, 500) if quick else (1000, 1000), True)
+    n = 250 if quick else 1024
+    yield Bench(f"large 8x{n}x{n}", semicylinders(8, n), (1000, 1000), False)
+
+
+def software_configs(main: bool):
+    """(label, path, style options, raster options) of the software rows."""
+    yield "software flat, GL rule", "flat", {}, RasterOptions()
+    yield "software bands, GL rule", "pixel_color", BANDS, RasterOptions()
+    yield ("software bands, GL rule, no early depth", "pixel_color", BANDS,
+           RasterOptions(early_depth=False))
+    yield "software bands, 0 sub-pixel bits", "pixel_color", BANDS, RasterOptions(subpixel_bits=0)
+    for size in TABLE_SIZES if main else (10,):
+        yield (f"software bands, span table S={size}", "pixel_color", BANDS,
+               RasterOptions(generator="table", table_size=size, subpixel_bits=0))
+    yield ("software bands, span table S=10, no early depth (es2008)", "pixel_color", BANDS,
+           RasterOptions(generator="table", subpixel_bits=0, early_depth=False))
+    yield ("software bands, GL rule, 1 thread", "pixel_color", BANDS, RasterOptions(threads=1))
+
+
+def step_probe(repeats: int):
+    """A :func:`measure` probe: the median seconds of each step over ``repeats`` more draws."""
+    def probe(path) -> dict:
+        samples = {name: [] for name, _ in STEPS}
+        for _ in range(repeats):
+            path.target.clear()
+            path.draw()
+            for name, value in path.stats.seconds.items():
+                samples[name].append(value)
+        stats = path.stats
+        return dict(fragments=stats.fragments, kept=stats.kept, table_fit=stats.table_fit,
+                    threads=stats.threads, table_MB=stats.table_bytes / 1e6,
+                    fragment_pool_MB=stats.fragment_bytes / 1e6,
+                    steps_ms={name: 1e3 * statistics.median(v) for name, v in samples.items()})
+    return probe
+
+
+def peak_memory(path) -> dict:
+    """A probe: the largest numpy allocation total during one more draw (tracemalloc) and the
+    process's peak resident set so far."""
+    path.target.clear()
+    tracemalloc.start()
+    try:
+        path.draw()
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    return dict(draw_peak_MB=peak / 1e6,
+                process_peak_MB=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e3)
+
+
+def bench_rows(ctx, bench: Bench, repeats: int, say) -> tuple[list[dict], dict]:
+    mesh, size = bench.mesh, bench.size
+    camera = default_camera(mesh, size, view=(0.0, 0.0), up="y")
+    rows, images, gl_wall = [], {}, {}
+    triangles = len(mesh.triangles)
+    for label, name, options in (("EGL position-only (the floor)", "position", {}),
+                                 ("EGL flat", "flat", {}), ("EGL bands", "pixel_color", BANDS)):
+        m = measure(ctx, mesh, name, Style(**options), camera=camera, size=size, repeats=repeats)
+        gl_wall[name] = m.row["wall_ms"]
+        images[label] = m.image
+        rows.append(dict(scene=bench.label, triangles=triangles, size=f"{size[0]}x{size[1]}",
+                         renderer=m.row["renderer"], config=label, shading=name,
+                         wall_ms=m.row["wall_ms"], wall_ms_min=m.row["wall_ms_min"],
+                         wall_ms_max=m.row["wall_ms_max"],
+                         Mtri_per_s=triangles / m.row["wall_ms"] / 1e3))
+        say(f"{bench.label} {label}: {m.row['wall_ms']:.1f} ms")
+    for label, name, options, raster in software_configs(bench.main):
+        path = SoftwarePath(name, Style(**options), raster)
+        probes = step_probe(3 if bench.main else 2)
+        if not bench.main and label == "software bands, GL rule":
+            def probes(p, steps=probes):  # the 16.8 M scene's memory, on one row
+                return {**steps(p), **peak_memory(p)}
+        m = measure(None, mesh, path, camera=camera, size=size, repeats=repeats, probe=probes)
+        images[label] = m.image
+        same = images["EGL bands" if name == "pixel_color" else "EGL flat"]
+        diff = compare_images(same, m.image)
+        wall = m.row["wall_ms"]
+        row = dict(scene=bench.label, triangles=triangles, size=f"{size[0]}x{size[1]}",
+                   renderer=m.row["renderer"], config=label, shading=name, wall_ms=wall,
+                   wall_ms_min=m.row["wall_ms_min"], wall_ms_max=m.row["wall_ms_max"],
+                   Mtri_per_s=triangles / wall / 1e3,
+                   speed_vs_llvmpipe_floor=gl_wall["position"] / wall,
+                   speed_vs_llvmpipe_same=gl_wall[name] / wall,
+                   fragments=m.row["fragments"], table_fit_pct=100.0 * m.row["table_fit"]
+                   / max(m.row["kept"], 1), table_MB=m.row["table_MB"],
+                   differing_pct_vs_egl=100.0 * diff.share_differing,
+                   max_diff_vs_egl=diff.max_abs, threads=m.row["threads"],
+                   fragment_pool_MB=m.row["fragment_pool_MB"],
+                   draw_peak_MB=m.row.get("draw_peak_MB"),
+                   process_peak_MB=m.row.get("process_peak_MB"), steps_ms=m.row["steps_ms"])
+        if "0 sub-pixel bits" not in label and "span table" in label:
+            row["differing_px_vs_half_space_0_bits"] = int(
+                (m.image != images["software bands, 0 sub-pixel bits"]).any(axis=-1).sum())
+        rows.append(row)
+        say(f"{bench.label} {label}: {wall:.1f} ms, {row['Mtri_per_s']:.1f} M triangles/s, "
+            f"{row['speed_vs_llvmpipe_floor']:.2f}x llvmpipe's floor, "
+            f"{row['differing_pct_vs_egl']:.3f} % pixels differ from EGL")
+    return rows, images
+
+
+def small_case_steps(say) -> dict:
+    """Each step's seconds with the kernels interpreted and compiled, on a small case."""
+    mesh = semicylinders(8, 10)
+    size = (100, 100)
+    camera = default_camera(mesh, size, view=(0.0, 0.0), up="y")
+    path = SoftwarePath("pixel_color", Style(**BANDS),
+                        RasterOptions(generator="table", subpixel_bits=0, early_depth=False))
+    from workbench.scene.derive import derive
+
+    derive(mesh, path.needs, path.style)
+    path.prepare(None, mesh, camera)
+    path.make_target(size)
+    path.draw()  # compiled once
+    on = {name: [] for name, _ in STEPS}
+    for _ in range(5):
+        path.target.clear()
+        path.draw()
+        for name, value in path.stats.seconds.items():
+            on[name].append(value)
+    path.target.clear()
+    path.draw(vectorized=False)
+    off = dict(path.stats.seconds)
+    say(f"small case ({len(mesh.triangles)} triangles, {path.stats.fragments} fragments): "
+        f"interpreted {sum(off.values()):.2f} s")
+    return dict(triangles=len(mesh.triangles), fragments=path.stats.fragments,
+                off=off, on={k: statistics.median(v) for k, v in on.items()})
+
+
+def step_rows(rows: list[dict], small: dict) -> list[dict]:
+    paper_label = "software bands, span table S=10, no early depth (es2008)"
+    ours = {r["scene"]: r["steps_ms"] for r in rows if r.get("config") == paper_label}
+    default = {r["scene"]: r["steps_ms"] for r in rows
+               if r.get("config") == "software bands, GL rule"}
+    out = []
+    for name, vectorised in STEPS:
+        off, on = small["off"][name], small["on"][name]
+        paper = PAPER_STEPS.get(name)
+        row = dict(step=name, vectorised="Y" if vectorised else "N",
+                   small_off_ms=1e3 * off, small_on_ms=1e3 * on,
+                   small_ratio=off / on if on > 0 else None)
+        for scene, steps in ours.items():
+            row[f"{scene} es2008 pipeline ms"] = steps[name]
+        for scene, steps in default.items():
+            row[f"{scene} GL rule + early depth ms"] = steps[name]
+        if paper is not None:
+            (a, b, c), (d, e, f) = paper
+            row.update({"paper 1M off s": a, "paper 1M on s": b, "paper 1M ratio": c,
+                        "paper 16.6M off s": d, "paper 16.6M on s": e, "paper 16.6M ratio": f})
+        out.append(row)
+    total = dict(step="total", vectorised="",
+                 small_off_ms=sum(r["small_off_ms"] for r in out),
+                 small_on_ms=sum(r["small_on_ms"] for r in out))
+    total["small_ratio"] = total["small_off_ms"] / total["small_on_ms"]
+    for key in out[0]:
+        if key.endswith(" ms") or key.startswith("paper") and key.endswith(" s"):
+            total[key] = sum(r.get(key) or 0.0 for r in out)
+    out.append(total)
+    return out
+
+
+def span_table_rows(rows: list[dict]) -> list[dict]:
+    main_rows = {r["config"]: r for r in rows if r["scene"].startswith("benchmark")}
+    half = main_rows.get("software bands, 0 sub-pixel bits")
+    out = []
+    for size in TABLE_SIZES:
+        start = time.perf_counter()
+        build_span_table(size)
+        build_s = time.perf_counter() - start
+        span_table(size)  # make sure the cache holds it
+        forget_tables()
+        start = time.perf_counter()
+        table = span_table(size)
+        load_s = time.perf_counter() - start
+        drawn = main_rows.get(f"software bands, span table S={size}", {})
+        out.append(dict(S=size, entries=2 * (2 * size) ** 5, MB=table.nbytes / 1e6,
+                        paper_MB=PAPER_MB[size], build_s=build_s, cache_load_s=load_s,
+                        table_fit_pct=drawn.get("table_fit_pct"), wall_ms=drawn.get("wall_ms"),
+                        half_space_0_bits_wall_ms=None if half is None else half["wall_ms"],
+                        differing_px_vs_half_space=drawn.get(
+                            "differing_px_vs_half_space_0_bits")))
+    return out
+
+
+def composite_rows(quick: bool, say) -> list[dict]:
+    from workbench.experiment.cluster import sweep_cluster
+    from workbench.experiment.sortlast import SoftwareDomains, render_sortlast
+    from workbench.scene.domains import split_domains
+
+    spec = "semicylinders:64" if quick else "semicylinders:250"
+    size = (500, 500) if quick else (1000, 1000)
+    mesh = semicylinders(8, 64 if quick else 250)
+    camera = default_camera(mesh, size, view=(0.0, 0.0), up="y")
+    render_domain = SoftwareDomains(spec, "pixel_color", Style(**BANDS), camera, size)
+    one = render_domain(np.arange(render_domain.prepared().triangles))
+    rows = []
+    with sweep_cluster(workers=2) as cluster:
+        for by in ("space", "part"):
+            for count in (1, 2, 4, 8):
+                domains = split_domains(render_domain.prepared().mesh, count, by=by)
+                for method in ("tree", "swap"):
+                    frame, stats = render_sortlast(cluster.client, render_domain, domains,
+                                                   method=method)
+                    differing = int(((frame.color != one.color).any(axis=-1)
+                                     | (frame.depth != one.depth)
+                                     | (frame.triangle != one.triangle)).sum())
+                    rows.append(dict(scene=spec, size=f"{size[0]}x{size[1]}", split=by,
+                                     domains=count, method=method, workers=stats.workers,
+                                     equal_to_one_process=differing == 0,
+                                     differing_px=differing,
+                                     bytes_moved_MB=stats.bytes_moved / 1e6,
+                                     schedule_MB=stats.schedule_bytes / 1e6,
+                                     render_s=stats.render_s, composite_s=stats.composite_s))
+                    say(f"composite {by} D={count} {method}: equal {differing == 0}, "
+                        f"{stats.bytes_moved / 1e6:.1f} MB moved, {stats.composite_s:.3f} s")
+    return rows
+
+
+def plot_steps(path: Path, steps: list[dict]) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = [r["step"] for r in steps if r["step"] != "total"]
+    fig, ax = plt.subplots(figsize=(9, 6))
+    y = np.arange(len(names))
+    series = [(k, k) for k in steps[0] if k.endswith(" ms") and not k.startswith("small")]
+    series.append(("paper 1M on s", "es2008 on one ES processor, 1 M (paper Table 2)"))
+    height = 0.8 / len(series)
+    for i, (key, label) in enumerate(series):
+        scale = 1e3 if key.endswith(" s") else 1.0
+        values = [(r.get(key) or 0.0) * scale for r in steps if r["step"] != "total"]
+        ax.barh(y + i * height, values, height, label=label)
+    ax.set_yticks(y + 0.4 - height / 2, names)
+    ax.invert_yaxis()
+    ax.set_xscale("log")
+    ax.set_xlabel("time per step [ms] (log scale)")
+    ax.set_title("es2008 rendering steps: ours (2 cores) and the paper's (one vector processor)")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
+    ax.grid(True, axis="x", alpha=0.3)
+    fig.tight_layout()
+    with atomic_open(path, "wb") as fh:
+        fig.savefig(fh, format="png", dpi=110)
+    plt.close(fig)
+
+
+def save_images(out_dir: Path, images: dict) -> None:
+    egl = images["EGL bands"]
+    h, w = egl.shape[:2]
+    window = (slice(h // 2 - h // 8, h // 2 + h // 8), slice(w // 2 - w // 8, w // 2 + w // 8))
+    soft = images["software bands, GL rule"]
+    table = images["software bands, span table S=10"]
+    save_image_grid(out_dir / "images.png",
+                    [egl[window], soft[window], table[window],
+                     difference_map(egl, soft)[window], difference_map(egl, table)[window]],
+                    ["EGL (llvmpipe) bands", "software, GL rule", "software, span table S=10",
+                     "|EGL - GL rule|", "|EGL - span table|"], columns=3)
+
+
+@experiment("table_software_raster", "es2008 Tables 2-3: the software rasterizer with a span "
+            "look-up table against llvmpipe, per-step times, sort-last compositing on Dask")
+def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
+    say = progress or (lambda msg: None)
+    repeats = 5 if quick else 7
+    ctx = create_context()
+    say(f"renderer: {renderer(ctx)}")
+    rows, images = [], {}
+    for bench in benches(quick):
+        bench_out, bench_images = bench_rows(ctx, bench, repeats, say)
+        rows += bench_out
+        if bench.main:
+            images = bench_images
+    for label, triangles, seconds in PAPER_RUNS:
+        rows.append(dict(scene=label, triangles=int(triangles), size="1000x1000",
+                         renderer="Earth Simulator, one vector processor (paper)",
+                         config="es2008 (paper)", shading="flat + band texture",
+                         wall_ms=seconds * 1e3, Mtri_per_s=triangles / seconds / 1e6))
+    small = small_case_steps(say)
+    steps = step_rows(rows, small)
+    write_table(steps, out_dir, "steps",
+                title=f"Per-step times (ms; paper columns in s); small case: "
+                      f"{small['triangles']} triangles, {small['fragments']} fragments, "
+                      f"kernels interpreted (off) and compiled (on)")
+    plot_steps(out_dir / "steps.png", steps)
+    write_table(span_table_rows(rows), out_dir, "span_table",
+                title="Span look-up table: memory, build, and its draw against half-space")
+    composite = composite_rows(quick, say)
+    write_table(composite, out_dir, "composite",
+                title="Sort-last compositing on a LocalCluster of 2 worker processes")
+    save_images(out_dir, images)
+    for row in rows:
+        row.pop("steps_ms", None)
+    return rows
+
+
+if __name__ == "__main__":
+    raise SystemExit(main("table_software_raster", run.__doc__ or ""))
