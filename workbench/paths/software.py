@@ -81,6 +81,7 @@ class SoftwarePath(RenderPath):
         self.target: SoftwareTarget | None = None
         self.stats = None
         self.mesh = None
+        self._workspace: dict = {}
 
     @property
     def renderer(self) -> str:
@@ -150,10 +151,12 @@ class SoftwarePath(RenderPath):
         step = int(step)
         shown = self.shown_coordinates(step)
         node = self._vertex_node
-        self._positions = (shown if node is None else shown[node]) - self.origin
+        # what GL uploads per step: float32 relative to the origin (subtracted in float64)
+        self._positions = ((shown if node is None else shown[node]) - self.origin).astype(
+            np.float32)
         self._normals = self._values = self._triangle_values = None
         if self._gl.split:
-            self._normals = self._gl._gouraud.normals(shown)
+            self._normals = self._gl._gouraud.normals(shown).astype(np.float32)
         field = self.style.field
         if self._gl.field_per == "node":
             t = self.scale.normalise(mesh.node_field(field, step))
@@ -168,7 +171,8 @@ class SoftwarePath(RenderPath):
             if values is not None:
                 setattr(self, name, np.where(np.isfinite(values), values, NO_VALUE))
         self.step = step
-        return 0
+        return sum(a.nbytes for a in (self._positions, self._normals, self._values,
+                                      self._triangle_values) if a is not None)
 
     def draw(self, vectorized: bool = True) -> None:
         """Rasterize into the target made by :meth:`make_target` (on top of what it holds);
@@ -180,7 +184,7 @@ class SoftwarePath(RenderPath):
             self._positions, self._triangles, self._view, self._projection, self.target.size,
             self._shading, self.options, normals=self._normals, values=self._values,
             triangle_values=self._triangle_values, clip_planes=self._planes,
-            frame=self.target.frame, vectorized=vectorized)
+            frame=self.target.frame, vectorized=vectorized, workspace=self._workspace)
 
     def render_triangles(self, ids, background=(255, 255, 255, 255)) -> Frame:
         """A new frame of :attr:`target`'s size (``make_target`` first) with only the triangles
@@ -202,3 +206,4 @@ class SoftwarePath(RenderPath):
     def release(self) -> None:
         self.mesh = None
         self.target = None
+        self._workspace = {}

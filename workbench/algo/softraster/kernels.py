@@ -137,12 +137,19 @@ def light_vertices(kind, view, normals, s, texels, texf, linear, missing, attr):
             attr[v, 3] = a
 
 
+@numba.njit(cache=True, inline="always")
+def _eye(view, pos, v, r):
+    """Row ``r`` of ``view · (p, 1)`` in float32, summed in the vertex shader's order."""
+    return view[r, 0] * pos[v, 0] + view[r, 1] * pos[v, 1] + view[r, 2] * pos[v, 2] + view[r, 3]
+
+
 @numba.njit(cache=True, parallel=True)
 def light_triangles(pos, tris, view, fx, fy, bits, out):
     """Flat lighting, as GL's ``cross(dFdx(p_eye), dFdy(p_eye))``: the headlight of the normal
-    of the eye-space position's gradient over the *snapped* image positions (``fx``, ``fy``),
-    which is what a GL driver differentiates; ``pos`` (V, 3) float64 relative to the origin,
-    ``view`` (3, 3) float64; ``out`` (K,) float32 (0.25 for a triangle without area)."""
+    of the gradient of the float32 eye-space vertex positions (as the vertex shader computes
+    them) over the *snapped* image positions (``fx``, ``fy``), which is what a GL driver
+    differentiates; ``pos`` (V, 3) float32 relative to the origin, ``view`` (4, 4) float32;
+    ``out`` (K,) float32 (0.25 for a triangle without area)."""
     inv = 1.0 / (1 << bits)
     for k in prange(tris.shape[0]):
         a, b, c = tris[k, 0], tris[k, 1], tris[k, 2]
@@ -152,15 +159,13 @@ def light_triangles(pos, tris, view, fx, fy, bits, out):
         if det == 0:
             out[k] = np.float32(0.25)
             continue
-        dp1x, dp1y, dp1z = pos[b, 0] - pos[a, 0], pos[b, 1] - pos[a, 1], pos[b, 2] - pos[a, 2]
-        dp2x, dp2y, dp2z = pos[c, 0] - pos[a, 0], pos[c, 1] - pos[a, 1], pos[c, 2] - pos[a, 2]
-        # eye-space differences along the two edges, then their gradients over the image
-        e1x = view[0, 0] * dp1x + view[0, 1] * dp1y + view[0, 2] * dp1z
-        e1y = view[1, 0] * dp1x + view[1, 1] * dp1y + view[1, 2] * dp1z
-        e1z = view[2, 0] * dp1x + view[2, 1] * dp1y + view[2, 2] * dp1z
-        e2x = view[0, 0] * dp2x + view[0, 1] * dp2y + view[0, 2] * dp2z
-        e2y = view[1, 0] * dp2x + view[1, 1] * dp2y + view[1, 2] * dp2z
-        e2z = view[2, 0] * dp2x + view[2, 1] * dp2y + view[2, 2] * dp2z
+        ea0, ea1, ea2 = _eye(view, pos, a, 0), _eye(view, pos, a, 1), _eye(view, pos, a, 2)
+        e1x = np.float64(_eye(view, pos, b, 0)) - ea0
+        e1y = np.float64(_eye(view, pos, b, 1)) - ea1
+        e1z = np.float64(_eye(view, pos, b, 2)) - ea2
+        e2x = np.float64(_eye(view, pos, c, 0)) - ea0
+        e2y = np.float64(_eye(view, pos, c, 1)) - ea1
+        e2z = np.float64(_eye(view, pos, c, 2)) - ea2
         gxx, gyx = (e1x * y2 - e2x * y1) / det, (e2x * x1 - e1x * x2) / det
         gxy, gyy = (e1y * y2 - e2y * y1) / det, (e2y * x1 - e1y * x2) / det
         gxz, gyz = (e1z * y2 - e2z * y1) / det, (e2z * x1 - e1z * x2) / det

@@ -63,7 +63,7 @@ _KERNELS = ("transform", "light_vertices", "light_triangles", "clip_triangles",
             "depth_gradient", "scalar_gradient", "range_and_tc", "collect_table_fit",
             "bin_triangles", "generate_fragments", "interpolate_z", "interpolate_color",
             "write_fragments")
-_HELPERS = ("texel_rgba", "unorm8", "pack", "headlight", "_plane")
+_HELPERS = ("texel_rgba", "unorm8", "pack", "headlight", "_plane", "_eye")
 
 
 @dataclass(frozen=True)
@@ -181,7 +181,9 @@ def _threads(count: int | None):
 
 
 def _checked(positions, triangles, ids, normals, values, triangle_values, shading):
-    pos = np.asarray(positions, np.float64)
+    pos = np.asarray(positions)
+    if pos.dtype != np.float32:
+        pos = pos.astype(np.float64, copy=False)
     if pos.ndim != 2 or pos.shape[1] != 3:
         raise ValueError(f"positions must be (V, 3), got {pos.shape}")
     tris = np.ascontiguousarray(triangles, np.int64)
@@ -222,9 +224,10 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
            shading: Shading = Shading(), options: RasterOptions = RasterOptions(), *,
            ids=None, normals=None, values=None, triangle_values=None, clip_planes=(),
            background=(255, 255, 255, 255), frame: Frame | None = None,
-           vectorized: bool = True) -> tuple[Frame, RenderStats]:
-    """Draw ``triangles`` (K, 3) vertex indices of ``positions`` (V, 3) float64 model units,
-    relative to the camera's upload origin, with the ``view`` and orthographic ``projection``
+           vectorized: bool = True, workspace: dict | None = None) -> tuple[Frame, RenderStats]:
+    """Draw ``triangles`` (K, 3) vertex indices of ``positions`` (V, 3) model units relative to
+    the camera's upload origin (float64, cast to float32 as GL uploads them, or that float32
+    upload itself), with the ``view`` and orthographic ``projection``
     (4, 4) float64 matrices into a ``size`` (W, H) frame cleared to ``background`` (RGBA
     0–255), or on top of ``frame``.
 
@@ -234,8 +237,10 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
     them (see :class:`Shading`); a non-finite or no-value entry
     (:data:`workbench.paths.colormap.NO_VALUE`) draws the missing colour. ``clip_planes``
     (P, 4) relative to the origin keep ``a·x + b·y + c·z + d ≥ 0``. ``vectorized=False`` runs
-    every step as plain Python (slow; for the step table on small cases). Degenerate,
-    non-finite and wholly clipped triangles draw nothing.
+    every step as plain Python (slow; for the step table on small cases). ``workspace``, a
+    dict kept by the caller, lends the per-vertex arrays from one draw to the next (no fresh
+    pages for every frame of a large model). Degenerate, non-finite and wholly clipped
+    triangles draw nothing.
     """
     pos, tris, ids = _checked(positions, triangles, ids, normals, values, triangle_values, shading)
     proj = check_orthographic(projection)
@@ -280,14 +285,15 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
         stats.threads = threads
         t0 = time.perf_counter()
         # ---- transform and light (all vertices once)
-        rel32 = pos.astype(np.float32)
+        rel32 = pos if pos.dtype == np.float32 else pos.astype(np.float32)
         mvp32 = (proj @ view).astype(np.float32)
         n_v = len(pos)
-        fx, fy = np.empty(n_v, np.int64), np.empty(n_v, np.int64)
-        fz, ok = np.empty(n_v, np.float32), np.empty(n_v, bool)
+        lend = _lender(workspace)
+        fx, fy = lend("fx", n_v, np.int64), lend("fy", n_v, np.int64)
+        fz, ok = lend("fz", n_v, np.float32), lend("ok", n_v, bool)
         k.transform(rel32, mvp32, width, height, bits, fx, fy, fz, ok)
         n_attr = _ATTRS[kind]
-        attr = np.zeros((n_v, n_attr), np.float32)
+        attr = lend("attr", (n_v, n_attr), np.float32)
         scale, offset = (np.float32(v) for v in shading.coord)
         if kind in ("gouraud", "vertex_color", "pixel_color"):
             s = np.zeros(n_v, np.float32)
@@ -295,13 +301,14 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
                 t = np.asarray(values, np.float64)
                 s = t.astype(np.float32) * scale + offset
                 s[~np.isfinite(t)] = np.float32(-1e30)
-            k.light_vertices(code, view[:3, :3].astype(np.float32),
-                             np.asarray(normals, np.float64).astype(np.float32), s, texels,
-                             texf, shading.linear, missing, attr)
+            normals32 = np.asarray(normals)
+            if normals32.dtype != np.float32:
+                normals32 = normals32.astype(np.float32)
+            k.light_vertices(code, np.ascontiguousarray(view[:3, :3], np.float32), normals32,
+                             s, texels, texf, shading.linear, missing, attr)
         tri_light = np.zeros(len(tris) if kind in ("flat", "element_color") else 1, np.float32)
         if kind in ("flat", "element_color"):
-            k.light_triangles(pos, tris, np.ascontiguousarray(view[:3, :3]), fx, fy, bits,
-                              tri_light)
+            k.light_triangles(rel32, tris, view.astype(np.float32), fx, fy, bits, tri_light)
         tri_s = np.zeros(1, np.float32)
         if kind == "element_color":
             tv = np.asarray(triangle_values, np.float64)
@@ -373,3 +380,17 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
 @contextmanager
 def _null(value):
     yield value
+
+
+def _lender(workspace: dict | None):
+    """``lend(name, shape, dtype)``: an uninitialised array, reused from ``workspace`` when it
+    holds one of that shape and dtype."""
+    def lend(name, shape, dtype):
+        if workspace is None:
+            return np.empty(shape, dtype)
+        held = workspace.get(name)
+        if held is None or held.shape != (shape if isinstance(shape, tuple) else (shape,)) \
+                or held.dtype != dtype:
+            held = workspace[name] = np.empty(shape, dtype)
+        return held
+    return lend
