@@ -131,3 +131,22 @@ def test_cli_refuses_with_one_line(tmp_path, capsys, flags, message):
                  "--rasterizer", "software", *flags])
     err = capsys.readouterr().err
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1
+
+
+def test_cli_sort_last_render_equals_the_one_process_render(tmp_path, capsys):
+    from PIL import Image
+
+    one, many = tmp_path / "one.png", tmp_path / "many.png"
+    common = ["render", "semicylinders:12", "--field", "distance", "--bands", "6", "--raw",
+              "--size", "200x160", "--rasterizer", "software"]
+    assert main([*common, "-o", str(one)]) == 0
+    assert main([*common, "-o", str(many), "--domains", "3", "--split", "part",
+                 "--composite", "swap", "--workers", "2"]) == 0
+    assert "3 domains by part on 2 workers" in capsys.readouterr().out
+    assert np.array_equal(np.asarray(Image.open(one)), np.asarray(Image.open(many)))
+
+
+def test_cli_sort_last_needs_the_software_rasterizer(tmp_path, capsys):
+    code = main(["render", "semicylinders:8", "-o", str(tmp_path / "x.png"), "--domains", "2"])
+    err = capsys.readouterr().err
+    assert code == 2 and "--rasterizer software" in err and len(err.strip().splitlines()) == 1

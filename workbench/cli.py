@@ -142,6 +142,8 @@ def cmd_render(args) -> int:
     size = args.size
     camera = default_camera(scene, size, view=args.view, projection=args.projection, up=args.up,
                             style=path.style)
+    if args.domains is not None:
+        return _render_sortlast(args, scene, path, camera, size)
     result = measure(ctx, scene, path, camera=camera, size=size, samples=args.samples,
                      timed=False)
     out = Path(args.output)
@@ -157,6 +159,42 @@ def cmd_render(args) -> int:
     print(f"{out}: {result.row['scene']}, {path.triangles} triangles, {path.vertices_sent} "
           f"vertices sent{strips}, path {path_name}"
           + (f", {result.row['renderer']}" if args.rasterizer == "software" else ""))
+    return 0
+
+
+def _render_sortlast(args, mesh, path, camera, size) -> int:
+    """``render --domains D``: the mesh split into D domains, drawn by the software rasterizer
+    on Dask workers and composited by depth (sort-last), written like a plain render."""
+    from .experiment.cluster import sweep_cluster
+    from .experiment.figures import save_field_figure, save_png
+    from .experiment.sortlast import SoftwareDomains, render_sortlast
+    from .scene.domains import split_domains
+
+    if args.rasterizer != "software":
+        raise ValueError("--domains draws the domains with the software rasterizer: add "
+                         "--rasterizer software")
+    if args.all_faces:
+        raise ValueError("--domains loads the scene again on each worker; --all-faces is not "
+                         "passed on")
+    domains = split_domains(mesh, args.domains, by=args.split)
+    render_domain = SoftwareDomains(args.mesh, path.name, path.style, camera, size, path.options)
+    with sweep_cluster(args.workers, args.scheduler, gl=False) as cluster:
+        frame, stats = render_sortlast(cluster.client, render_domain, domains,
+                                       method=args.composite)
+    out = Path(args.output)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    path.prepare(None, mesh, camera)  # the colour scale of the bar
+    scale = getattr(path, "scale", None)
+    if args.field is not None and not args.raw and scale is not None:
+        save_field_figure(out, frame.color, value_range=scale.value_range,
+                          colormap=path.style.colormap, label=args.field, units=args.units,
+                          title=f"{mesh.name} ({path.name}, {args.domains} domains)",
+                          bands=args.bands)
+    else:
+        save_png(out, frame.color)
+    print(f"{out}: {mesh.name}, {len(mesh.triangles)} triangles in {args.domains} domains "
+          f"by {args.split} on {stats.workers} workers; {args.composite} compositing "
+          f"{stats.composite_s:.3f} s, {stats.bytes_moved / 1e6:.1f} MB moved between workers")
     return 0
 
 
@@ -325,6 +363,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--subpixel-bits", type=int, metavar="B",
                    help="software vertex snapping: 8 as llvmpipe (default), 0 for the table")
     p.add_argument("--threads", type=int, help="software rasterizer threads (default: all cores)")
+    p.add_argument("--domains", type=int, metavar="D",
+                   help="sort-last: split the mesh into D domains, draw them with the software "
+                        "rasterizer on Dask workers and composite them by depth")
+    p.add_argument("--split", choices=("space", "part"), default="space",
+                   help="domains by recursive bisection in space (default) or by whole parts")
+    p.add_argument("--composite", choices=("tree", "swap"), default="tree",
+                   help="compositing schedule: binary tree (default) or binary swap")
+    p.add_argument("--workers", type=int, help="local Dask worker processes (default: one per core)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="an existing Dask scheduler (tcp://host:port) instead of a local cluster")
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("hausdorff", help="certified Hausdorff distance between two meshes",

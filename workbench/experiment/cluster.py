@@ -143,10 +143,13 @@ def _renderer_of(client: Client) -> str:
 
 @contextmanager
 def sweep_cluster(workers: int | None = None, scheduler: str | None = None, *,
-                  raster_threads: int | None = None) -> Iterator[SweepCluster]:
+                  raster_threads: int | None = None, gl: bool = True) -> Iterator[SweepCluster]:
     """A :class:`SweepCluster`: a new LocalCluster of ``workers`` processes (default
     ``os.cpu_count()``, one thread each), or the cluster at ``scheduler``
     (``tcp://host:port``), with :class:`GLContextPlugin` registered on every worker.
+
+    ``gl=False`` registers no GL context on the workers (work that draws with the software
+    rasterizer only: the workers need no EGL; ``renderer`` is then "software").
 
     ``raster_threads`` sets llvmpipe's rasterizer threads (``LP_NUM_THREADS``) in the local
     workers, unless the environment sets it already: 1 suits error-only sweeps, whose workers
@@ -181,9 +184,11 @@ def sweep_cluster(workers: int | None = None, scheduler: str | None = None, *,
                 client.wait_for_workers(1, timeout=WORKER_WAIT_S)
             except TimeoutError as exc:
                 raise OSError(f"scheduler {scheduler}: {exc or 'no workers'}") from None
-        client.register_plugin(GLContextPlugin(), name=PLUGIN_NAME)
+        if gl:
+            client.register_plugin(GLContextPlugin(), name=PLUGIN_NAME)
         count = len(client.scheduler_info(n_workers=-1)["workers"])
-        yield SweepCluster(client, count, _renderer_of(client), client.scheduler.address)
+        yield SweepCluster(client, count, _renderer_of(client) if gl else "software",
+                           client.scheduler.address)
     finally:
         if client is not None:
             client.close()
