@@ -150,3 +150,25 @@ def test_cli_sort_last_needs_the_software_rasterizer(tmp_path, capsys):
     code = main(["render", "semicylinders:8", "-o", str(tmp_path / "x.png"), "--domains", "2"])
     err = capsys.readouterr().err
     assert code == 2 and "--rasterizer software" in err and len(err.strip().splitlines()) == 1
+
+
+def test_flat_differs_only_where_gl_itself_draws_two_colours(ctx, sheets):
+    # llvmpipe takes the flat normal from per-pixel float32 derivatives: a triangle whose light
+    # lies on a rounding edge gets two colours; the software rasterizer gives it one
+    camera = default_camera(sheets, SIZE, view=(0.0, 0.0), up="y")
+    gl = measure(ctx, sheets, "flat", camera=camera, size=SIZE, timed=False)
+    path = SoftwarePath("flat")
+    path.prepare(None, sheets, camera)
+    path.make_target(SIZE)
+    path.target.clear()
+    path.draw()
+    triangle = path.target.frame.triangle.ravel()
+    drawn = triangle >= 0
+    key = gl.image[..., :3].astype(np.int64).reshape(-1, 3) @ np.array([1, 256, 65536])
+    low = np.full(triangle.max() + 1, 2 ** 40)
+    high = np.full(triangle.max() + 1, -1)
+    np.minimum.at(low, triangle[drawn], key[drawn])
+    np.maximum.at(high, triangle[drawn], key[drawn])
+    differs = (path.target.frame.color != gl.image).any(axis=-1).ravel()
+    assert not (differs & ~drawn).any()
+    assert (high > low)[triangle[differs]].all()

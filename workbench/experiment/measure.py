@@ -109,6 +109,10 @@ def measure(ctx, scene, path, style=None, camera: Camera | None = None,
     surface) with ``camera`` (default :func:`default_camera`) into a ``size`` (W, H)
     framebuffer with ``samples`` MSAA samples cleared to ``background``.
 
+    A path whose ``rasterizer`` is "software" (:class:`~workbench.paths.software.SoftwarePath`)
+    draws on the CPU into its own target: ``ctx`` may be None, the draws are timed by the wall
+    clock alone (``gpu_ms`` None) and the row's renderer names the rasterizer.
+
     Derives the path's ``needs`` on the scene first (cached there) and refuses, with
     RuntimeError, a path whose ``prepare`` derived anything it did not declare. With ``timed``
     it warms up ``warmup`` times and times ``repeats`` (≥ 5) draws; otherwise it draws once.
