@@ -9,13 +9,26 @@ fields, (T, M) each and present when the file has the data:
   model, e.g. MPa for mm/ms/kg... decks), from the six stress components;
 * ``"plastic_strain"``: effective plastic strain of the mid-surface integration point;
 * ``"thickness"``: current shell thickness;
-* ``"alive"``: 1 for an element in use, 0 for a deleted one (nothing is dropped).
+* ``"alive"``: 1 for an element in use, 0 for a deleted one (nothing is dropped);
+* ``"stress_xx"``, ``"stress_yy"``, ``"stress_zz"``, ``"stress_xy"``, ``"stress_yz"``,
+  ``"stress_zx"``: the six components of the shell's mid-surface (membrane) stress tensor, the
+  mean of the written through-thickness layers (:func:`through_thickness_mean`), for section
+  forces (:mod:`workbench.algo.forcetube`). They can be left out (``stress_components=False``)
+  to save memory on large results.
 
-The mid-surface point follows the d3plot layer order: with 3 layers (LS-DYNA's default MAXINT)
-they are written mid, inner, outer, so the first; otherwise bottom to top, so the middle one
-(the mean of the two middle ones for an even count). Shells of rigid parts carry no stress,
-strain or thickness in a d3plot; their values are NaN. Beams, solids and thick shells are not
-read. Part ids are the user part ids, names come from the part titles.
+**Stress coordinates.** LS-DYNA writes the shell stress tensor of a d3plot in the *global*
+Cartesian system, and lasso-python's ``element_shell_stress`` ((T, shells, layers, 6), ordered
+xx, yy, zz, xy, yz, zx) holds it as written; only the force/moment resultants are in element
+axes. The one exception is a deck that sets ``CMPFLG = 1`` in ``*DATABASE_EXTENT_BINARY``:
+then orthotropic and anisotropic materials are written in their material axes, and nothing
+in the file says so — such results would need transforming before their tensors are used.
+
+The mid-surface point of ``von_mises`` and ``plastic_strain`` follows the d3plot layer order:
+with 3 layers (LS-DYNA's default MAXINT) they are written mid, inner, outer, so the first;
+otherwise bottom to top, so the middle one (the mean of the two middle ones for an even
+count). Shells of rigid parts carry no stress, strain or thickness in a d3plot; their values
+are NaN. Beams, solids and thick shells are not read. Part ids are the user part ids, names
+come from the part titles.
 
 Refused with :class:`~workbench.scene.parse.ParseError`: a file lasso-python cannot read, or one
 without shell elements.
@@ -34,6 +47,7 @@ from .mesh import FEMesh
 from .parse import ParseError, ParseWarning, build_mesh
 
 RIGID_MATERIAL_TYPE = 20
+STRESS_COMPONENTS = ("xx", "yy", "zz", "xy", "yz", "zx")  # d3plot (and lasso-python) order
 
 
 def von_mises(stress: np.ndarray) -> np.ndarray:
@@ -68,13 +82,31 @@ def mid_surface(values: np.ndarray, layer_axis: int = 2) -> np.ndarray:
     return pair.mean(axis=layer_axis)
 
 
-def read_d3plot(path, units: str = "mm", all_faces: bool = False) -> FEMesh:
+def through_thickness_mean(values: np.ndarray, layer_axis: int = 2) -> np.ndarray:
+    """float64 mean of shell data over the through-thickness layers on ``layer_axis``.
+
+    With LS-DYNA's defaults (2 integration points through the thickness, 3 layers written:
+    the mid surface as the mean of the two, then the inner and outer point) this is the
+    membrane stress exactly, also for plastic states (2-point Gauss integration of the
+    resultant); with more points the written layers are a subset of them and the mean is the
+    membrane value exactly while the stress varies linearly through the thickness, an
+    approximation otherwise.
+    """
+    values = np.asarray(values, dtype=np.float64)
+    if values.shape[layer_axis] == 0:
+        raise ValueError("no integration-point layers")
+    return values.mean(axis=layer_axis)
+
+
+def read_d3plot(path, units: str = "mm", all_faces: bool = False,
+                stress_components: bool = True) -> FEMesh:
     """Read a d3plot family (``d3plot``, ``d3plot01``, ...) into an :class:`FEMesh` with steps.
 
     ``path`` is the first file of the family; a later member (``d3plot01``) is read from the
     first one beside it. See the module notes for the fields. ``units`` labels the coordinates.
     Solid elements are drawn by their boundary faces (every face with ``all_faces``), each
-    keeping its solid's id and part; the shell fields are NaN on them.
+    keeping its solid's id and part; the shell fields are NaN on them. ``stress_components``
+    reads the six mid-surface stress components as element fields.
     """
     from lasso.dyna import ArrayType, D3plot
 
@@ -176,6 +208,11 @@ def read_d3plot(path, units: str = "mm", all_faces: bool = False) -> FEMesh:
         if ArrayType.element_shell_stress in arrays:
             fields["von_mises"] = per_shell(von_mises(mid_surface(
                 arrays[ArrayType.element_shell_stress], layer_axis=2)))
+            stress = np.asarray(arrays[ArrayType.element_shell_stress])
+            if stress_components and stress.ndim == 4 and stress.shape[3] == 6:
+                membrane = through_thickness_mean(stress, layer_axis=2)
+                for k, name in enumerate(STRESS_COMPONENTS):
+                    fields[f"stress_{name}"] = per_shell(membrane[..., k])
         if ArrayType.element_shell_effective_plastic_strain in arrays:
             fields["plastic_strain"] = per_shell(mid_surface(
                 arrays[ArrayType.element_shell_effective_plastic_strain], layer_axis=2))
