@@ -337,3 +337,23 @@ def test_force_tubes_on_the_crushed_car(car, still):
     assert peak[-1] > 1e6                                 # N: well beyond rounding
     assert np.all(np.abs(np.diff(tube.axial[2:], axis=0)).max(axis=1) > 1e3)  # it changes
     assert tube.axial[2].min() < 0                        # the crush starts in compression
+
+
+def test_yield_cap_scales_only_the_tensors_above_it():
+    from workbench.algo.forcetube import prismatic_tube
+    from workbench.algo.membrane import membrane_stress, von_mises
+
+    mesh, _ = prismatic_tube(8, 100.0, 20.0, 2.0, 1.0, 4, steps=1)
+    stretched = mesh.nodes.copy()
+    stretched[:, 0] *= 1.01  # 1 % axial strain: about 2 100 MPa elastic
+    moved = type(mesh)(nodes=mesh.nodes, elements=mesh.elements, parts=mesh.parts,
+                       steps=np.stack([mesh.nodes, stretched]))
+    free = membrane_stress(moved, 1)
+    capped = membrane_stress(moved, 1, yield_stress=300.0)
+    assert von_mises(free).min() > 1000.0
+    assert np.allclose(von_mises(capped), 300.0, rtol=1e-12)
+    ratio = capped / np.where(free == 0, 1, free)
+    assert np.allclose(ratio[free != 0], 300.0 / von_mises(free)[0], rtol=1e-12)
+    assert np.array_equal(membrane_stress(moved, 1, yield_stress=1e9), free)
+    with pytest.raises(ValueError, match="yield_stress"):
+        membrane_stress(moved, 1, yield_stress=-1.0)

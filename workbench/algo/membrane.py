@@ -158,7 +158,8 @@ def _membrane(ref: np.ndarray, cur: np.ndarray, elements: np.ndarray, young: flo
 
 
 def membrane_stress(mesh: FEMesh, step: int, *, reference_step: int = 0,
-                    young: float = 210000.0, poisson: float = 0.3) -> np.ndarray:
+                    young: float = 210000.0, poisson: float = 0.3,
+                    yield_stress: float | None = None) -> np.ndarray:
     """(M, 3, 3) float64 Cauchy stress of each shell element of ``mesh`` at ``step``, for the
     elastic membrane (plane-stress Saint Venant–Kirchhoff) deformation from the geometry of
     ``reference_step`` (stress-free) — see the module notes for the formulas.
@@ -166,36 +167,67 @@ def membrane_stress(mesh: FEMesh, step: int, *, reference_step: int = 0,
     Symmetric tensors in global coordinates with no component along the element's current
     normal, in the units of ``young`` (MPa by default: steel, E = 210 000 N/mm², ν = 0.3, for a
     model in mm). The thickness is assumed unchanged by the deformation. Degenerate elements
-    (no triangle with a non-zero area at both steps) get zeros.
+    (no triangle with a non-zero area at both steps) get zeros. With ``yield_stress`` (same
+    units), a tensor whose von Mises stress exceeds it is scaled down to it: a cap that keeps
+    folded sheet metal at plausible stresses, not a plasticity model (no history, no
+    hardening).
 
     Refused (ValueError): ``step`` or ``reference_step`` out of range, non-finite coordinates at
-    either step, ``young`` not positive and finite, ``poisson`` outside (−1, ½].
+    either step, ``young`` not positive and finite, ``poisson`` outside (−1, ½], a
+    ``yield_stress`` that is not positive and finite.
     """
     young, poisson = _check_material(young, poisson)
     step = _check_step(mesh, step, "step")
     reference_step = _check_step(mesh, reference_step, "reference_step")
     ref = _coords(mesh, reference_step)
     cur = ref if step == reference_step else _coords(mesh, step)
-    return _membrane(ref, cur, mesh.elements.astype(np.int64), young, poisson)
+    return _capped(_membrane(ref, cur, mesh.elements.astype(np.int64), young, poisson),
+                   _check_yield(yield_stress))
+
+
+def _check_yield(yield_stress):
+    if yield_stress is None:
+        return None
+    value = float(yield_stress)
+    if not (np.isfinite(value) and value > 0):
+        raise ValueError(f"yield_stress must be positive and finite, got {yield_stress}")
+    return value
+
+
+def von_mises(sigma: np.ndarray) -> np.ndarray:
+    """(M,) von Mises stress of (M, 3, 3) symmetric tensors."""
+    s = np.asarray(sigma, np.float64)
+    dev = s - np.trace(s, axis1=1, axis2=2)[:, None, None] * np.eye(3) / 3.0
+    return np.sqrt(1.5 * np.einsum("kij,kij->k", dev, dev))
+
+
+def _capped(sigma: np.ndarray, yield_stress) -> np.ndarray:
+    if yield_stress is None:
+        return sigma
+    vm = von_mises(sigma)
+    scale = np.where(vm > yield_stress, yield_stress / np.where(vm > 0, vm, 1.0), 1.0)
+    return sigma * scale[:, None, None]
 
 
 def with_membrane_stress(mesh: FEMesh, *, reference_step: int = 0, young: float = 210000.0,
-                         poisson: float = 0.3) -> FEMesh:
+                         poisson: float = 0.3, yield_stress: float | None = None) -> FEMesh:
     """A copy of ``mesh`` with the element fields ``stress_xx``, ``stress_yy``, ``stress_zz``,
     ``stress_xy``, ``stress_yz``, ``stress_zx`` (:data:`~workbench.algo.forcetube.STRESS_FIELDS`)
     holding :func:`membrane_stress` of every step — (T, M) for a mesh with T time steps, (M,)
     (all zero) for a static one — so that :func:`~workbench.algo.forcetube.force_tube` reads
     them. Stress fields the mesh already has are replaced; everything else (topology, steps,
-    other fields, ids) is kept and shared with ``mesh``. Refusals as :func:`membrane_stress`.
+    other fields, ids) is kept and shared with ``mesh``. ``yield_stress`` caps each tensor as in
+    :func:`membrane_stress`. Refusals as :func:`membrane_stress`.
     """
     young, poisson = _check_material(young, poisson)
+    yield_stress = _check_yield(yield_stress)
     reference_step = _check_step(mesh, reference_step, "reference_step")
     ref = _coords(mesh, reference_step)
     elements = mesh.elements.astype(np.int64)
     values = np.empty((mesh.n_steps, len(STRESS_FIELDS), mesh.n_elements))
     for step in range(mesh.n_steps):
         cur = ref if step == reference_step else _coords(mesh, step)
-        sigma = _membrane(ref, cur, elements, young, poisson)
+        sigma = _capped(_membrane(ref, cur, elements, young, poisson), yield_stress)
         for c, (i, j) in enumerate(_VOIGT):
             values[step, c] = sigma[:, i, j]
     fields = dict(mesh.element_fields)
