@@ -25,7 +25,9 @@ FIELD_PATHS = {"vertex_color": "x", "pixel_color": "x", "element_color": "cell"}
 LINE_WIRE = {name: name != "quad_wire" for name in PATHS}
 # the paths that draw any FE mesh directly (the fe2003 texture paths draw a preprocessed surface
 # of one configuration and are tested in test_fetexture_paths)
-MESH_PATHS = sorted(name for name, cls in PATHS.items() if issubclass(cls, MeshPath))
+# the mesh paths that take a plain Style (flange fixes its field: tests/test_flange.py)
+MESH_PATHS = sorted(name for name, cls in PATHS.items()
+                    if issubclass(cls, MeshPath) and cls.style_class is Style)
 
 
 def grid(nx=1, ny=1, x0=-0.5, x1=0.5, y0=-0.5, y1=0.5, offset=(0.0, 0.0, 0.0), z=None):
@@ -70,14 +72,14 @@ def colors(image, mask):
 def test_registry_and_bad_names():
     assert set(PATHS) == {"position", "flat", "gouraud", "vertex_color", "pixel_color",
                           "element_color", "quad_wire", "fe_wire_texture", "fe_normal_map",
-                          "fe_normal_wire", "spacetime_vertex", "spacetime_pixel"}
+                          "fe_normal_wire", "spacetime_vertex", "spacetime_pixel", "flange"}
     assert MESH_PATHS == sorted(set(PATHS) - {"fe_wire_texture", "fe_normal_map",
                                               "fe_normal_wire", "spacetime_vertex",
-                                              "spacetime_pixel"})
+                                              "spacetime_pixel", "flange"})
     with pytest.raises(ValueError, match="known paths"):
         make_path("phong")
     for cls in PATHS.values():
-        assert cls.needs <= {"triangles", "edges", "gouraud", "fepatch"}
+        assert cls.needs <= {"triangles", "edges", "gouraud", "fepatch", "part_distances"}
     assert "edges" in make_path("flat", Style(wireframe=True)).needs
     assert "edges" not in make_path("flat").needs
     assert make_path("position").needs == {"triangles"}

@@ -1,7 +1,7 @@
 """Render paths: comparable ways of drawing a scene, all behind one protocol
 (:class:`~workbench.paths.base.RenderPath`) and in one registry (``PATHS``)."""
 
-from . import fetexture, fields, spacetime, surface, wire  # noqa: F401  (each registers its paths)
+from . import fetexture, fields, flange, spacetime, surface, wire  # noqa: F401  (each registers)
 from .base import (PATHS, GLPath, MeshPath, RenderPath, Style, check_options, make_path,
                    path_class, path_options)
 from .colormap import ColorScale, colormap_lut, scale_for

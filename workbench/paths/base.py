@@ -54,7 +54,7 @@ from ..gl import load_program
 from .colormap import NO_VALUE, ColorScale, scale_for
 
 # what a path may ask the scene to derive and cache (see workbench.scene.derive)
-NEEDS = frozenset({"triangles", "edges", "gouraud", "fepatch"})
+NEEDS = frozenset({"triangles", "edges", "gouraud", "fepatch", "part_distances"})
 MAX_CLIP_PLANES = 4
 GL_CLIP_DISTANCE0 = 0x3000
 POLYGON_OFFSET = (1.0, 1.0)  # fill pass under a wire frame: (factor, units)
@@ -151,7 +151,7 @@ class Style:
 
     def summary(self) -> str:
         """The fields that differ from the defaults, as ``name=value`` words (for table rows)."""
-        default = Style()
+        default = type(self)()
         return " ".join(f"{name}={_word(getattr(self, name))}" for name in self.__dataclass_fields__
                         if getattr(self, name) != getattr(default, name))
 

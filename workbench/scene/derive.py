@@ -7,7 +7,9 @@ reports what that cost. The items:
 * ``triangles`` — the triangulation (quads split along the shorter diagonal);
 * ``edges`` — the unique element edges of a wire frame;
 * ``gouraud`` — the crease-split vertices at ``Style.crease_deg`` (the triangulation included);
-* ``fepatch`` — the fe2003 model of ``Style.fepatch`` (patches, simplified surface, textures).
+* ``fepatch`` — the fe2003 model of ``Style.fepatch`` (patches, simplified surface, textures);
+* ``part_distances`` — every node's distance to the nearest other part within
+  ``Style.cutoff`` at ``Style.step`` (crash2000 §4.1; the flange path's field).
 
 :func:`derived_items` lists what a mesh holds, so that a caller can check that preparing a path
 derived nothing it had not declared, and :func:`derivation_cost` measures on a fresh copy what
@@ -47,6 +49,8 @@ def _key(item: str, style) -> tuple:
         return item, float(getattr(style, "crease_deg", 30.0))
     if item == "fepatch":
         return item, str(getattr(style, "fepatch", "A"))
+    if item == "part_distances":
+        return item, float(getattr(style, "cutoff", 50.0)), int(getattr(style, "step", 0))
     return (item,)
 
 
@@ -57,6 +61,7 @@ def derived_items(mesh) -> set[tuple]:
     held = {("triangles",) if k == ("triangulation",) else k for k in held}
     held |= {("gouraud", float(c)) for c in mesh.__dict__.get("_gouraud_cache", {})}
     held |= {("fepatch", p) for p in mesh.__dict__.get("_fepatch_cache", {})}
+    held |= {("part_distances", *k) for k in mesh.__dict__.get("_part_distance_cache", {})}
     return held
 
 
@@ -104,7 +109,11 @@ def _compute(mesh, item: str, style):
         return mesh.gouraud(float(getattr(style, "crease_deg", 30.0)))
     if item == "fepatch":
         return mesh.fepatch_model(str(getattr(style, "fepatch", "A")))
-    raise ValueError(f"no derived item {item!r}; known: triangles, edges, gouraud, fepatch")
+    if item == "part_distances":
+        return mesh.part_distances(float(getattr(style, "cutoff", 50.0)),
+                                   int(getattr(style, "step", 0)))
+    raise ValueError(f"no derived item {item!r}; known: triangles, edges, gouraud, fepatch, "
+                     f"part_distances")
 
 
 def derive(mesh, needs, style) -> Derivation:

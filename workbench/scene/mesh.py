@@ -258,6 +258,19 @@ class FEMesh:
             cache[fepatch] = build_model(self.elements, self.coordinates(0), fepatch)
         return cache[fepatch]
 
+    def part_distances(self, cutoff: float, step: int = 0):
+        """The crash2000 distances of step ``step``: for every node, the exact distance to the
+        nearest element of another part within ``cutoff`` (model units), as
+        :func:`workbench.algo.part_distance.part_distances` computes them with AABB trees of
+        one element per leaf; cached per (cutoff, step)."""
+        cache = self.__dict__.setdefault("_part_distance_cache", {})
+        key = (float(cutoff), int(step))
+        if key not in cache:
+            from ..algo.part_distance import part_distances
+
+            cache[key] = part_distances(self, float(cutoff), step=int(step))
+        return cache[key]
+
     def __repr__(self) -> str:
         return (f"FEMesh({self.name!r}: {self.n_nodes} nodes, {self.n_elements} elements "
                 f"({self.n_quads} quads), {len(np.unique(self.parts))} parts, {self.n_steps} steps)")

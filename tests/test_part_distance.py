@@ -1,0 +1,323 @@
+"""Per-node distance to other parts (crash2000 §4.1) and part connectivity: both hierarchies and
+leaf sizes against brute force on random multi-part meshes and on the car deck, own parts of
+shared nodes, far-from-origin models, Table 2 counters, thread-count independence, refusals."""
+
+import numba
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from test_hierarchy import mesh_options, random_mesh
+
+from workbench import data
+from workbench.algo.distance import points_triangles_distance
+from workbench.algo.hierarchy import local_origin
+from workbench.algo.part_distance import (
+    brute_force_part_distances,
+    connectivity,
+    node_parts,
+    part_distances,
+)
+from workbench.scene.mesh import FEMesh
+
+CONFIGS = [(kind, leaf) for kind in ("aabb", "obb") for leaf in (1, 10)]
+
+
+def distance_to_part(mesh, node, part, step=0):
+    """Exact distance from a node to the triangles of one part (brute force)."""
+    tr = mesh.triangulation
+    tri = tr.triangles[mesh.parts[tr.element_of] == part]
+    coords = mesh.coordinates(step)
+    return points_triangles_distance(coords[node:node + 1], coords[tri]).min()
+
+
+def assert_matches(mesh, r, expected, cutoff, step=0):
+    """Distances equal the brute force (relative 1e-12) and the part named is the reference's
+    or, on a tie, another part at the same distance."""
+    bd, bp = expected
+    np.testing.assert_allclose(r.distance, bd, rtol=1e-12, atol=0)
+    assert ((r.other_part >= 0) == np.isfinite(r.distance)).all()
+    for i in np.flatnonzero(r.other_part != bp):
+        assert distance_to_part(mesh, i, r.other_part[i], step) == pytest.approx(bd[i], rel=1e-12)
+    assert r.element_tests + r.plane_skips == r.leaf_elements
+
+
+# --------------------------------------------------------------------------- random meshes
+@settings(max_examples=40, deadline=None)
+@given(mesh_options, st.sampled_from([0.2, 1.0, 5.0]))
+def test_every_hierarchy_matches_brute_force(options, cutoff):
+    mesh = random_mesh(**options)
+    expected = brute_force_part_distances(mesh, cutoff)
+    for kind, leaf in CONFIGS + [("aabb", 3)]:
+        r = part_distances(mesh, cutoff, kind=kind, leaf_size=leaf)
+        assert_matches(mesh, r, expected, cutoff)
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.integers(0, 10**6), st.sampled_from(["aabb", "obb"]))
+def test_touching_coplanar_shared_and_degenerate_all_at_once(seed, kind):
+    mesh = random_mesh(seed, 4, touching=True, coplanar=True, shared=True, degenerate=True,
+                       single=True, unused=True)
+    expected = brute_force_part_distances(mesh, 1.0)
+    for leaf in (1, 10):
+        r = part_distances(mesh, 1.0, kind=kind, leaf_size=leaf)
+        assert_matches(mesh, r, expected, 1.0)
+    # the flat copy overlaps its original in one plane, touching parts share a point: nodes at
+    # distance 0 up to rounding
+    assert (expected[0] <= 1e-12).sum() >= 2
+
+
+def test_unused_nodes_and_nodes_of_degenerate_elements():
+    mesh = random_mesh(4, 2, degenerate=True, unused=True)
+    r = part_distances(mesh, 100.0)
+    unused = np.setdiff1d(np.arange(mesh.n_nodes), mesh.elements.ravel())
+    assert len(unused) == 2
+    assert np.isinf(r.distance[unused]).all() and (r.other_part[unused] == -1).all()
+    assert r.nodes_queried == mesh.n_nodes - 2
+    # with a cut-off of 100 every used node sees the other part, unless a (degenerate)
+    # element of the other part uses it too: then it has no other part
+    ptr, _ = node_parts(mesh)
+    used = np.unique(mesh.elements)
+    both = (ptr[used + 1] - ptr[used]) == 2
+    assert both.any() and (~both).any()
+    assert np.isfinite(r.distance[used[~both]]).all()
+    assert np.isinf(r.distance[used[both]]).all()
+
+
+def test_a_node_of_two_parts_measures_the_third_parts_only():
+    # parts 1 and 2 share the seam x = 1; part 3 is a plate 0.5 above the seam
+    nodes = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],  # part 1
+                      [2, 0, 0], [2, 1, 0],  # part 2 (shares nodes 1, 2)
+                      [0.5, 0, 0.5], [1.5, 0, 0.5], [1.5, 1, 0.5], [0.5, 1, 0.5]], float)
+    elements = [[0, 1, 2, 3], [1, 4, 5, 2], [6, 7, 8, 9]]
+    mesh = FEMesh(nodes=nodes, elements=elements, parts=[1, 2, 3])
+    ptr, own = node_parts(mesh)
+    assert own[ptr[1]:ptr[2]].tolist() == [1, 2]
+    for kind, leaf in CONFIGS:
+        r = part_distances(mesh, 2.0, kind=kind, leaf_size=leaf)
+        assert r.distance[1] == 0.5 and r.other_part[1] == 3  # not 0 to part 2
+        assert r.distance[0] == pytest.approx(np.hypot(0.5, 0.5)) and r.other_part[0] == 3
+        assert r.distance[4] == pytest.approx(np.hypot(0.5, 0.5)) and r.other_part[4] == 3
+    two = FEMesh(nodes=nodes[:6], elements=elements[:2], parts=[1, 2])
+    r = part_distances(two, 2.0)
+    assert np.isinf(r.distance[[1, 2]]).all()  # a seam node has no third part
+    assert r.distance[0] == 1.0 and r.other_part[0] == 2
+
+
+@pytest.mark.parametrize("kind,leaf", CONFIGS)
+def test_far_from_the_origin_keeps_its_digits(kind, leaf):
+    mesh = random_mesh(11, 4, touching=True, coplanar=True, shared=True)
+    near = part_distances(mesh, 1.0, kind=kind, leaf_size=leaf)
+    far_mesh = mesh.translated([1e6, -1e6, 1e6])
+    far = part_distances(far_mesh, 1.0, kind=kind, leaf_size=leaf)
+    finite = np.isfinite(near.distance)
+    assert finite.sum() > 10
+    assert (np.isfinite(far.distance) == finite).all()
+    assert np.abs(far.distance[finite] - near.distance[finite]).max() <= 1e-9
+    assert_matches(far_mesh, far, brute_force_part_distances(far_mesh, 1.0), 1.0)
+
+
+def test_time_steps():
+    mesh = random_mesh(21, 3)
+    rng = np.random.default_rng(0)
+    steps = np.stack([mesh.nodes, mesh.nodes + rng.normal(size=mesh.nodes.shape) * 0.3])
+    moving = FEMesh(nodes=mesh.nodes, elements=mesh.elements, parts=mesh.parts, steps=steps)
+    r0 = part_distances(moving, 2.0, step=0)
+    r1 = part_distances(moving, 2.0, step=1, kind="obb", leaf_size=10)
+    assert_matches(moving, r1, brute_force_part_distances(moving, 2.0, step=1), 2.0, step=1)
+    np.testing.assert_array_equal(r0.distance, part_distances(mesh, 2.0).distance)
+    assert not np.array_equal(r0.distance, r1.distance)
+
+
+# --------------------------------------------------------------------------- counters
+def test_counters_of_table_2():
+    mesh = random_mesh(7, 4, touching=True)
+    n_parts = len(np.unique(mesh.parts))
+    runs = {(k, leaf): part_distances(mesh, 1.0, kind=k, leaf_size=leaf) for k, leaf in CONFIGS}
+    for (kind, leaf), r in runs.items():
+        assert r.kind == kind and r.leaf_size == leaf and r.cutoff == 1.0
+        assert r.element_tests + r.plane_skips == r.leaf_elements > 0
+        assert r.bv_tests > 0 and r.build_s > 0 and r.query_s > 0
+        assert r.n_top_bvs == n_parts - 1
+        np.testing.assert_array_equal(r.distance, runs["aabb", 1].distance)
+    assert runs["aabb", 1].n_bvs == runs["obb", 1].n_bvs == 2 * mesh.n_elements - n_parts
+    assert runs["aabb", 10].n_bvs == runs["obb", 10].n_bvs < runs["aabb", 1].n_bvs
+    # without the point-to-plane test every element reached is measured, with the same result
+    for kind, leaf in CONFIGS:
+        r = part_distances(mesh, 1.0, kind=kind, leaf_size=leaf, plane_test=False)
+        assert r.plane_skips == 0 and r.element_tests == r.leaf_elements
+        assert r.element_tests >= runs[kind, leaf].element_tests
+        np.testing.assert_array_equal(r.distance, runs[kind, leaf].distance)
+        assert r.bv_tests == runs[kind, leaf].bv_tests
+
+
+def test_plane_test_skips_elements_in_big_leaves():
+    # a flat plate under a corrugated one: the elements of a leaf lie in different planes, and
+    # those farther by their plane than the nearest element so far are skipped
+    n = 24
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    p = np.stack([i.ravel(), j.ravel(), np.zeros(i.size)], 1) * 0.25
+    ids = np.arange(len(p)).reshape(n + 1, n + 1)
+    q = np.stack([ids[:-1, :-1], ids[1:, :-1], ids[1:, 1:], ids[:-1, 1:]], -1).reshape(-1, 4)
+    wave = p + [0.0, 0.0, 1.0]
+    wave[:, 2] += 0.4 * np.sin(4.0 * p[:, 0]) * np.cos(3.0 * p[:, 1])
+    mesh = FEMesh(nodes=np.concatenate([p, wave]), elements=np.concatenate([q, q + len(p)]),
+                  parts=np.repeat([1, 2], len(q)))
+    r = part_distances(mesh, 1.5, kind="aabb", leaf_size=10)
+    off = part_distances(mesh, 1.5, kind="aabb", leaf_size=10, plane_test=False)
+    np.testing.assert_array_equal(r.distance, off.distance)
+    assert r.plane_skips > 0.1 * r.leaf_elements
+    # skipped elements never beat the best so far: the search itself is unchanged
+    assert (r.bv_tests, r.leaf_elements) == (off.bv_tests, off.leaf_elements)
+    assert r.element_tests == off.element_tests - r.plane_skips
+
+
+def test_results_do_not_depend_on_the_thread_count():
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("numba has a single thread here")
+    mesh = random_mesh(3, 4, touching=True, coplanar=True)
+    from workbench.scene.generators import refine
+
+    mesh = refine(mesh, 4)  # a few thousand nodes: many parallel chunks
+    before = numba.get_num_threads()
+    try:
+        results = []
+        for threads in (1, 2):
+            numba.set_num_threads(threads)
+            results.append([part_distances(mesh, 0.5, kind=k, leaf_size=leaf)
+                            for k, leaf in CONFIGS])
+    finally:
+        numba.set_num_threads(before)
+    for a, b in zip(*results):
+        np.testing.assert_array_equal(a.distance, b.distance)
+        np.testing.assert_array_equal(a.other_part, b.other_part)
+        assert (a.bv_tests, a.element_tests, a.plane_skips) == \
+            (b.bv_tests, b.element_tests, b.plane_skips)
+
+
+# --------------------------------------------------------------------------- the car
+@pytest.fixture(scope="module")
+def car():
+    path = data.shared_file(data.CAR_DECK)
+    if path is None:
+        pytest.skip("the shared car deck (lsopt_car6) is not available")
+    from workbench.scene.io import load
+
+    mesh = load(path)
+    return mesh, brute_force_part_distances(mesh, 1.5)
+
+
+@pytest.mark.parametrize("kind,leaf", CONFIGS)
+def test_car_every_node_equals_brute_force(car, kind, leaf):
+    mesh, expected = car
+    r = part_distances(mesh, 1.5, kind=kind, leaf_size=leaf)
+    assert_matches(mesh, r, expected, 1.5)
+    assert np.isfinite(r.distance).sum() > 100  # flanges and seams of the deck
+    assert r.nodes_queried == mesh.n_nodes
+    if leaf == 10:  # crash2000: the plane test avoids most exact distances in big leaves
+        assert r.plane_skips > 0.5 * r.leaf_elements
+
+
+def test_car_far_from_the_origin(car):
+    mesh, _ = car
+    near = part_distances(mesh, 1.5)
+    far = part_distances(mesh.translated([1e6, 1e6, -1e6]), 1.5, kind="obb")
+    finite = np.isfinite(near.distance)
+    assert (np.isfinite(far.distance) == finite).all()
+    assert np.abs(far.distance[finite] - near.distance[finite]).max() <= 1e-9
+
+
+# --------------------------------------------------------------------------- connectivity
+def brute_connectivity(mesh, distance):
+    parts = np.unique(mesh.parts)
+    tr = mesh.triangulation
+    # relative to the same origin as the hierarchy: bitwise the same local coordinates
+    local = mesh.nodes - local_origin(mesh.nodes, np.unique(mesh.elements))
+    d = points_triangles_distance(local, local[tr.triangles])
+    tri_part = mesh.parts[tr.element_of]
+    ptr, own = node_parts(mesh)
+    best = np.full((len(parts), len(parts)), np.inf)
+    count = np.zeros((len(parts), len(parts)), np.int64)
+    for i in range(mesh.n_nodes):
+        mine = own[ptr[i]:ptr[i + 1]]
+        for b, pb in enumerate(parts):
+            if pb in mine or not (tri_part == pb).any():
+                continue
+            dmin = d[i, tri_part == pb].min()
+            if dmin <= distance:
+                for pa in mine:
+                    a = np.searchsorted(parts, pa)
+                    best[a, b] = min(best[a, b], dmin)
+                    count[a, b] += 1
+    return parts, np.minimum(best, best.T), count + count.T
+
+
+@settings(max_examples=25, deadline=None)
+@given(mesh_options, st.sampled_from(["aabb", "obb"]), st.sampled_from([1, 10]),
+       st.sampled_from([0.3, 1.0]))
+def test_connectivity_matches_brute_force_pair_minimum(options, kind, leaf, distance):
+    mesh = random_mesh(**options)
+    c = connectivity(mesh, distance, kind=kind, leaf_size=leaf)
+    parts, best, count = brute_connectivity(mesh, distance)
+    np.testing.assert_array_equal(c.parts, parts)
+    np.testing.assert_allclose(c.min_distance, best, rtol=1e-12, atol=0)
+    np.testing.assert_array_equal(c.nodes_within, count)
+    rows = c.rows()
+    assert len(rows) == int(np.triu(count > 0, 1).sum())
+    for row in rows:
+        a, b = np.searchsorted(parts, [row["part_a"], row["part_b"]])
+        assert row["part_a"] < row["part_b"] and row["min_distance"] == best[a, b] <= distance
+
+
+def test_connectivity_sees_a_second_neighbour():
+    # plates at z = 0 (A), 0.5 (B), -0.8 (C), -1.0 (D): every node's nearest other part is
+    # B, A, D, C; A and C are still 0.8 apart and must be listed
+    sq = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+    z = [0.0, 0.5, -0.8, -1.0]
+    mesh = FEMesh(nodes=np.concatenate([sq + [0, 0, h] for h in z]),
+                  elements=np.arange(16).reshape(4, 4), parts=[1, 2, 3, 4])
+    nearest = part_distances(mesh, 1.0)
+    assert set(zip(np.repeat([1, 2, 3, 4], 4), nearest.other_part)) == {(1, 2), (2, 1), (3, 4),
+                                                                       (4, 3)}
+    for kind in ("aabb", "obb"):
+        c = connectivity(mesh, 1.0, kind=kind)
+        rows = {(r["part_a"], r["part_b"]): (r["min_distance"], r["nodes_within"])
+                for r in c.rows()}
+        assert rows == {(1, 2): (0.5, 8), (1, 3): (pytest.approx(0.8), 8), (1, 4): (1.0, 8),
+                        (3, 4): (pytest.approx(0.2), 8)}
+
+
+# --------------------------------------------------------------------------- refusals
+def test_refusals():
+    mesh = random_mesh(1, 2)
+    for f in (part_distances, connectivity, brute_force_part_distances):
+        for bad in (0.0, -1.0, np.nan, np.inf, "x", None):
+            with pytest.raises(ValueError, match="finite number > 0"):
+                f(mesh, bad)
+    for f in (part_distances, connectivity):
+        with pytest.raises(ValueError, match="kind"):
+            f(mesh, 1.0, kind="sphere")
+        for bad in (0, -2, 2.5):
+            with pytest.raises(ValueError, match="leaf_size"):
+                f(mesh, 1.0, leaf_size=bad)
+        with pytest.raises(ValueError, match="step"):
+            f(mesh, 1.0, step=3)
+    # NaN or inf at a used node of the measured step; at an unused node it does not matter
+    steps = np.stack([mesh.nodes, mesh.nodes])
+    steps[1, mesh.elements[-1, 2]] = np.nan
+    extra = np.concatenate([mesh.nodes, [[0.0, 0.0, 0.0]]])
+    steps_unused = np.stack([extra, extra])
+    steps_unused[1, -1] = np.inf
+    moving = FEMesh(nodes=mesh.nodes, elements=mesh.elements, parts=mesh.parts, steps=steps)
+    loose = FEMesh(nodes=extra, elements=mesh.elements, parts=mesh.parts, steps=steps_unused)
+    for f in (part_distances, connectivity, brute_force_part_distances):
+        f(moving, 1.0, step=0)
+        f(loose, 1.0, step=1)
+        with pytest.raises(ValueError, match="non-finite"):
+            f(moving, 1.0, step=1)
+    empty = random_mesh(1, 1)
+    empty.elements = np.zeros((0, 4), np.int32)
+    empty.parts = np.zeros(0, np.int32)
+    for f in (part_distances, connectivity, brute_force_part_distances):
+        with pytest.raises(ValueError, match="no elements"):
+            f(empty, 1.0)
