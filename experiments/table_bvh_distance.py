@@ -40,9 +40,8 @@ from pathlib import Path
 
 import numpy as np
 
-from workbench.algo.forcetube import force_tube, prismatic_tube, section_force, stress_tensor
-from workbench.algo.forcetube import tube_mesh, with_tube
-from workbench.algo.hierarchy import ElementHierarchy
+from workbench.algo.forcetube import (BRUTE_FORCE, force_tube, prismatic_tube, section_force,
+                                      stress_tensor, tube_mesh, with_tube)
 from workbench.algo.membrane import with_membrane_stress
 from workbench.algo.part_distance import brute_force_part_distances, connectivity, part_distances
 from workbench.data import CAR_DECK, shared_file
@@ -306,11 +305,10 @@ def forcetube_rows(ctx, mesh, label: str, out_dir: Path, quick: bool, say) -> li
     loaded = with_membrane_stress(crash, yield_stress=YIELD_MPA)
     points, parts = car_trace_line(mesh)
     start = time.perf_counter()
-    brute = force_tube(loaded, points, parts=parts, per_segment=12)
+    brute = force_tube(loaded, points, parts=parts, per_segment=12, cut=BRUTE_FORCE)
     brute_s = time.perf_counter() - start
     start = time.perf_counter()
-    tube = force_tube(loaded, points, parts=parts, per_segment=12,
-                      cut=lambda step: ElementHierarchy(loaded, step=step).cut_by_plane)
+    tube = force_tube(loaded, points, parts=parts, per_segment=12)  # through the hierarchy
     tree_s = time.perf_counter() - start
     same = bool(np.array_equal(tube.force, brute.force, equal_nan=True))
     for k, step in enumerate(tube.steps):

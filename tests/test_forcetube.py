@@ -384,3 +384,15 @@ def test_bad_mesh_input_is_refused():
         force_tube(moving, [[0, 0, 0], [10.0, 0, 0]])
     with pytest.raises(ValueError, match="normal must not be zero"):
         section_force(*inputs(mesh), [5.0, 0, 0], [0, 0, 0])
+
+
+def test_planes_found_through_the_hierarchy_give_the_brute_force_forces():
+    from workbench.algo.forcetube import BRUTE_FORCE
+
+    mesh, exact = prismatic_tube(sides=10, length=300.0, radius=30.0, thickness=2.0,
+                                 stress=[50.0, -120.0], segments=15, steps=2, stretch=0.02)
+    line = [[10.0, 0.0, 0.0], [150.0, 5.0, 0.0], [290.0, 0.0, 3.0]]
+    through = force_tube(mesh, line, per_segment=6)
+    brute = force_tube(mesh, line, per_segment=6, cut=BRUTE_FORCE)
+    assert np.array_equal(through.force, brute.force)
+    assert np.array_equal(through.crossed, brute.crossed) and through.crossed.min() > 0

@@ -149,9 +149,10 @@ def cmd_render(args) -> int:
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
     scale = getattr(path, "scale", None)
-    if is_mesh and args.field is not None and not args.raw and scale is not None:
+    field = args.field if args.field is not None else getattr(path.style, "field", None)
+    if is_mesh and field is not None and not args.raw and scale is not None:
         save_field_figure(out, result.image, value_range=scale.value_range,
-                          colormap=path.style.colormap, label=args.field, units=args.units,
+                          colormap=path.style.colormap, label=field, units=args.units,
                           title=f"{scene.name} ({path_name})", bands=args.bands)
     else:
         save_png(out, result.image)

@@ -70,6 +70,9 @@ _VOIGT = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (2, 0))
 
 
 # --------------------------------------------------------------------------- section planes
+BRUTE_FORCE = "brute force"  # force_tube(cut=BRUTE_FORCE): test every element against a plane
+
+
 def _control_points(control_points) -> np.ndarray:
     try:
         pts = np.asarray(control_points, dtype=np.float64)
@@ -384,7 +387,8 @@ def _polyline_distance(x: np.ndarray, line: np.ndarray) -> np.ndarray:
 def force_tube(mesh: FEMesh, control_points, *, steps=None, per_segment: int = 8,
                blend: int = 2, stress_fields: Sequence[str] = STRESS_FIELDS,
                thickness_field: str = THICKNESS_FIELD, parts=None,
-               selection_radius: float | None = None, cut: Callable | None = None) -> ForceTube:
+               selection_radius: float | None = None,
+               cut: Callable | str | None = None) -> ForceTube:
     """Section forces of ``mesh`` through the planes of the trace line ``control_points``
     (K, 3, model units, positions at step 0) for each of ``steps`` (default: every step).
 
@@ -403,9 +407,11 @@ def force_tube(mesh: FEMesh, control_points, *, steps=None, per_segment: int = 8
     no force). The others contribute nothing, also when their stress is missing (NaN); a
     counted crossed element with NaN stress makes that plane's force NaN.
 
-    ``cut(step)`` may return the plane query for that step's coordinates — a callable
-    ``(point, normal) -> element indices`` such as a bounding-volume hierarchy's; by default
-    the elements are tested by brute force. A trace line that cuts nothing yields zero forces.
+    The elements a plane cuts are found through an AABB hierarchy of the step's coordinates
+    (:meth:`workbench.algo.hierarchy.ElementHierarchy.cut_by_plane`, as crash2000 does), or,
+    with ``cut=BRUTE_FORCE``, by testing every element; ``cut(step)`` may also return any plane
+    query ``(point, normal) -> element indices`` for that step. A trace line that cuts nothing
+    yields zero forces.
 
     Refused (ValueError): the trace-line refusals of :func:`section_planes` (also for a step
     where the moved control points make a zero-length segment), missing stress or thickness
@@ -464,7 +470,12 @@ def force_tube(mesh: FEMesh, control_points, *, steps=None, per_segment: int = 8
         counted = include
         if "alive" in mesh.element_fields:
             counted = include & (mesh.element_field("alive", int(step)) != 0)
-        query = None if cut is None else cut(int(step))
+        if cut is None:  # the elements a plane cuts, found through a hierarchy of this step
+            from .hierarchy import ElementHierarchy
+
+            query = ElementHierarchy(mesh, step=int(step)).cut_by_plane
+        else:
+            query = None if cut == BRUTE_FORCE else cut(int(step))
         if query is not None and not callable(query):
             raise ValueError("cut(step) must return a callable (point, normal) -> element "
                              "indices")
