@@ -142,7 +142,10 @@ def _diagonal_cross(e: np.ndarray, coords: np.ndarray) -> tuple[np.ndarray, np.n
 def _unit_or_zero(n: np.ndarray, ok: np.ndarray) -> np.ndarray:
     """Rows of ``n`` scaled to unit length where ``ok``, zero elsewhere."""
     out = np.zeros_like(n)
-    out[ok] = n[ok] / np.sqrt(np.einsum("ij,ij->i", n[ok], n[ok]))[:, None]
+    # scaled by the largest component first: the squares of tiny components (1e-160) would
+    # underflow to subnormals and lose the unit length
+    v = n[ok] / np.abs(n[ok]).max(axis=1)[:, None]
+    out[ok] = v / np.sqrt(np.einsum("ij,ij->i", v, v))[:, None]
     return out
 
 
