@@ -44,7 +44,7 @@ def expect_all(sigma, tensor, scale):
 def test_exact_rigid_motion_gives_zero_stress():
     """A rotation with rational entries (from the integer quaternion (1, 2, 3, 4), |q|² = 30)
     of integer coordinates that are multiples of 30, plus an integer shift: the moved
-    coordinates are exact, so the stress must vanish to the brief's 1e-9 of E·1e-6."""
+    coordinates are exact, so the stress must vanish to 1e-9 of E·1e-6."""
     a, b, c, d = 1, 2, 3, 4
     rot = np.array([[a*a + b*b - c*c - d*d, 2*(b*c - a*d), 2*(b*d + a*c)],
                     [2*(b*c + a*d), a*a - b*b + c*c - d*d, 2*(c*d - a*b)],
