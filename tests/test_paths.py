@@ -72,10 +72,11 @@ def colors(image, mask):
 def test_registry_and_bad_names():
     assert set(PATHS) == {"position", "flat", "gouraud", "vertex_color", "pixel_color",
                           "element_color", "quad_wire", "fe_wire_texture", "fe_normal_map",
-                          "fe_normal_wire", "spacetime_vertex", "spacetime_pixel", "flange"}
+                          "fe_normal_wire", "spacetime_vertex", "spacetime_pixel", "flange",
+                          "exploded"}
     assert MESH_PATHS == sorted(set(PATHS) - {"fe_wire_texture", "fe_normal_map",
                                               "fe_normal_wire", "spacetime_vertex",
-                                              "spacetime_pixel", "flange"})
+                                              "spacetime_pixel", "flange", "exploded"})
     with pytest.raises(ValueError, match="known paths"):
         make_path("phong")
     for cls in PATHS.values():

@@ -411,8 +411,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_reproduce)
 
     from .experiment.sweep import add_sweep_parser
+    from .explode_cli import add_explode_parser
     from .stress import add_stress_parser
 
+    add_explode_parser(sub, _pair, _size)
     add_sweep_parser(sub)
     add_stress_parser(sub)
     return parser

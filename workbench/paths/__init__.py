@@ -2,6 +2,7 @@
 (:class:`~workbench.paths.base.RenderPath`) and in one registry (``PATHS``)."""
 
 from . import fetexture, fields, flange, spacetime, surface, wire  # noqa: F401  (each registers)
+from . import exploded  # noqa: F401  (registers)
 from .base import (PATHS, GLPath, MeshPath, RenderPath, Style, check_options, make_path,
                    path_class, path_options)
 from .colormap import ColorScale, colormap_lut, scale_for

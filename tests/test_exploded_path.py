@@ -1,0 +1,202 @@
+"""The exploded-view path (ghost2013) on a generated box of six panels around a small inner box:
+occlusion counts, reveal, picking after the explosion, the animation, the CLI and refusals."""
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from workbench.cli import main
+from workbench.experiment.measure import default_camera
+from workbench.gl import Framebuffer
+from workbench.paths import make_path
+from workbench.paths.exploded import NO_PART, ExplodeStyle
+from workbench.scene.mesh import FEMesh
+
+SIZE = (240, 160)  # wider than the box: room beside it for the moved halves
+FOCUS = 7
+
+
+def _grid(origin, u, v, n):
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    points = origin + (i[..., None] / n) * u + (j[..., None] / n) * v
+    index = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
+    quads = np.stack([index[:-1, :-1], index[1:, :-1], index[1:, 1:], index[:-1, 1:]], -1)
+    return points.reshape(-1, 3), quads.reshape(-1, 4)
+
+
+def _box_faces(lo, hi, n):
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    ex, ey, ez = np.diag(hi - lo)
+    return [_grid(o, u, v, n) for o, u, v in ((lo, ey, ez), (lo + ex, ey, ez), (lo, ex, ez),
+                                              (lo + ey, ex, ez), (lo, ex, ey), (lo + ez, ex, ey))]
+
+
+def box_scene() -> FEMesh:
+    """Panels 1..6 (x−, x+, y−, y+, z−, z+) of the cube [−1, 1]³ and part 7, the cube
+    [−0.2, 0.2]³ inside."""
+    nodes, elements, parts, base = [], [], [], 0
+    faces = [(pid, f) for pid, f in enumerate(_box_faces((-1, -1, -1), (1, 1, 1), 8), start=1)]
+    faces += [(FOCUS, f) for f in _box_faces((-0.2, -0.2, -0.2), (0.2, 0.2, 0.2), 2)]
+    for pid, (points, quads) in faces:
+        nodes.append(points)
+        elements.append(quads + base)
+        parts += [pid] * len(quads)
+        base += len(points)
+    return FEMesh(np.concatenate(nodes), np.concatenate(elements), np.array(parts), name="box")
+
+
+@pytest.fixture(scope="module")
+def mesh():
+    return box_scene()
+
+
+@pytest.fixture
+def prepared(ctx, mesh):
+    """The path on the box seen along +y (from the −y side), split by the x plane."""
+    camera = default_camera(mesh, SIZE, view=(0.0, 0.0))
+    path = make_path("exploded", focus=FOCUS, plane="x")
+    path.prepare(ctx, mesh, camera)
+    fb = Framebuffer(ctx, SIZE)
+    fb.use()
+    yield path, fb, camera
+    fb.release()
+    path.release()
+
+
+def _draw(path, fb, draw=None):
+    fb.clear()
+    (draw or path.draw)()
+    return fb.read()
+
+
+def _orange(image):
+    """Pixels in the focus colour (orange: red well above blue) against the grey panels."""
+    return int(((image[..., 0].astype(int) - image[..., 2]) > 30).sum())
+
+
+def test_hidden_at_zero_revealed_at_large_offset(prepared):
+    path, fb, _ = prepared
+    assert path.front_side() == 1 or path.front_side() == -1
+    p_unocc, p_occ, _ = path.measure_occlusion()
+    assert p_unocc > 500 and p_occ == 0
+    assert path.occlusion_ratio() > 0.99
+    path.set_offset(1.5)
+    p_unocc, p_occ, _ = path.measure_occlusion()
+    assert (p_unocc - p_occ) / p_unocc <= 0.01
+    # part of the way: partly revealed
+    path.set_offset(0.1)
+    assert 0.05 < path.occlusion_ratio() < 0.95
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.1, 0.15, 1.5])
+def test_occlusion_counts_match_pixel_counts(prepared, offset):
+    path, fb, _ = prepared
+    path.set_offset(offset)
+    p_unocc, p_occ, _ = path.measure_occlusion()
+    assert p_unocc == _orange(_draw(path, fb, path.draw_focus))
+    assert p_occ == _orange(_draw(path, fb))
+    assert p_occ == int((path.id_image() == FOCUS).sum())
+
+
+def test_pick_after_explosion(prepared, mesh):
+    path, fb, camera = prepared
+    centre = camera.project(np.array([[0.0, -1.0, 0.0]]), SIZE)[0]
+    cx, cy = int(centre[0]), int(centre[1])
+    beyond = camera.project(np.array([[1.4, -1.0, 0.0]]), SIZE)[0]  # right of the box
+    bx, by = int(beyond[0]), int(beyond[1])
+    assert path.pick(cx, cy) == 3  # the front panel (y−) hides the focus
+    assert path.pick(bx, by) is None  # nothing drawn right of the box yet
+    path.set_offset(1.0)
+    assert path.pick(cx, cy) == FOCUS
+    # the + half of the front panel now covers x in [1, 2]: picked where it lies
+    assert path.pick(bx, by) == 3
+    # and where the image shows it (the colour image is not empty there)
+    image = _draw(path, fb)
+    assert (image[by, bx, :3] < 250).any()
+    ids = path.id_image()
+    assert ids[by, bx] == 3 and ids[cy, cx] == FOCUS and ids[2, 2] == NO_PART
+
+
+def test_animation_reveals_within_30_frames(prepared):
+    path, fb, _ = prepared
+    o_max = path.settings.o_max
+    ratios, offsets = [], []
+    for _ in range(30):
+        ratios.append(path.step_animation())
+        offsets.append(path.offset)
+        _draw(path, fb)
+    assert ratios[0] > 0.99  # hidden at the start
+    assert max(offsets) <= o_max and min(offsets) > 0
+    assert min(ratios[1:]) <= 0.01
+    final = path.occlusion_ratio()
+    assert final <= 0.2  # near the reveal offset: at most a sliver covered again
+    assert path.state.frame == 30
+
+
+def test_ghosted_front_half_is_translucent(prepared):
+    path, fb, _ = prepared
+    path.set_offset(0.05)
+    opaque = _draw(path, fb)
+    path.set_offset(0.05, alpha=0.5)
+    ghost = _draw(path, fb)
+    # the focus shows through the translucent front half (the + half: the eye lies on the
+    # plane, a tie that front_sign gives to +1), not through the opaque back half
+    assert path.front_side() == 1
+    assert _orange(ghost) > _orange(opaque) + 50
+    assert (ghost[:, : SIZE[0] // 2 - 20] == opaque[:, : SIZE[0] // 2 - 20]).all()
+
+
+def _write_k(mesh, file):
+    lines = ["*KEYWORD", "*NODE"]
+    lines += [f"{i + 1:8d}{p[0]:16.8f}{p[1]:16.8f}{p[2]:16.8f}" for i, p in enumerate(mesh.nodes)]
+    lines.append("*ELEMENT_SHELL")
+    lines += [f"{i + 1:8d}{pid:8d}" + "".join(f"{n + 1:8d}" for n in e)
+              for i, (e, pid) in enumerate(zip(mesh.elements, mesh.parts))]
+    lines.append("*END")
+    file.write_text("\n".join(lines) + "\n")
+
+
+def test_cli_writes_gif(ctx, mesh, tmp_path, capsys):
+    deck = tmp_path / "box.k"
+    _write_k(mesh, deck)
+    out = tmp_path / "out.gif"
+    status = main(["explode", str(deck), "--focus", "7", "--view", "0,0", "--plane", "x",
+                   "--frames", "12", "--size", "96x80", "-o", str(out)])
+    assert status == 0
+    with Image.open(out) as gif:
+        assert gif.n_frames == 12 and gif.size == (96, 80)
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert lines[-1].startswith("revealed ") and "after 12 frames, offset " in lines[-1]
+    assert lines[-1].endswith("of o_max 3.46")
+    revealed = float(lines[-1].split()[1])
+    assert 0.8 <= revealed <= 1.0
+    strip = tmp_path / "strip.png"
+    assert main(["explode", str(deck), "--focus", "7", "--frames", "3", "--size", "40x30",
+                 "-o", str(strip)]) == 0
+    with Image.open(strip) as png:
+        assert png.size == (120, 30)
+
+
+def test_cli_refuses_missing_part(ctx, mesh, tmp_path, capsys):
+    deck = tmp_path / "box.k"
+    _write_k(mesh, deck)
+    status = main(["explode", str(deck), "--focus", "9", "-o", str(tmp_path / "x.gif")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1
+    assert "no part 9" in err[0] and "[1, 2, 3, 4, 5, 6, 7]" in err[0]
+    assert not (tmp_path / "x.gif").exists()
+
+
+def test_refusals(ctx, mesh):
+    camera = default_camera(mesh, SIZE)
+    with pytest.raises(ValueError, match=r"no part 9; part ids: \[1, 2, 3, 4, 5, 6, 7\]"):
+        make_path("exploded", focus=9).prepare(ctx, mesh, camera)
+    with pytest.raises(ValueError, match="empty focus"):
+        make_path("exploded").prepare(ctx, mesh, camera)
+    inner = mesh.part(FOCUS)
+    with pytest.raises(ValueError, match="whole"):
+        make_path("exploded", focus=FOCUS).prepare(ctx, inner, default_camera(inner, SIZE))
+    for bad in ("w", "0,0,0", "1,2", "nan,1,0"):
+        with pytest.raises(ValueError, match="plane must be"):
+            ExplodeStyle(focus=FOCUS, plane=bad)
+    assert ExplodeStyle(focus=FOCUS, plane=" 1, 0 ,0").plane == "1,0,0"
