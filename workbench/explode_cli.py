@@ -90,7 +90,9 @@ def cmd_explode(args) -> int:
         raise KeyError(f"{scene.name} has no part {args.focus}; part ids: {ids}")
     path = make_path("exploded", focus=args.focus, plane=args.plane, speed=1.0)
     ctx = create_context()
-    camera = default_camera(scene, args.size, view=args.view, up=args.up)
+    from .paths.exploded import exploded_camera
+
+    camera = exploded_camera(default_camera(scene, args.size, view=args.view, up=args.up), scene)
     fb = Framebuffer(ctx, args.size)
     frames = []
     try:

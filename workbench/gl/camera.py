@@ -22,6 +22,14 @@ PROJECTIONS = ("orthographic", "perspective")
 _UP_FRAMES = {"y": np.eye(3), "z": np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])}
 
 
+def up_frame(up: str) -> np.ndarray:
+    """(3, 3) float64: the world directions (columns) of the Y-up frame's x, y, z axes for the
+    ``up`` axis "y" or "z" (the frame :meth:`Camera.fit` turns its angles in)."""
+    if up not in _UP_FRAMES:
+        raise ValueError(f"up must be 'y' or 'z', got {up!r}")
+    return _UP_FRAMES[up].copy()
+
+
 def _look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray) -> np.ndarray:
     forward = target - eye
     forward /= np.linalg.norm(forward)

@@ -442,3 +442,19 @@ class ExplodedPath(MeshPath):
             self._scratch = None
         super().release()
         self._pick_program = self._pick_vao = None
+
+
+def exploded_camera(camera, mesh, o_max: float | None = None):
+    """``camera`` with its depth range widened by 2·``o_max`` (default the assembly's
+    :func:`~workbench.algo.explode.o_max_of`) on both sides. A camera fitted to the assembly
+    encloses the unexploded parts only: a half moved toward or away from the viewer would be
+    cut by the near or far plane, and a half clipped away would count as revealing the object.
+    A perspective camera's near plane moves toward the eye but stays in front of it."""
+    from dataclasses import replace
+
+    extra = 2.0 * (float(o_max) if o_max is not None else _explode().o_max_of(mesh))
+    near = camera.near - extra
+    if camera.projection == "perspective":
+        near = max(near, 1e-3 * camera.near)
+    return replace(camera, near=near, far=camera.far + extra)
+

@@ -1,0 +1,96 @@
+"""The fig_exploded experiment end to end in its quick form: what its tables and figures show."""
+
+import pytest
+from PIL import Image
+
+from workbench.data import CAR_DECK, shared_file
+from workbench.experiment.registry import discover, run_experiment
+from workbench.experiment.tables import read_table
+
+
+@pytest.fixture(scope="module")
+def result(tmp_path_factory):
+    discover()
+    root = tmp_path_factory.mktemp("figures")
+    return run_experiment("fig_exploded", figures_root=root, quick=True)
+
+
+def _box(rows):
+    return [r for r in rows if r["scene"] == "box"]
+
+
+def test_sweep_covers_both_planes_and_the_angles(result):
+    rows, _ = result
+    box = _box(rows)
+    for plane in ("manual", "auto"):
+        assert sorted(r["sweep_deg"] for r in box if r["plane"] == plane) == [
+            0, 20, 40, 60, 75, 85]
+    for r in rows:
+        assert 0.0 <= r["final_r"] <= 1.0 and 0.5 <= r["final_alpha"] <= 1.0
+        assert 0.0 <= r["final_offset_over_o_max"] <= 1.0
+        assert r["query_wall_ms"] > 0 and r["draw_wall_ms"] > 0
+
+
+def test_box_reveals_within_30_frames_up_to_40_degrees(result):
+    rows, _ = result
+    for r in _box(rows):
+        if r["sweep_deg"] <= 40 or r["plane"] == "auto":
+            assert isinstance(r["frames_to_reveal"], int), r
+            assert r["frames_to_reveal"] <= 30, r
+            assert r["offset_at_reveal_over_o_max"] <= 1.0
+
+
+@pytest.mark.xfail(strict=True, reason="measured: the manual plane at 60 degrees needs 35 "
+                                       "frames at s_u = 1 (reveal offset 0.66 o_max)")
+def test_box_reveals_within_30_frames_at_60_degrees_manual_plane(result):
+    rows, _ = result
+    row = [r for r in _box(rows) if r["sweep_deg"] == 60 and r["plane"] == "manual"][0]
+    assert isinstance(row["frames_to_reveal"], int) and row["frames_to_reveal"] <= 30
+
+
+def test_box_reveal_offset_matches_closed_form(result):
+    rows, _ = result
+    for r in _box(rows):
+        if r["plane"] == "manual" and r["closed_form_reveal_over_o_max"] <= 1.0:
+            measured = r["measured_reveal_over_o_max"]
+            assert measured is not None
+            # r <= 0.01 allows a sliver: measured slightly below the exact offset
+            assert 0.9 * r["closed_form_reveal_over_o_max"] <= measured <= \
+                r["closed_form_reveal_over_o_max"] * 1.01 + 1e-3
+        elif r["plane"] == "manual":  # needs more than o_max: ghosting shows the object
+            assert r["frames_to_reveal"] == "not within 40"
+            assert r["visible_through_ghost_pct"] >= 99.0 and r["final_alpha"] < 0.8
+
+
+def test_occlusion_driven_reveals_at_least_uniform_on_the_box(result):
+    _, out_dir = result
+    compare = [r for r in read_table(out_dir / "compare.csv") if r["scene"] == "box"]
+    assert len(compare) == 6
+    for r in compare:
+        assert r["occlusion_driven_revealed"] >= r["uniform_revealed"], r
+        assert r["occlusion_driven_revealed"] >= r["fixed_offset_manual_plane_revealed"], r
+
+
+def test_figures(result):
+    rows, out_dir = result
+    names = ["strip_box.png", "box.gif"]
+    if any(r["scene"] == "car" for r in rows):
+        names += ["strip_car.png", "car.gif"]
+    for name in names:
+        assert (out_dir / name).stat().st_size > 0
+    for gif in [n for n in names if n.endswith(".gif")]:
+        with Image.open(out_dir / gif) as im:
+            assert im.n_frames > 1
+
+
+def test_car_rows_name_their_focus(result):
+    rows, out_dir = result
+    car = [r for r in rows if r["scene"] == "car"]
+    if shared_file(CAR_DECK) is None:
+        assert not car
+        return
+    assert len(car) == 12
+    parts = read_table(out_dir / "car_parts.csv")
+    hidden = max(parts, key=lambda p: (p["r"], p["p_unocc"]))
+    assert hidden["r"] == 1.0
+    assert {r["focus_part"] for r in car} == {hidden["part"]}
