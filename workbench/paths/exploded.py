@@ -18,8 +18,10 @@ Beyond ``draw`` the path offers what the paper's interaction needs:
   framebuffer of the bound viewport's size: the focus alone into a cleared depth buffer
   (``p_unocc``) and the focus after both halves (``p_occ``). Each query draws the focus a second
   time with ``depth ≤`` over a depth-only pre-pass of the same geometry, so a count is the number
-  of pixels where the focus is the nearest surface (no overdraw of its own back faces). Returns
-  ``(p_unocc, p_occ, gpu_ms)``; ``last_occlusion`` holds the GPU and wall times.
+  of pixels where the focus is the nearest surface (no overdraw of its own back faces). The
+  focus never moves, so ``p_unocc`` is counted once per camera, step and image size and kept;
+  each frame then costs the ``p_occ`` pass only. Returns ``(p_unocc, p_occ, gpu_ms)``;
+  ``last_occlusion`` holds the GPU and wall times and whether ``p_unocc`` was counted anew.
 * :meth:`ExplodedPath.step_animation` — ``r = (p_unocc − p_occ)/p_unocc`` (0 when the focus is
   off screen), then :func:`~workbench.algo.explode.next_state`; the offset and the ghosting
   opacity (:func:`~workbench.algo.explode.ghost_alpha`) follow the new state.
@@ -224,6 +226,7 @@ class ExplodedPath(MeshPath):
 
     def set_camera(self, camera) -> None:
         super().set_camera(camera)
+        self._unoccluded = {}  # p_unocc per image size, for this camera and step
         eye = self.origin + np.asarray(camera.eye, np.float64)  # world space, float64
         if camera.projection == "orthographic":  # parallel rays: an eye far back along them
             view = np.asarray(camera.target, np.float64) - np.asarray(camera.eye, np.float64)
@@ -348,12 +351,15 @@ class ExplodedPath(MeshPath):
         fb = self._target(size)
         program, vao = self._program, self._vao
         alone, behind, timer = SamplesPassed(ctx), SamplesPassed(ctx), GpuTimer(ctx)
+        cache = getattr(self, "_unoccluded", {})
+        key = (fb.size, getattr(self, "step", None))
+        passes = ((behind, True),) if key in cache else ((alone, False), (behind, True))
         start = time.perf_counter()
         try:
             fb.use()
             fb.fbo.color_mask = (False, False, False, False)
             with timer:
-                for query, halves in ((alone, False), (behind, True)):
+                for query, halves in passes:
                     fb.fbo.depth_mask = True
                     fb.fbo.clear(depth=1.0)
                     ctx.depth_func = "<"
@@ -368,7 +374,11 @@ class ExplodedPath(MeshPath):
                     fb.fbo.depth_mask = False
                     with query:
                         self._pass(program, vao, halves=False)
-            p_unocc, p_occ = alone.samples, behind.samples
+            counted = key not in cache
+            if counted:
+                cache[key] = alone.samples
+                self._unoccluded = cache
+            p_unocc, p_occ = cache[key], behind.samples
             gpu_ms = timer.elapsed_ms
         finally:
             ctx.depth_func = "<"
@@ -376,7 +386,8 @@ class ExplodedPath(MeshPath):
             fb.fbo.color_mask = (True, True, True, True)
             self._restore(previous, viewport)
         wall_ms = (time.perf_counter() - start) * 1e3
-        self.last_occlusion = dict(p_unocc=p_unocc, p_occ=p_occ, gpu_ms=gpu_ms, wall_ms=wall_ms)
+        self.last_occlusion = dict(p_unocc=p_unocc, p_occ=p_occ, gpu_ms=gpu_ms, wall_ms=wall_ms,
+                                   unoccluded_counted=counted)
         return p_unocc, p_occ, gpu_ms
 
     def occlusion_ratio(self, size=None) -> float:
