@@ -200,3 +200,30 @@ def test_refusals(ctx, mesh):
         with pytest.raises(ValueError, match="plane must be"):
             ExplodeStyle(focus=FOCUS, plane=bad)
     assert ExplodeStyle(focus=FOCUS, plane=" 1, 0 ,0").plane == "1,0,0"
+
+
+def test_automatic_plane_follows_the_camera(ctx, mesh):
+    """The automatic plane is chosen again when the view changes; a manual one stays."""
+    from workbench.experiment.measure import default_camera
+    from workbench.paths import make_path
+
+    views = [(0.0, 0.0), (90.0, 0.0)]
+    cameras = [default_camera(mesh, (96, 80), view=v, up="y") for v in views]
+    auto = make_path("exploded", focus=7, plane="auto")
+    manual = make_path("exploded", focus=7, plane="x")
+    normals = {}
+    for path in (auto, manual):
+        path.prepare(ctx, mesh, cameras[0])
+        first = path.normal.copy()
+        path.set_camera(cameras[1])
+        normals[path.style.plane] = (first, path.normal.copy())
+        for camera in cameras:
+            view = np.asarray(camera.target) - np.asarray(camera.eye)
+            view /= np.linalg.norm(view)
+            if path is auto:
+                path.set_camera(camera)
+                # never within the rejection angle of the view it was chosen for
+                assert abs(float(path.normal @ view)) < np.cos(np.radians(20.0))
+        path.release()
+    assert not np.allclose(np.abs(normals["auto"][0]), np.abs(normals["auto"][1]))
+    assert np.array_equal(normals["x"][0], normals["x"][1])

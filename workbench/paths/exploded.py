@@ -190,18 +190,10 @@ class ExplodedPath(MeshPath):
         style = self.style
         points = mesh.coordinates(style.step)
         in_focus = mesh.parts == style.focus
-        focus_nodes = np.unique(mesh.elements[in_focus])
-        rest_nodes = np.unique(mesh.elements[~in_focus])
-        spec = parse_plane(style.plane)
-        if spec == "auto":
-            view_dir = np.asarray(camera.target, np.float64) - np.asarray(camera.eye, np.float64)
-            self.plane = algo.auto_plane(points[focus_nodes], points[rest_nodes], view_dir,
-                                         reject_deg=style.reject_deg)
-        else:
-            self.plane = algo.manual_plane(spec, points[focus_nodes])
-        normal = np.asarray(self.plane.normal, np.float64)
-        self.normal = normal / np.linalg.norm(normal)
-        self.plane_point = np.asarray(self.plane.point, np.float64)
+        self._focus_points = points[np.unique(mesh.elements[in_focus])]
+        self._rest_points = points[np.unique(mesh.elements[~in_focus])]
+        self._plane_spec = parse_plane(style.plane)
+        self._choose_plane(camera)
         o_max = style.o_max if style.o_max is not None else float(algo.o_max_of(mesh))
         self.settings = algo.ExplodeSettings(o_max=o_max, speed=style.speed, dt=style.dt,
                                              ghost_start=style.ghost_start)
@@ -214,18 +206,37 @@ class ExplodedPath(MeshPath):
         self._pick_vao = self._keep(ctx.vertex_array(
             self._pick_program, [(self._positions, "3f", "position")], self._index,
             index_element_size=4))
+        self._set_clip_planes()
+        self.set_camera(camera)
+
+    def _choose_plane(self, camera) -> None:
+        """The split plane: the style's manual one, or the automatic one for ``camera``'s view
+        direction (chosen again whenever the camera changes, as the view decides it)."""
+        algo = _explode()
+        if self._plane_spec == "auto":
+            view_dir = np.asarray(camera.target, np.float64) - np.asarray(camera.eye, np.float64)
+            self.plane = algo.auto_plane(self._focus_points, self._rest_points, view_dir,
+                                         reject_deg=self.style.reject_deg)
+        else:
+            self.plane = algo.manual_plane(self._plane_spec, self._focus_points)
+        normal = np.asarray(self.plane.normal, np.float64)
+        self.normal = normal / np.linalg.norm(normal)
+        self.plane_point = np.asarray(self.plane.point, np.float64)
+
+    def _upload_plane(self) -> None:
         # the plane through the upload origin, in float64 before the float32 cast
         d = -float(self.normal @ self.plane_point) + float(self.normal @ self.origin)
         for program in self._programs():
             program["split_plane"].value = (*(float(v) for v in self.normal), d)
-        self._set_clip_planes()
-        self.set_camera(camera)
 
     def _programs(self) -> list:
         return [p for p in (self._program, self._pick_program) if p is not None]
 
     def set_camera(self, camera) -> None:
         super().set_camera(camera)
+        if self._plane_spec == "auto":
+            self._choose_plane(camera)
+        self._upload_plane()
         self._unoccluded = {}  # p_unocc per image size, for this camera and step
         eye = self.origin + np.asarray(camera.eye, np.float64)  # world space, float64
         if camera.projection == "orthographic":  # parallel rays: an eye far back along them
