@@ -61,16 +61,17 @@ from pathlib import Path
 
 import numpy as np
 
-from workbench.algo.explode import o_max_of, occlusion_ratio, uniform_explosion
+from workbench.algo.explode import occlusion_ratio, uniform_explosion
 from workbench.data import CAR_DECK, shared_file
-from workbench.experiment.figures import save_image_grid
+from workbench.experiment.figures import save_animation, save_image_grid, with_progress_bar
 from workbench.experiment.measure import default_camera
 from workbench.experiment.registry import experiment, main
-from workbench.experiment.tables import atomic_open, write_table
+from workbench.experiment.tables import write_table
 from workbench.gl import Framebuffer, GpuTimer, create_context, renderer
 from workbench.gl.camera import up_frame
 from workbench.paths import make_path
 from workbench.paths.exploded import exploded_camera
+from workbench.scene import generators
 from workbench.scene.mesh import FEMesh
 
 ANGLES = (0.0, 20.0, 40.0, 60.0, 75.0, 85.0)
@@ -84,33 +85,9 @@ BAR_PX = 3
 
 
 # ---------------------------------------------------------------------------- scenes
-def _grid(origin, u, v, n):
-    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-    points = origin + (i[..., None] / n) * u + (j[..., None] / n) * v
-    index = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
-    quads = np.stack([index[:-1, :-1], index[1:, :-1], index[1:, 1:], index[:-1, 1:]], -1)
-    return points.reshape(-1, 3), quads.reshape(-1, 4)
-
-
-def _box_faces(lo, hi, n):
-    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    ex, ey, ez = np.diag(hi - lo)
-    return [_grid(o, u, v, n) for o, u, v in ((lo, ey, ez), (lo + ex, ey, ez), (lo, ex, ez),
-                                              (lo + ey, ex, ez), (lo, ex, ey), (lo + ez, ex, ey))]
-
-
 def box_scene() -> FEMesh:
-    """Panels 1..6 (x−, x+, y−, y+, z−, z+) of [−B, B]³ and part 7, the cube [−a, a]³."""
-    nodes, elements, parts, base = [], [], [], 0
-    b, a = BOX_HALF, FOCUS_HALF
-    faces = list(enumerate(_box_faces((-b,) * 3, (b,) * 3, 8), start=1))
-    faces += [(BOX_FOCUS, f) for f in _box_faces((-a,) * 3, (a,) * 3, 2)]
-    for pid, (points, quads) in faces:
-        nodes.append(points)
-        elements.append(quads + base)
-        parts += [pid] * len(quads)
-        base += len(points)
-    return FEMesh(np.concatenate(nodes), np.concatenate(elements), np.array(parts), name="box")
+    """Panels 1..6 of [−B, B]³ and part 7, the cube [−a, a]³ (:func:`box_in_box`)."""
+    return generators.box_in_box(BOX_HALF, FOCUS_HALF)
 
 
 def box_reveal_offset(theta_deg: float) -> float:
@@ -160,14 +137,6 @@ def _tinted(image) -> int:
     return int(((image[..., 0].astype(int) - image[..., 2].astype(int)) > 12).sum())
 
 
-def _with_bar(image, done, total):
-    frame = image[..., :3].copy()
-    width = frame.shape[1]
-    frame[-BAR_PX:, :] = 255
-    frame[-BAR_PX:, : max(1, round(width * done / total))] = (40, 40, 40)
-    return frame
-
-
 def animate(ctx, scene, focus, plane, camera, size, frames, keep_images=False):
     """Run the animation for ``frames`` frames; returns the per-frame record."""
     path = make_path("exploded", focus=focus, plane=plane, speed=1.0, dt=0.1)
@@ -192,7 +161,7 @@ def animate(ctx, scene, focus, plane, camera, size, frames, keep_images=False):
             rec["d_wall"].append((time.perf_counter() - start) * 1e3)
             rec["d_gpu"].append(timer.elapsed_ms)
             if keep_images:
-                rec["images"].append(_with_bar(fb.read(), i + 1, frames))
+                rec["images"].append(with_progress_bar(fb.read(), i + 1, frames, BAR_PX))
         fb.use()
         p_unocc, p_occ, _ = path.measure_occlusion()
         rec["final_r"] = occlusion_ratio(p_unocc, p_occ)
@@ -349,12 +318,7 @@ def figures(ctx, out_dir, label, scene, focus, plane, camera, size, frames):
     save_image_grid(out_dir / f"strip_{label}.png", [images[i] for i in pick],
                     [f"frame {i + 1}: r {rec['r'][i]:.2f} -> offset {rec['offset'][i]:.3g}"
                      for i in pick], columns=4)
-    from PIL import Image
-
-    pil = [Image.fromarray(np.ascontiguousarray(im)) for im in images]
-    with atomic_open(out_dir / f"{label}.gif", "wb") as fh:
-        pil[0].save(fh, format="GIF", save_all=True, append_images=pil[1:], duration=100,
-                    loop=0)
+    save_animation(out_dir / f"{label}.gif", images)
 
 
 def load_car(say):

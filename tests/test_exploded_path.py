@@ -10,39 +10,16 @@ from workbench.experiment.measure import default_camera
 from workbench.gl import Framebuffer
 from workbench.paths import make_path
 from workbench.paths.exploded import NO_PART, ExplodeStyle
+from workbench.scene.generators import box_in_box
 from workbench.scene.mesh import FEMesh
 
 SIZE = (240, 160)  # wider than the box: room beside it for the moved halves
 FOCUS = 7
 
 
-def _grid(origin, u, v, n):
-    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-    points = origin + (i[..., None] / n) * u + (j[..., None] / n) * v
-    index = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
-    quads = np.stack([index[:-1, :-1], index[1:, :-1], index[1:, 1:], index[:-1, 1:]], -1)
-    return points.reshape(-1, 3), quads.reshape(-1, 4)
-
-
-def _box_faces(lo, hi, n):
-    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    ex, ey, ez = np.diag(hi - lo)
-    return [_grid(o, u, v, n) for o, u, v in ((lo, ey, ez), (lo + ex, ey, ez), (lo, ex, ez),
-                                              (lo + ey, ex, ez), (lo, ex, ey), (lo + ez, ex, ey))]
-
-
 def box_scene() -> FEMesh:
-    """Panels 1..6 (x−, x+, y−, y+, z−, z+) of the cube [−1, 1]³ and part 7, the cube
-    [−0.2, 0.2]³ inside."""
-    nodes, elements, parts, base = [], [], [], 0
-    faces = [(pid, f) for pid, f in enumerate(_box_faces((-1, -1, -1), (1, 1, 1), 8), start=1)]
-    faces += [(FOCUS, f) for f in _box_faces((-0.2, -0.2, -0.2), (0.2, 0.2, 0.2), 2)]
-    for pid, (points, quads) in faces:
-        nodes.append(points)
-        elements.append(quads + base)
-        parts += [pid] * len(quads)
-        base += len(points)
-    return FEMesh(np.concatenate(nodes), np.concatenate(elements), np.array(parts), name="box")
+    """Panels 1..6 of the cube [−1, 1]³ and part 7, the cube [−0.2, 0.2]³ inside."""
+    return box_in_box(1.0, 0.2)
 
 
 @pytest.fixture(scope="module")

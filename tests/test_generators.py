@@ -443,3 +443,16 @@ def test_crash_sequence_keeps_still_parts_in_place():
     assert np.isclose(c.steps[-1, front, 2] - m.nodes[front, 2], 0.2 * np.ptp(z))
     with pytest.raises(MeshError):
         crash_sequence(m, still_parts=(0, 1))
+
+
+def test_box_in_box_hides_its_inner_part_in_a_closed_box():
+    from workbench.scene.generators import box_in_box
+
+    mesh = box_in_box(1.0, 0.2, n=4, inner_n=2)
+    assert sorted(np.unique(mesh.parts).tolist()) == [1, 2, 3, 4, 5, 6, 7]
+    assert (mesh.parts != 7).sum() == 6 * 16 and (mesh.parts == 7).sum() == 6 * 4
+    inner = mesh.nodes[np.unique(mesh.elements[mesh.parts == 7])]
+    outer = mesh.nodes[np.unique(mesh.elements[mesh.parts != 7])]
+    assert np.abs(inner).max() == pytest.approx(0.2) and np.abs(outer).max(axis=1).min() == 1.0
+    with pytest.raises(ValueError, match="below box_half"):
+        box_in_box(1.0, 1.0)

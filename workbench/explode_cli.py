@@ -59,17 +59,8 @@ def _progress(frames: int):
     return bar, bar.write
 
 
-def _with_bar(image: np.ndarray, done: int, total: int) -> np.ndarray:
-    frame = image[..., :3].copy()
-    width = frame.shape[1]
-    frame[-BAR_PX:, :] = 255
-    frame[-BAR_PX:, : max(1, round(width * done / total))] = (40, 40, 40)
-    return frame
-
-
 def cmd_explode(args) -> int:
-    from PIL import Image
-
+    from .experiment.figures import save_animation, with_progress_bar
     from .experiment.measure import default_camera
     from .gl import Framebuffer, create_context
     from .paths import make_path
@@ -104,7 +95,7 @@ def cmd_explode(args) -> int:
                 r = path.step_animation()
                 fb.clear()
                 path.draw()
-                frames.append(_with_bar(fb.read(), i + 1, args.frames))
+                frames.append(with_progress_bar(fb.read(), i + 1, args.frames, BAR_PX))
                 write(f"frame {i + 1:>3}/{args.frames}: r {r:.3f}, offset {path.offset:.4g}, "
                       f"alpha {path.alpha:.3f}, occlusion {path.last_occlusion['wall_ms']:.2f} ms")
             if hasattr(steps, "close"):
@@ -115,11 +106,7 @@ def cmd_explode(args) -> int:
     finally:
         fb.release()
     out.parent.mkdir(parents=True, exist_ok=True)
-    images = [Image.fromarray(f) for f in frames]
-    if out.suffix.lower() == ".gif":
-        images[0].save(out, save_all=True, append_images=images[1:], duration=100, loop=0)
-    else:
-        Image.fromarray(np.concatenate(frames, axis=1)).save(out)
+    save_animation(out, frames)
     revealed = p_occ / p_unocc if p_unocc else 0.0
     print(f"{out}: {len(frames)} frames of {scene.name}, focus part {args.focus}")
     print(f"revealed {revealed:.3g} after {len(frames)} frames, offset {offset:.3g} of "

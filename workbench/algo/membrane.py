@@ -49,6 +49,8 @@ non-positive or non-finite modulus, a Poisson's ratio outside (−1, ½].
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..scene.mesh import FEMesh
@@ -233,17 +235,5 @@ def with_membrane_stress(mesh: FEMesh, *, reference_step: int = 0, young: float 
     fields = dict(mesh.element_fields)
     for c, name in enumerate(STRESS_FIELDS):
         fields[name] = values[:, c].copy() if mesh.steps is not None else values[0, c].copy()
-    return FEMesh(
-        nodes=mesh.nodes,
-        elements=mesh.elements,
-        parts=mesh.parts,
-        steps=mesh.steps,
-        node_fields=dict(mesh.node_fields),
-        element_fields=fields,
-        part_names=dict(mesh.part_names),
-        times=mesh.times,
-        node_ids=mesh.node_ids,
-        element_ids=mesh.element_ids,
-        name=mesh.name,
-        units=mesh.units,
-    )
+    return dataclasses.replace(mesh, node_fields=dict(mesh.node_fields), element_fields=fields,
+                               part_names=dict(mesh.part_names))

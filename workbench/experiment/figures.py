@@ -48,6 +48,38 @@ def save_png(path, image) -> Path:
     return atomic_write_bytes(path, buffer.getvalue())
 
 
+def with_progress_bar(image, done: int, total: int, height: int = 3) -> np.ndarray:
+    """(H, W, 3) uint8 copy of ``image`` with a bar along its bottom ``height`` rows, dark over
+    the share ``done / total`` of the width: it marks an animation's frames apart (GIF writers
+    merge identical consecutive frames)."""
+    frame = _check_image(image)[..., :3].copy()
+    width = frame.shape[1]
+    frame[-height:, :] = 255
+    frame[-height:, : max(1, round(width * done / total))] = (40, 40, 40)
+    return frame
+
+
+def save_animation(path, frames: Sequence, duration_ms: int = 100) -> Path:
+    """Write uint8 (H, W, 3|4) ``frames`` (all of one size) atomically: an animated GIF (one
+    frame every ``duration_ms``, looping) for a ``.gif`` path, else the frames side by side as a
+    PNG strip. Refuses no frames and frames of different sizes."""
+    from PIL import Image
+
+    frames = [_rgba(_check_image(f))[..., :3] for f in frames]
+    if not frames:
+        raise ValueError("no frames to write")
+    if any(f.shape != frames[0].shape for f in frames):
+        raise ValueError("animation frames differ in size")
+    path = Path(path)
+    if path.suffix.lower() != ".gif":
+        return save_png(path, np.concatenate(frames, axis=1))
+    images = [Image.fromarray(np.ascontiguousarray(f)) for f in frames]
+    buffer = io.BytesIO()
+    images[0].save(buffer, format="GIF", save_all=True, append_images=images[1:],
+                   duration=int(duration_ms), loop=0)
+    return atomic_write_bytes(path, buffer.getvalue())
+
+
 def _colormap(colormap):
     import matplotlib
     from matplotlib.colors import Colormap, ListedColormap
