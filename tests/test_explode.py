@@ -6,6 +6,9 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import settings as hypothesis_settings
+from hypothesis import strategies as st
 
 from workbench.algo.explode import (
     ExplodeSettings,
@@ -21,6 +24,7 @@ from workbench.algo.explode import (
     o_max_of,
     occlusion_ratio,
     point_sides,
+    release,
     reveal_offset,
     uniform_explosion,
 )
@@ -37,21 +41,28 @@ def box_points(lo, hi):
 # An inner box (the object) inside an outer box of diagonal o_max; a linear occlusion model
 # r(o) = max(0, 1 − o/o*) stands for the measured ratio, revealing the object at o*.
 O_MAX = math.sqrt(3.0)  # outer box [0, 1]^3
-SETTINGS = ExplodeSettings(o_max=O_MAX, speed=1.0, dt=0.1)
+SETTINGS = ExplodeSettings(o_max=O_MAX, speed=1.0, dt=0.1)  # ratio exponent 1/2
+THESIS = ExplodeSettings(o_max=O_MAX, speed=1.0, dt=0.1, ratio_exponent=1.0)
 
 
 def linear_r(offset, o_star):
     return max(0.0, 1.0 - offset / o_star)
 
 
-def run(o_star, frames, settings=SETTINGS):
-    state, offsets, ratios = ExplodeState(), [], []
+def run(o_star, frames, settings=SETTINGS, state=None):
+    state, offsets, ratios = state or ExplodeState(), [], []
     for _ in range(frames):
         r = linear_r(state.offset, o_star)
         ratios.append(r)
         state = next_state(state, r, settings)
         offsets.append(state.offset)
     return state, np.array(offsets), np.array(ratios)
+
+
+def frames_to_reveal(o_star, settings, limit=400):
+    _, _, ratios = run(o_star, limit, settings)
+    hit = np.flatnonzero(ratios <= 0.01)
+    return int(hit[0]) if len(hit) else None
 
 
 def test_box_in_box_scene_agrees_with_closed_form():
@@ -62,69 +73,110 @@ def test_box_in_box_scene_agrees_with_closed_form():
     assert reveal_offset(inner, plane, (-1, 0, 0)) == pytest.approx(0.2)
 
 
-@pytest.mark.parametrize("fraction", [0.05, 0.1, 0.2, 0.3, 0.4])
-def test_reveals_within_30_frames_up_to_four_tenths_of_o_max(fraction):
-    # achievable at s_u = 1, dt = 0.1: r <= 0.01 within 30 frames for o* <= 0.4 o_max
-    # (25 frames at 0.4); 0.45 o_max needs 31 and 0.5 o_max 37 (next test)
-    o_star = fraction * O_MAX
-    _, offsets, ratios = run(o_star, 30)
-    assert ratios.min() <= 0.01 or linear_r(offsets[-1], o_star) <= 0.01
+def test_thesis_ratio_reveals_within_30_frames_up_to_four_tenths_of_o_max():
+    # s_u = 1, dt = 0.1, speed ∝ r: o* = 0.4 o_max takes 25 frames, 0.5 o_max 37
+    for fraction in (0.05, 0.1, 0.2, 0.3, 0.4):
+        assert frames_to_reveal(fraction * O_MAX, THESIS) <= 30
+    assert 30 < frames_to_reveal(0.5 * O_MAX, THESIS) <= 40
 
 
-def test_half_o_max_reveals_within_40_frames_not_30():
-    o_star = 0.5 * O_MAX
-    _, offsets, _ = run(o_star, 40)
-    r = np.array([linear_r(o, o_star) for o in offsets])
-    first = int(np.argmax(r <= 0.01))
-    assert r[first] <= 0.01 and 30 <= first + 1 <= 40
+def test_square_root_ratio_reveals_faster():
+    # speed ∝ √r arrives in finitely many frames: o* = 0.66 o_max within 30 frames
+    for fraction in (0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.66):
+        assert frames_to_reveal(fraction * O_MAX, SETTINGS) <= 30
+    for fraction in (0.2, 0.4, 0.6, 0.8, 0.9):
+        assert frames_to_reveal(fraction * O_MAX, SETTINGS) < frames_to_reveal(fraction * O_MAX,
+                                                                               THESIS)
+
+
+def check_converges_monotonically(o_star, settings, frames=400):
+    """Monotone, no step longer than s_u·dt·o_max, never past o_max, never more than one step
+    past o*, and held from the first frame at or beyond o*; returns the final state."""
+    state, offsets, ratios = run(o_star, frames, settings)
+    steps = np.diff(np.concatenate([[0.0], offsets]))
+    assert (steps >= 0.0).all()  # monotone: never moves back
+    assert steps.max() <= settings.max_step * (1 + 1e-12)
+    assert offsets.max() <= min(settings.o_max, o_star + settings.max_step)
+    past = np.flatnonzero(offsets >= o_star)
+    if len(past):
+        assert (offsets[past[0]:] == offsets[past[0]]).all()
+    return state, offsets
 
 
 @pytest.mark.parametrize("fraction", [0.02, 0.05, 0.1, 0.3, 0.5, 0.8])
-def test_never_exceeds_o_max_then_stays_within_one_step(fraction):
+def test_converges_monotonically_and_halts_within_one_step(fraction):
     o_star = fraction * O_MAX
-    _, offsets, _ = run(o_star, 400)
-    assert offsets.max() <= O_MAX and offsets.min() >= 0.0
-    tail = offsets[200:]
-    assert np.abs(tail - o_star).max() <= SETTINGS.max_step
-    # every single step is at most speed·dt·o_max
-    assert np.abs(np.diff(offsets)).max() <= SETTINGS.max_step + 1e-15
+    state, offsets = check_converges_monotonically(o_star, SETTINGS)
+    assert state.phase == "hold" and state.ideal == state.offset
+    assert o_star <= offsets[-1] <= o_star + SETTINGS.max_step
+    # the thesis's r-proportional speed approaches o* from below without arriving, unless a
+    # step from far below carries it past
+    state, offsets = check_converges_monotonically(o_star, THESIS, frames=1000)
+    if state.phase == "hold":
+        assert o_star <= offsets[-1] <= o_star + THESIS.max_step
+    else:
+        assert 0.0 <= o_star - offsets[-1] <= 1e-3 * o_star
 
 
-def test_overshooting_steps_oscillate_around_reveal_offset():
-    o_star = 0.03 * O_MAX  # one step from 0 carries the halves well past o*
-    _, offsets, ratios = run(o_star, 200)
-    tail = offsets[100:]
-    assert (tail > o_star).any() and (tail < o_star).any()
-    assert (ratios[100:] == 0).any() and (ratios[100:] > 0).any()
+@hypothesis_settings(max_examples=60, deadline=None)
+@given(fraction=st.floats(0.001, 1.5), exponent=st.floats(0.05, 1.0),
+       speed_dt=st.floats(0.01, 1.0))
+def test_converges_monotonically_property(fraction, exponent, speed_dt):
+    s = ExplodeSettings(o_max=O_MAX, speed=speed_dt / 0.1, dt=0.1, ratio_exponent=exponent)
+    check_converges_monotonically(fraction * O_MAX, s)
+
+
+def test_released_explosion_shrinks_back_to_the_reveal_offset():
+    o_big, o_star = 0.9 * O_MAX, 0.3 * O_MAX
+    held = ExplodeState(offset=o_big, ideal=o_big, phase="hold")
+    assert next_state(held, 0.0, SETTINGS).offset == o_big  # held: stays while revealed
+    state = release(held)
+    assert state.phase == "collapse" and state.offset == o_big
+    state, offsets, _ = run(o_star, 300, state=state)
+    assert offsets[0] == pytest.approx(0.9 * o_big)  # collapses at s_u·offset
+    assert offsets.min() < o_star  # until the object is occluded again ...
+    assert state.phase == "hold" and o_star <= state.offset <= o_star + SETTINGS.max_step
 
 
 def test_visible_focus_never_explodes():
     state = ExplodeState()
     for _ in range(50):
         state = next_state(state, 0.0, SETTINGS)
-        assert state.offset == 0.0 and state.ideal == 0.0
+        assert state.offset == 0.0 and state.ideal == 0.0 and state.phase == "collapse"
     assert state.frame == 50
 
 
-def test_enclosed_focus_approaches_o_max_monotonically():
+@pytest.mark.parametrize("settings", [SETTINGS, THESIS], ids=["sqrt", "thesis"])
+def test_enclosed_focus_approaches_o_max_monotonically(settings):
     state, offsets = ExplodeState(), []
     for _ in range(200):
-        state = next_state(state, 1.0, SETTINGS)
+        state = next_state(state, 1.0, settings)
         offsets.append(state.offset)
-        assert state.ideal == O_MAX
+        assert state.ideal == O_MAX and state.phase == "grow"
     offsets = np.array(offsets)
     assert (np.diff(offsets) > 0).all()
     assert offsets.max() <= O_MAX and offsets[-1] == pytest.approx(O_MAX, rel=1e-6)
 
 
-def test_revealed_collapses_toward_zero():
-    state = ExplodeState(offset=1.0, ideal=O_MAX)
-    nxt = next_state(state, 0.0, SETTINGS)
+def test_revealed_halts_or_collapses():
+    growing = ExplodeState(offset=1.0, ideal=O_MAX, phase="grow")
+    held = next_state(growing, 0.0, SETTINGS)
+    assert held.offset == 1.0 and held.ideal == 1.0 and held.phase == "hold"
+    resting = ExplodeState(offset=1.0)
+    nxt = next_state(resting, 0.0, SETTINGS)
     assert nxt.offset == pytest.approx(0.9) and nxt.ideal == 0.0
     # revealed_below: r at or below it counts as revealed
     s = ExplodeSettings(o_max=O_MAX, revealed_below=0.05)
-    assert next_state(state, 0.05, s).offset == pytest.approx(0.9)
-    assert next_state(state, 0.06, s).offset > 1.0
+    assert next_state(resting, 0.05, s).offset == pytest.approx(0.9)
+    assert next_state(resting, 0.06, s).offset > 1.0
+    assert next_state(growing, 0.05, s).offset == 1.0
+
+
+def test_growth_speed_follows_the_ratio_exponent():
+    state = ExplodeState(offset=0.0)
+    for p in (1.0, 0.5, 0.25):
+        s = ExplodeSettings(o_max=2.0, speed=1.0, dt=0.1, ratio_exponent=p)
+        assert next_state(state, 0.25, s).offset == pytest.approx(0.1 * 2.0 * 0.25 ** p)
 
 
 def test_offset_clipped_to_range():
@@ -297,10 +349,17 @@ def test_uniform_explosion_same_distance():
     ({"o_max": 1.0, "dt": -0.1}, "dt"),
     ({"o_max": 1.0, "ghost_start": 1.0}, "ghost_start"),
     ({"o_max": 1.0, "revealed_below": 1.0}, "revealed_below"),
+    ({"o_max": 1.0, "ratio_exponent": 0.0}, "ratio_exponent"),
+    ({"o_max": 1.0, "ratio_exponent": 1.5}, "ratio_exponent"),
 ])
 def test_settings_refused(kwargs, match):
     with pytest.raises(ValueError, match=match):
         ExplodeSettings(**kwargs)
+
+
+def test_unknown_phase_refused():
+    with pytest.raises(ValueError, match="phase"):
+        ExplodeState(phase="explode")
 
 
 @pytest.mark.parametrize("r", [-0.1, 1.1, float("nan")])

@@ -5,11 +5,12 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from workbench.algo.explode import cull_back_faces
 from workbench.cli import main
 from workbench.experiment.measure import default_camera
 from workbench.gl import Framebuffer
 from workbench.paths import make_path
-from workbench.paths.exploded import NO_PART, ExplodeStyle
+from workbench.paths.exploded import NO_PART, ExplodeStyle, exploded_camera
 from workbench.scene.generators import box_in_box
 from workbench.scene.mesh import FEMesh
 
@@ -94,20 +95,97 @@ def test_pick_after_explosion(prepared, mesh):
     assert ids[by, bx] == 3 and ids[cy, cx] == FOCUS and ids[2, 2] == NO_PART
 
 
-def test_animation_reveals_within_30_frames(prepared):
-    path, fb, _ = prepared
+def test_animation_reveals_within_30_frames_and_holds(prepared):
+    path, fb, camera = prepared
     o_max = path.settings.o_max
-    ratios, offsets = [], []
+    ratios, offsets, in_frame = [], [], []
     for _ in range(30):
+        _draw(path, fb)  # counts the focus as it draws
         ratios.append(path.step_animation())
+        in_frame.append(path.last_occlusion["in_frame"])
         offsets.append(path.offset)
-        _draw(path, fb)
+    assert all(in_frame)
     assert ratios[0] > 0.99  # hidden at the start
     assert max(offsets) <= o_max and min(offsets) > 0
+    assert (np.diff(offsets) >= 0).all()  # monotone
     assert min(ratios[1:]) <= 0.01
-    final = path.occlusion_ratio()
-    assert final <= 0.2  # near the reveal offset: at most a sliver covered again
+    # halted once revealed: the offset stays and the focus stays fully visible
+    assert path.state.phase == "hold" and offsets[-1] == offsets[-2]
+    assert path.occlusion_ratio() == 0.0
     assert path.state.frame == 30
+    path.set_camera(camera)  # a new view releases the hold
+    assert path.state.phase == "collapse" and path.offset == offsets[-1]
+
+
+# the eye on the split plane, well on its + side, and nearly along the normal on its − side
+# (where the ghosted front half's culled back faces lie between the eye and the focus)
+VIEWS = [(0.0, 0.0), (30.0, 10.0), (-85.0, 0.0)]
+
+
+@pytest.mark.parametrize("view", VIEWS)
+@pytest.mark.parametrize("offset, alpha", [(0.0, 1.0), (0.1, 1.0), (0.15, 0.6), (1.5, 0.5),
+                                           (3.0, 0.52)])
+def test_in_frame_count_equals_the_separate_pass(prepared, mesh, view, offset, alpha):
+    path, fb, _ = prepared
+    path.set_camera(exploded_camera(default_camera(mesh, SIZE, view=view), mesh))
+    path.set_offset(offset, alpha)
+    expected = path.measure_occlusion()[:2]
+    path.count_in_draw = False
+    plain = _draw(path, fb)
+    path.count_in_draw = True
+    counted = _draw(path, fb)
+    assert (counted == plain).all()  # counting writes no colour
+    path.step_animation()
+    assert path.last_occlusion["in_frame"]
+    assert (path.last_occlusion["p_unocc"], path.last_occlusion["p_occ"]) == expected
+
+
+@pytest.mark.parametrize("offset", [0.1, 0.3])
+def test_in_frame_count_restores_culled_back_faces(ctx, mesh, offset):
+    # panels wound inwards: from the (30, 10) view the ghosted front half shows the camera its
+    # back faces, which it culls; the count must still see them as the separate pass does
+    # (without their depth it counts all 944 pixels of the focus as visible, not 0 and 50)
+    inward = FEMesh(mesh.nodes, mesh.elements[:, ::-1], mesh.parts, name="inward box")
+    camera = default_camera(inward, SIZE, view=VIEWS[1])
+    path = make_path("exploded", focus=FOCUS, plane="x")
+    fb = Framebuffer(ctx, SIZE)
+    try:
+        path.prepare(ctx, inward, camera)
+        fb.use()
+        path.set_offset(offset, 0.5)
+        assert cull_back_faces(path.plane, path.offset, path.eye, path.front_side())
+        expected = path.measure_occlusion()[:2]
+        _draw(path, fb)
+        path.step_animation()
+        assert path.last_occlusion["in_frame"]
+        assert (path.last_occlusion["p_unocc"], path.last_occlusion["p_occ"]) == expected
+    finally:
+        fb.release()
+        path.release()
+
+
+def test_stale_or_multisampled_frames_use_the_separate_pass(ctx, prepared, mesh):
+    path, fb, _ = prepared
+    path.set_offset(0.1)
+    _draw(path, fb)
+    path.set_offset(0.12)  # drawn at another offset: the frame's count is not used
+    expected = path.measure_occlusion()[:2]
+    path.step_animation()
+    assert not path.last_occlusion["in_frame"]
+    assert (path.last_occlusion["p_unocc"], path.last_occlusion["p_occ"]) == expected
+    msaa = Framebuffer(ctx, SIZE, samples=4)
+    try:
+        msaa.use()
+        path.set_offset(0.1)
+        expected = path.measure_occlusion()[:2]
+        msaa.clear()
+        path.draw()
+        path.step_animation()
+        assert not path.last_occlusion["in_frame"]
+        assert (path.last_occlusion["p_unocc"], path.last_occlusion["p_occ"]) == expected
+    finally:
+        msaa.release()
+        fb.use()
 
 
 def test_ghosted_front_half_is_translucent(prepared):
@@ -162,6 +240,11 @@ def test_cli_refuses_missing_part(ctx, mesh, tmp_path, capsys):
     assert status == 2 and len(err) == 1
     assert "no part 9" in err[0] and "[1, 2, 3, 4, 5, 6, 7]" in err[0]
     assert not (tmp_path / "x.gif").exists()
+    status = main(["explode", str(deck), "--focus", "7", "--ratio-exponent", "2",
+                   "-o", str(tmp_path / "x.gif")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "ratio_exponent must be in (0, 1]" in err[0]
+    assert not (tmp_path / "x.gif").exists()
 
 
 def test_refusals(ctx, mesh):
@@ -177,6 +260,9 @@ def test_refusals(ctx, mesh):
         with pytest.raises(ValueError, match="plane must be"):
             ExplodeStyle(focus=FOCUS, plane=bad)
     assert ExplodeStyle(focus=FOCUS, plane=" 1, 0 ,0").plane == "1,0,0"
+    for bad in (0.0, 1.5, float("nan")):
+        with pytest.raises(ValueError, match="ratio_exponent"):
+            ExplodeStyle(focus=FOCUS, ratio_exponent=bad)
 
 
 def test_automatic_plane_follows_the_camera(ctx, mesh):

@@ -1,9 +1,11 @@
 """GL layer: context, framebuffer read-back, queries and the float64-origin camera."""
 
+import moderngl
 import numpy as np
 import pytest
 
-from workbench.gl import Camera, Framebuffer, GpuTimer, SamplesPassed, create_context, renderer
+from workbench.gl import (Camera, Framebuffer, GpuTimer, SamplesPassed, create_context, renderer,
+                          write_masks)
 
 VERT = """#version 330
 uniform mat4 mvp;
@@ -179,3 +181,36 @@ def test_releasing_a_bound_framebuffer_leaves_no_gl_error(ctx):
         fb.release()
         Framebuffer(ctx, (16, 16)).release()
         assert ctx.error == "GL_NO_ERROR"
+
+
+def test_write_masks_stop_colour_and_depth_writes_and_restore_them(ctx):
+    prog = ctx.program(
+        vertex_shader="#version 330\nin vec2 p; uniform float z;\n"
+                      "void main() { gl_Position = vec4(p, z, 1.0); }",
+        fragment_shader="#version 330\nuniform vec3 col; out vec4 c;\n"
+                        "void main() { c = vec4(col, 1.0); }")
+    vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], "f4").tobytes())
+    vao = ctx.vertex_array(prog, [(vbo, "2f", "p")])
+    fb = Framebuffer(ctx, (8, 6))
+    fb.clear()
+    ctx.viewport = (0, 0, 4, 3)  # a sub-viewport survives the masks
+
+    def fill(z, col):
+        prog["z"].value, prog["col"].value = z, col
+        vao.render()
+
+    ctx.enable_only(moderngl.DEPTH_TEST)
+    with write_masks(ctx, color=False, depth=True):
+        fill(0.0, (1.0, 0.0, 0.0))  # depth 0.5 written, no colour
+        assert ctx.viewport == (0, 0, 4, 3)
+    assert (fb.read()[..., :3] == 255).all()
+    fill(0.5, (0.0, 1.0, 0.0))  # behind the invisible quad: fails the depth test
+    assert (fb.read()[..., :3] == 255).all()
+    with write_masks(ctx, color=True, depth=False):
+        fill(-0.5, (0.0, 0.0, 1.0))  # in front: drawn, its depth not kept
+    fill(-0.25, (1.0, 0.0, 0.0))  # between: passes because the blue quad left no depth
+    image = fb.read()
+    assert (image[-3:, :4, :3] == (255, 0, 0)).all()  # row 0 at the top: the viewport's rows
+    assert (image[:3, :, :3] == 255).all() and (image[:, 4:, :3] == 255).all()
+    assert fb.fbo.color_mask == (True,) * 4 and fb.fbo.depth_mask
+    fb.release()

@@ -11,12 +11,21 @@ half's opacity, its culling, and chooses split planes.
   object is fully visible and 1 when it is fully hidden (:func:`occlusion_ratio`).
 * **Dynamics** (:func:`next_state`, eq. 2.2 with the dynamic ratio). While the object is
   occluded (``r > revealed_below``) the ideal offset is ``o_max`` and the offset moves toward it
-  at ``s = s_u·(o_max − offset)·r``; while it is revealed the ideal offset is 0 and the offset
-  collapses at ``s = s_u·(0 − offset)``. One frame adds ``s·dt``; the offset stays in
-  ``[0, o_max]``. The offset therefore rises until the object is just revealed and, where a
-  step overshoots the reveal offset, collapses back a little: near the reveal offset it
-  settles into a small oscillation, within one step of it (no step is longer than
-  ``s_u·dt·o_max``).
+  at ``s = s_u·(o_max − offset)·r^p``; ``p = 1`` is the thesis's ratio, the default is 1/2
+  (below). One frame adds
+  ``s·dt``; the offset stays in ``[0, o_max]``. The first frame that finds the object revealed
+  halts the movement and makes the current offset the ideal one (the thesis's "setting the
+  current offset as the ideal offset"): from rest the offset therefore rises monotonically and
+  stops within one step of the reveal offset (no step is longer than ``s_u·dt·o_max``). A
+  released state (:func:`release`, after the view or the plane changed) collapses toward 0 at
+  ``s = s_u·(0 − offset)`` while the object stays revealed, and grows again once it is
+  occluded.
+* **Ratio exponent** ``p`` (beyond the thesis). Where the halves slide off the object at a
+  steady rate, ``r`` falls linearly to 0 at the reveal offset ``o*``; a speed proportional to
+  ``r`` then approaches ``o*`` only exponentially (``o* − offset`` shrinks by a constant factor
+  per frame), so the last percent of the object takes most of the frames. With ``p < 1`` the
+  speed falls as ``(o* − offset)^p`` and the offset arrives in a finite number of frames
+  (``p = 1/2``: ``o' = c·√(o* − o)`` reaches ``o*`` at ``2·√(o*)/c``), still decelerating.
 * **Maximum offset.** ``o_max`` is the assembly's bounding-box diagonal (:func:`o_max_of`), so
   the halves never separate by more than twice the assembly's diameter.
 * **Ghosting** (:func:`ghost_alpha`, eq. 2.3). Above ``ghost_start·o_max`` the front half fades
@@ -131,7 +140,9 @@ class ExplodeSettings:
     ``speed``: ``s_u`` of eq. 2.2 (per second, ≥ 0). ``dt``: seconds per frame (≥ 0).
     ``ghost_start``: fraction of ``o_max`` above which the front half fades (0.7 in the thesis;
     in [0, 1)). ``revealed_below``: ``r`` at or below which the object counts as fully revealed
-    (in [0, 1)). Anything else is refused.
+    (in [0, 1)). ``ratio_exponent``: ``p`` in the growth speed ``s_u·Δoffset·r^p`` (in (0, 1];
+    1 is the thesis, the default 0.5 arrives in finitely many frames). Anything else is
+    refused.
     """
 
     o_max: float
@@ -139,6 +150,7 @@ class ExplodeSettings:
     dt: float = 0.1
     ghost_start: float = 0.7
     revealed_below: float = 0.0
+    ratio_exponent: float = 0.5
 
     def __post_init__(self) -> None:
         o_max = _scalar(self.o_max, "o_max")
@@ -152,6 +164,8 @@ class ExplodeSettings:
             raise ValueError(f"ghost_start must be in [0, 1), got {self.ghost_start}")
         if not 0.0 <= _scalar(self.revealed_below, "revealed_below") < 1.0:
             raise ValueError(f"revealed_below must be in [0, 1), got {self.revealed_below}")
+        if not 0.0 < _scalar(self.ratio_exponent, "ratio_exponent") <= 1.0:
+            raise ValueError(f"ratio_exponent must be in (0, 1], got {self.ratio_exponent}")
 
     @property
     def max_step(self) -> float:
@@ -159,15 +173,27 @@ class ExplodeSettings:
         return self.speed * self.dt * self.o_max
 
 
+PHASES = ("collapse", "grow", "hold")
+
+
 @dataclass(frozen=True)
 class ExplodeState:
     """The animation state: current ``offset`` of each half (model units), the ``ideal``
-    offset it moves toward (``o_max`` while occluded, 0 while revealed) and the ``frame``
-    count."""
+    offset it moves toward, the ``phase`` and the ``frame`` count.
+
+    ``phase``: ``"grow"`` while the object is occluded (ideal ``o_max``), ``"hold"`` once a
+    growing explosion has revealed it (ideal = the held offset), ``"collapse"`` at rest or after
+    :func:`release` (ideal 0 while revealed). An unknown phase is refused.
+    """
 
     offset: float = 0.0
     ideal: float = 0.0
     frame: int = 0
+    phase: str = "collapse"
+
+    def __post_init__(self) -> None:
+        if self.phase not in PHASES:
+            raise ValueError(f"phase must be one of {PHASES}, got {self.phase!r}")
 
 
 # ---------------------------------------------------------------------------- dynamics
@@ -188,28 +214,38 @@ def occlusion_ratio(p_unoccluded, p_occluded) -> float:
 def next_state(state: ExplodeState, r, settings: ExplodeSettings) -> ExplodeState:
     """The state one frame later given this frame's occlusion ratio ``r`` in [0, 1].
 
-    Occluded (``r > revealed_below``): ideal = ``o_max``, ``s = speed·(o_max − offset)·r``.
-    Revealed: ideal = 0, ``s = speed·(0 − offset)`` (no factor ``r``, which is ~0 there).
+    Occluded (``r > revealed_below``): phase ``"grow"``, ideal ``o_max``,
+    ``s = speed·(o_max − offset)·r^p`` (``p`` = ``ratio_exponent``).
+    Revealed after growing or holding: phase ``"hold"``, the offset stays and becomes the ideal.
+    Revealed otherwise (at rest, or released): phase ``"collapse"``, ideal 0,
+    ``s = speed·(0 − offset)`` (no factor ``r``, which is ~0 there).
     The new offset is ``offset + s·dt`` clipped to ``[0, o_max]`` (an incoming offset outside
     that range, e.g. after ``o_max`` shrank, is clipped first); ``frame`` counts up by one.
 
-    With an occlusion that falls to 0 at a reveal offset ``o*`` the offset rises toward
-    ``o*`` ever more slowly (``r`` shrinks) and, when a step carries it past ``o*``, the
-    object is revealed and the offset collapses back a little: it settles into a small
-    oscillation within one step (``speed·dt·o_max`` at most) of ``o*``. If the object is
-    never revealed the offset approaches ``o_max`` monotonically (for ``speed·dt ≤ 1``).
-    ``r`` outside [0, 1] or NaN is refused.
+    With an occlusion that falls to 0 at a reveal offset ``o*`` the offset rises monotonically
+    from rest and halts at the first revealing step, within one step (``speed·dt·o_max`` at
+    most) above ``o*``. If the object is never revealed the offset approaches ``o_max``
+    monotonically (for ``speed·dt ≤ 1``). ``r`` outside [0, 1] or NaN is refused.
     """
     rr = _ratio(r)
     offset = min(max(_scalar(state.offset, "offset"), 0.0), settings.o_max)
+    frame = int(state.frame) + 1
     if rr > settings.revealed_below:
-        ideal = settings.o_max
-        s = settings.speed * (ideal - offset) * rr
-    else:
-        ideal = 0.0
-        s = settings.speed * (ideal - offset)
-    new = min(max(offset + s * settings.dt, 0.0), settings.o_max)
-    return ExplodeState(offset=float(new), ideal=float(ideal), frame=int(state.frame) + 1)
+        s = settings.speed * (settings.o_max - offset) * rr ** settings.ratio_exponent
+        new = min(max(offset + s * settings.dt, 0.0), settings.o_max)
+        return ExplodeState(offset=float(new), ideal=float(settings.o_max), frame=frame,
+                            phase="grow")
+    if state.phase in ("grow", "hold"):
+        return ExplodeState(offset=float(offset), ideal=float(offset), frame=frame, phase="hold")
+    new = min(max(offset - settings.speed * offset * settings.dt, 0.0), settings.o_max)
+    return ExplodeState(offset=float(new), ideal=0.0, frame=frame, phase="collapse")
+
+
+def release(state: ExplodeState) -> ExplodeState:
+    """``state`` set to collapse while the object stays revealed (phase ``"collapse"``, ideal
+    0): what a change of view or split plane calls for, so that an explosion larger than the
+    new view needs shrinks back until the object is just revealed again."""
+    return ExplodeState(offset=state.offset, ideal=0.0, frame=state.frame, phase="collapse")
 
 
 def ghost_alpha(offset, settings: ExplodeSettings, r=1.0) -> float:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 import moderngl
 import numpy as np
 
@@ -18,6 +20,29 @@ def sample_counts(ctx: moderngl.Context) -> tuple[int, ...]:
         counts.append(n)
         n *= 2
     return tuple(counts)
+
+
+@contextmanager
+def write_masks(ctx: moderngl.Context, color: bool = True, depth: bool = True):
+    """Within the block the bound framebuffer (``ctx.fbo``) writes colour and depth only as
+    asked; its previous masks and the viewport are restored after.
+
+    moderngl applies a framebuffer's colour mask when the framebuffer is bound, not when the
+    mask is set, so the framebuffer is bound again (keeping ``ctx.viewport``) after each change.
+    """
+    fbo, viewport = ctx.fbo, ctx.viewport
+    previous = fbo.color_mask, fbo.depth_mask
+
+    def apply(color_mask, depth_mask) -> None:
+        fbo.color_mask, fbo.depth_mask = color_mask, depth_mask
+        fbo.use()
+        ctx.viewport = viewport
+
+    apply((color,) * 4, depth)
+    try:
+        yield fbo
+    finally:
+        apply(*previous)
 
 
 class Framebuffer:

@@ -19,12 +19,23 @@ Beyond ``draw`` the path offers what the paper's interaction needs:
   (``p_unocc``) and the focus after both halves (``p_occ``). Each query draws the focus a second
   time with ``depth ≤`` over a depth-only pre-pass of the same geometry, so a count is the number
   of pixels where the focus is the nearest surface (no overdraw of its own back faces). The
-  focus never moves, so ``p_unocc`` is counted once per camera, step and image size and kept;
-  each frame then costs the ``p_occ`` pass only. Returns ``(p_unocc, p_occ, gpu_ms)``;
-  ``last_occlusion`` holds the GPU and wall times and whether ``p_unocc`` was counted anew.
+  focus never moves, so ``p_unocc`` is counted once per camera, step and image size and kept.
+  Returns ``(p_unocc, p_occ, gpu_ms)``; ``last_occlusion`` holds the counts, the GPU and wall
+  times, whether ``p_unocc`` was counted anew and whether ``p_occ`` came from the frame.
+* **Counting in the frame** (the thesis's "during the actual rendering"). With
+  ``count_in_draw`` on (the default), :meth:`ExplodedPath.draw` ends with the same ``depth ≤``
+  count of the focus over the frame it has just drawn, colour and depth writes off: that is
+  ``p_occ`` for the frame's offset at the cost of one more draw of the focus alone. A blended
+  front half writes depth like an opaque one, so a ghosted frame counts the same; where its
+  back faces were culled they are first drawn into the depth buffer alone (the frame's depth
+  buffer then holds the halves as the separate pass sees them). The result is read only by the
+  next :meth:`step_animation`. A multisampled framebuffer (samples, not pixels) is counted by
+  the separate pass instead.
 * :meth:`ExplodedPath.step_animation` — ``r = (p_unocc − p_occ)/p_unocc`` (0 when the focus is
-  off screen), then :func:`~workbench.algo.explode.next_state`; the offset and the ghosting
-  opacity (:func:`~workbench.algo.explode.ghost_alpha`) follow the new state.
+  off screen) from the last frame's count when that frame was drawn at the current state (the
+  separate pass otherwise), then :func:`~workbench.algo.explode.next_state`; the offset and the
+  ghosting opacity (:func:`~workbench.algo.explode.ghost_alpha`) follow the new state. A new
+  camera or offset releases a held explosion (:func:`~workbench.algo.explode.release`).
 * :meth:`ExplodedPath.pick` — colour picking: every part drawn with a second program writing
   its code (index in the sorted part ids + 1, 24 bits in RGB) with the geometry, offsets,
   clipping and culling of the drawn image, blending off, into the internal framebuffer; one
@@ -49,7 +60,7 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from ..gl import Framebuffer, GpuTimer, SamplesPassed, load_program
+from ..gl import Framebuffer, GpuTimer, SamplesPassed, load_program, write_masks
 from .base import MeshPath, Style
 
 AXES = ("x", "y", "z")
@@ -91,7 +102,8 @@ class ExplodeStyle(Style):
     half's distance from the plane), ``alpha`` (opacity of the front half), ``focus_color``,
     and the animation settings ``o_max`` (model units; None: the mesh's diameter by
     ``o_max_of``), ``speed`` (s_u), ``dt``, ``ghost_start`` (share of o_max where ghosting
-    starts) and ``reject_deg`` (the automatic plane's limit on normal·view)."""
+    starts), ``ratio_exponent`` (p in the growth speed s_u·Δoffset·r^p; 1 is the thesis,
+    default 0.5) and ``reject_deg`` (the automatic plane's limit on normal·view)."""
 
     focus: int | None = None
     plane: str = "auto"
@@ -102,6 +114,7 @@ class ExplodeStyle(Style):
     speed: float = 1.0
     dt: float = 0.1
     ghost_start: float = 0.7
+    ratio_exponent: float = 0.5
     reject_deg: float = 20.0
 
     def __post_init__(self) -> None:
@@ -124,6 +137,8 @@ class ExplodeStyle(Style):
             setattr(self, name, value)
         if not 0.0 <= float(self.ghost_start) < 1.0:
             raise ValueError(f"ghost_start must be in [0, 1), got {self.ghost_start}")
+        if not 0.0 < float(self.ratio_exponent) <= 1.0:
+            raise ValueError(f"ratio_exponent must be in (0, 1], got {self.ratio_exponent}")
         if self.strips != "none" or self.quad_diagonal == "strip":
             raise ValueError("the exploded path draws a triangle list: strips='none' and "
                              "quad_diagonal 'auto' or 'shorter'")
@@ -152,6 +167,8 @@ class ExplodedPath(MeshPath):
         self.offset, self.alpha = self.style.offset, self.style.alpha
         self.last_r: float | None = None
         self.last_occlusion: dict = {}
+        self.count_in_draw = True
+        self._frame_count: dict | None = None
 
     # ------------------------------------------------------------------ prepare
     def _check_scene(self, mesh) -> None:
@@ -196,7 +213,8 @@ class ExplodedPath(MeshPath):
         self._choose_plane(camera)
         o_max = style.o_max if style.o_max is not None else float(algo.o_max_of(mesh))
         self.settings = algo.ExplodeSettings(o_max=o_max, speed=style.speed, dt=style.dt,
-                                             ghost_start=style.ghost_start)
+                                             ghost_start=style.ghost_start,
+                                             ratio_exponent=style.ratio_exponent)
         self.state = algo.ExplodeState(offset=style.offset)
         self.offset, self.alpha = style.offset, style.alpha
         super()._build(ctx, mesh, camera)
@@ -207,6 +225,9 @@ class ExplodedPath(MeshPath):
             self._pick_program, [(self._positions, "3f", "position")], self._index,
             index_element_size=4))
         self._set_clip_planes()
+        self._alone, self._behind, self._in_frame = (SamplesPassed(ctx), SamplesPassed(ctx),
+                                                     SamplesPassed(ctx))
+        self._timer = GpuTimer(ctx)
         self.set_camera(camera)
 
     def _choose_plane(self, camera) -> None:
@@ -238,6 +259,9 @@ class ExplodedPath(MeshPath):
             self._choose_plane(camera)
         self._upload_plane()
         self._unoccluded = {}  # p_unocc per image size, for this camera and step
+        self._frame_count = None
+        if hasattr(self, "state"):  # a new view: a held explosion may shrink again
+            self.state = _explode().release(self.state)
         eye = self.origin + np.asarray(camera.eye, np.float64)  # world space, float64
         if camera.projection == "orthographic":  # parallel rays: an eye far back along them
             view = np.asarray(camera.target, np.float64) - np.asarray(camera.eye, np.float64)
@@ -254,9 +278,10 @@ class ExplodedPath(MeshPath):
         if not 0.0 < alpha <= 1.0:
             raise ValueError(f"alpha must be in (0, 1], got {alpha}")
         self.offset, self.alpha = offset, alpha
+        self._frame_count = None
         if hasattr(self, "state"):
-            self.state = _explode().ExplodeState(offset=offset, ideal=self.state.ideal,
-                                                 frame=self.state.frame)
+            self.state = _explode().release(
+                _explode().ExplodeState(offset=offset, frame=self.state.frame))
 
     def front_side(self) -> int:
         """+1 if the half moved along +normal is in front of the focus, else −1."""
@@ -325,6 +350,37 @@ class ExplodedPath(MeshPath):
     def draw(self) -> None:
         self._require_prepared()
         self._pass(self._program, self._vao)
+        self._frame_count = self._count_in_frame() if self.count_in_draw else None
+
+    def _count_in_frame(self) -> dict | None:
+        """Issue the in-frame ``p_occ`` query over what :meth:`draw` just drew (see the module
+        docstring); None in a multisampled framebuffer."""
+        ctx = self.ctx
+        fbo = ctx.fbo
+        attachments = list(fbo.color_attachments) + [fbo.depth_attachment]
+        if any(getattr(a, "samples", 0) for a in attachments if a):
+            return None
+        program, vao = self._program, self._vao
+        front = self.front_side()
+        with write_masks(ctx, color=False, depth=True):
+            if self.alpha < 1.0 and self._cull(front):  # depth of the culled back faces
+                ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
+                with self._clip_distances(len(self.style.clip_planes) + 1):
+                    ctx.enable_only(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+                    ctx.front_face, ctx.cull_face = "ccw", "front"
+                    self._half(program, front)
+                    self._range(vao, self._rest_range)
+                ctx.enable_only(moderngl.DEPTH_TEST)
+                ctx.cull_face = "back"
+            with write_masks(ctx, color=False, depth=False):
+                ctx.depth_func = "<="
+                try:
+                    with self._in_frame:
+                        self._pass(program, vao, halves=False)
+                finally:
+                    ctx.depth_func = "<"
+        size = tuple(int(v) for v in ctx.viewport[2:])
+        return dict(key=(size, getattr(self, "step", None)), offset=self.offset)
 
     def draw_focus(self) -> None:
         """The focus part alone, as :meth:`draw` shows it."""
@@ -352,67 +408,99 @@ class ExplodedPath(MeshPath):
         fbo.use()
         self.ctx.viewport = viewport
 
+    def _count(self, fb: Framebuffer, query, halves: bool) -> None:
+        """One counting pass into ``fb`` (bound, colour writes off): the focus's
+        nearest-surface pixels, after both halves (opaque: ghosting does not count as
+        revealing) when ``halves``."""
+        ctx, program, vao = self.ctx, self._program, self._vao
+        fb.fbo.clear(depth=1.0)
+        ctx.depth_func = "<"
+        if halves:
+            alpha, self.alpha = self.alpha, 1.0
+            try:
+                self._pass(program, vao, focus=False)
+            finally:
+                self.alpha = alpha
+        self._pass(program, vao, halves=False)  # depth of the focus
+        with write_masks(ctx, color=False, depth=False):
+            ctx.depth_func = "<="
+            try:
+                with query:
+                    self._pass(program, vao, halves=False)
+            finally:
+                ctx.depth_func = "<"
+
+    def _counted(self, size, behind: bool) -> tuple[int | None, int | None, dict]:
+        """(p_unocc, p_occ, times): p_unocc from the cache or counted, p_occ counted when
+        ``behind`` (else None), in the internal framebuffer of ``size``."""
+        ctx = self.ctx
+        previous, viewport = ctx.fbo, ctx.viewport
+        fb = self._target(size)
+        key = (fb.size, getattr(self, "step", None))
+        counted = key not in self._unoccluded
+        start = time.perf_counter()
+        try:
+            fb.use()
+            with write_masks(ctx, color=False, depth=True), self._timer:
+                if counted:
+                    self._count(fb, self._alone, halves=False)
+                if behind:
+                    self._count(fb, self._behind, halves=True)
+            if counted:
+                self._unoccluded[key] = self._alone.samples
+            p_occ = self._behind.samples if behind else None
+            gpu_ms = self._timer.elapsed_ms
+        finally:
+            self._restore(previous, viewport)
+        wall_ms = (time.perf_counter() - start) * 1e3
+        return self._unoccluded[key], p_occ, dict(gpu_ms=gpu_ms, wall_ms=wall_ms,
+                                                  unoccluded_counted=counted)
+
     def measure_occlusion(self, size=None) -> tuple[int, int, float]:
         """(p_unocc, p_occ, gpu_ms): the focus's visible pixels drawn alone and drawn after both
         halves, counted by occlusion queries in the internal framebuffer (``size``, default the
         bound viewport's); the previously bound framebuffer and viewport are restored."""
         self._require_prepared()
-        ctx = self.ctx
-        previous, viewport = ctx.fbo, ctx.viewport
-        fb = self._target(size)
-        program, vao = self._program, self._vao
-        alone, behind, timer = SamplesPassed(ctx), SamplesPassed(ctx), GpuTimer(ctx)
-        cache = getattr(self, "_unoccluded", {})
-        key = (fb.size, getattr(self, "step", None))
-        passes = ((behind, True),) if key in cache else ((alone, False), (behind, True))
+        p_unocc, p_occ, times = self._counted(size, behind=True)
+        self.last_occlusion = dict(p_unocc=p_unocc, p_occ=p_occ, in_frame=False, **times)
+        return p_unocc, p_occ, times["gpu_ms"]
+
+    def _frame_occlusion(self, size) -> tuple[int, int] | None:
+        """(p_unocc, p_occ) from the last frame's own count, None where there is none for the
+        current state and ``size``."""
+        frame, self._frame_count = self._frame_count, None
+        if frame is None or frame["offset"] != self.offset:
+            return None
+        frame_size, step = frame["key"]
+        if step != getattr(self, "step", None) or (size is not None and
+                                                    tuple(int(v) for v in size) != frame_size):
+            return None
         start = time.perf_counter()
-        try:
-            fb.use()
-            fb.fbo.color_mask = (False, False, False, False)
-            with timer:
-                for query, halves in passes:
-                    fb.fbo.depth_mask = True
-                    fb.fbo.clear(depth=1.0)
-                    ctx.depth_func = "<"
-                    if halves:  # both halves opaque: ghosting does not count as revealing
-                        alpha, self.alpha = self.alpha, 1.0
-                        try:
-                            self._pass(program, vao, focus=False)
-                        finally:
-                            self.alpha = alpha
-                    self._pass(program, vao, halves=False)  # depth of the focus
-                    ctx.depth_func = "<="
-                    fb.fbo.depth_mask = False
-                    with query:
-                        self._pass(program, vao, halves=False)
-            counted = key not in cache
-            if counted:
-                cache[key] = alone.samples
-                self._unoccluded = cache
-            p_unocc, p_occ = cache[key], behind.samples
-            gpu_ms = timer.elapsed_ms
-        finally:
-            ctx.depth_func = "<"
-            fb.fbo.depth_mask = True
-            fb.fbo.color_mask = (True, True, True, True)
-            self._restore(previous, viewport)
+        p_occ = self._in_frame.samples
+        p_unocc, _, times = self._counted(frame_size, behind=False)
         wall_ms = (time.perf_counter() - start) * 1e3
-        self.last_occlusion = dict(p_unocc=p_unocc, p_occ=p_occ, gpu_ms=gpu_ms, wall_ms=wall_ms,
-                                   unoccluded_counted=counted)
-        return p_unocc, p_occ, gpu_ms
+        self.last_occlusion = dict(p_unocc=p_unocc, p_occ=p_occ, in_frame=True,
+                                   gpu_ms=times["gpu_ms"] if times["unoccluded_counted"] else 0.0,
+                                   wall_ms=wall_ms,
+                                   unoccluded_counted=times["unoccluded_counted"])
+        return p_unocc, p_occ
 
     def occlusion_ratio(self, size=None) -> float:
         """r = (p_unocc − p_occ)/p_unocc: 1 hidden, 0 revealed (0 as well when off screen)."""
         return _explode().occlusion_ratio(*self.measure_occlusion(size)[:2])
 
     def step_animation(self, settings=None, size=None) -> float:
-        """One frame of the dynamics: measure r at the current offset, advance the state with
-        ``next_state`` (``settings`` default the style's), take its offset and the ghosting
-        opacity ``ghost_alpha``; returns r."""
+        """One frame of the dynamics: r at the current offset (from the last frame's own count
+        when :meth:`draw` drew the current state, else measured by :meth:`measure_occlusion`),
+        advance the state with ``next_state`` (``settings`` default the style's), take its
+        offset and the ghosting opacity ``ghost_alpha``; returns r."""
         self._require_prepared()
         algo = _explode()
         settings = self.settings if settings is None else settings
-        r = algo.occlusion_ratio(*self.measure_occlusion(size)[:2])
+        counts = self._frame_occlusion(size)
+        if counts is None:
+            counts = self.measure_occlusion(size)[:2]
+        r = algo.occlusion_ratio(*counts)
         self.state = algo.next_state(self.state, r, settings)
         self.offset = float(self.state.offset)
         self.alpha = float(algo.ghost_alpha(self.offset, settings, r))
