@@ -17,21 +17,27 @@ Manual plane y through it; the views turn from the default view projected perpen
 
 **View sweep** (``table.md``, the returned rows). θ is the angle between the view direction
 and the split plane (0° = the plane's normal perpendicular to the view, 90° = the view along
-the normal): 0, 20, 40, 60, 75, 85°. Per scene, θ and plane (the manual one and the automatic
-one, ``auto_plane``, chosen for that view; its own angle to the view is given): the animation
-(``step_animation``, s_u = 1, dt = 0.1) over N frames (quick 40, full 60); frames to full
-reveal (the first frame whose r <= 0.01, frame 0 at offset 0; "not within N" otherwise), the
-offset then and at the end over o_max (the bounding-box diagonal), the final r (measured after
-the last step), α at the end (the front half's opacity from ``ghost_alpha``), the share of the
-object's pixels showing through the ghosted front half at the end (pixels tinted by the object's
-colour in the drawn frame over those of the object drawn alone), and per frame the occlusion
-query pass (``measure_occlusion``: GPU timer, and wall clock) against the frame's ``draw``
-(GPU timer; wall clock with ``ctx.finish``), medians over the frames, with the ratio of the
-wall clock times. On llvmpipe the timer query around ``draw`` closes before the deferred
-rasterization runs (it reads ~0 ms) while the query pass waits for its sample counts, so the GPU
-columns are not comparable and the wall clock ratio is the one to read.
+the normal): 0, 20, 40, 60, 75, 85°. Per scene, θ, plane (the manual one and the automatic
+one, ``auto_plane``, chosen for that view; its own angle to the view is given) and ratio
+exponent p (1, the thesis's speed ∝ r, and 1/2, ∝ √r): the animation (``step_animation``,
+s_u = 1, dt = 0.1) over N frames (quick 40, full 60); frames to full reveal (the first frame
+whose r <= 0.01, frame 0 at offset 0; "not within N" otherwise), the offset then and at the
+end over o_max (the bounding-box diagonal), the final r (measured after the last step) and
+phase ("hold": halted revealed), α at the end (the front half's opacity from ``ghost_alpha``),
+the share of the object's pixels showing through the ghosted front half at the end (pixels
+tinted by the object's colour in the drawn frame over those of the object drawn alone).
 
-**Comparison** (``compare.md``). At each automatic-plane row's final offset D (the total
+**Occlusion cost** (same rows, wall clock with ``ctx.finish``, medians over the frames). Each
+frame is drawn without and with its in-frame count; the count's cost is the difference plus
+``step_animation``'s readback (or its separate pass, where the frame could not be counted),
+against the draw without it (``occlusion_over_draw``); ``counted_in_frame_pct`` says how many
+frames were counted as drawn. Beside it the separate ``p_occ`` pass (``measure_occlusion``
+with ``p_unocc`` cached), as each frame would need it otherwise (``separate_over_draw``). On
+llvmpipe the timer query around ``draw`` closes before the deferred rasterization runs (it
+reads ~0 ms), so the GPU columns are not comparable and the wall clock ratios are the ones to
+read.
+
+**Comparison** (``compare.md``). At each automatic-plane row's (p = 1) final offset D (the total
 displacement of each half), the revealed share 1 − r of: the occlusion-driven result (1 − its
 final r); a uniform explosion (every part, the object included, pushed from the assembly's
 bounding-box centre by D, ``uniform_explosion``; drawn as a translated copy of the mesh, camera
@@ -47,7 +53,7 @@ along the manual plane, the car at the default view along the automatic plane.
 Targets (reported, not asserted): full reveal within 30 frames at s_u = 1 for θ <= 60° on both
 scenes with offset <= o_max; where the reveal needs more than o_max, >= 99 % of the object's
 pixels showing through the ghosted half; occlusion-driven revealing more than uniform and fixed
-offset at equal displacement; the query pass at most 1x the draw.
+offset at equal displacement; the occlusion queries at most 1x the draw.
 
 Run: ``workbench run fig_exploded [--quick]`` or ``python experiments/fig_exploded.py [--quick]``.
 """
@@ -61,7 +67,7 @@ from pathlib import Path
 
 import numpy as np
 
-from workbench.algo.explode import occlusion_ratio, uniform_explosion
+from workbench.algo.explode import o_max_of, occlusion_ratio, uniform_explosion
 from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.figures import save_animation, save_image_grid, with_progress_bar
 from workbench.experiment.measure import default_camera
@@ -75,6 +81,7 @@ from workbench.scene import generators
 from workbench.scene.mesh import FEMesh
 
 ANGLES = (0.0, 20.0, 40.0, 60.0, 75.0, 85.0)
+EXPONENTS = (1.0, 0.5)  # the thesis's r, and r^0.5
 REVEALED = 0.01  # r at or below which the object counts as fully revealed
 TARGET_FRAMES = 30
 TARGET_ANGLE = 60.0
@@ -137,21 +144,25 @@ def _tinted(image) -> int:
     return int(((image[..., 0].astype(int) - image[..., 2].astype(int)) > 12).sum())
 
 
-def animate(ctx, scene, focus, plane, camera, size, frames, keep_images=False):
-    """Run the animation for ``frames`` frames; returns the per-frame record."""
-    path = make_path("exploded", focus=focus, plane=plane, speed=1.0, dt=0.1)
+def animate(ctx, scene, focus, plane, camera, size, frames, exponent=1.0, keep_images=False):
+    """Run the animation for ``frames`` frames; returns the per-frame record.
+
+    Each frame is drawn twice at the same state, without and with the in-frame count (their
+    wall clock difference is the count's cost), then ``step_animation`` reads the count and
+    moves the halves (its wall clock: the readback, or the separate pass on a ghosted frame);
+    the separate ``p_occ`` pass alone, as every frame would need it without the in-frame count,
+    is timed after it for comparison."""
+    path = make_path("exploded", focus=focus, plane=plane, speed=1.0, dt=0.1,
+                     ratio_exponent=exponent)
     fb = Framebuffer(ctx, size)
-    rec = dict(r=[], offset=[], alpha=[], q_gpu=[], q_wall=[], d_gpu=[], d_wall=[], images=[])
+    rec = dict(r=[], offset=[], alpha=[], in_frame=[], step_wall=[], sep_gpu=[], sep_wall=[],
+               d_gpu=[], d_wall=[], c_wall=[], images=[])
     try:
         path.prepare(ctx, scene, camera)
         timer = GpuTimer(ctx)
         for i in range(frames):
             fb.use()
-            rec["r"].append(path.step_animation())
-            rec["offset"].append(path.offset)
-            rec["alpha"].append(path.alpha)
-            rec["q_gpu"].append(path.last_occlusion["gpu_ms"])
-            rec["q_wall"].append(path.last_occlusion["wall_ms"])
+            path.count_in_draw = False
             fb.clear()
             ctx.finish()
             start = time.perf_counter()
@@ -160,8 +171,23 @@ def animate(ctx, scene, focus, plane, camera, size, frames, keep_images=False):
             ctx.finish()
             rec["d_wall"].append((time.perf_counter() - start) * 1e3)
             rec["d_gpu"].append(timer.elapsed_ms)
+            path.count_in_draw = True
+            fb.clear()
+            ctx.finish()
+            start = time.perf_counter()
+            path.draw()
+            ctx.finish()
+            rec["c_wall"].append((time.perf_counter() - start) * 1e3)
             if keep_images:
                 rec["images"].append(with_progress_bar(fb.read(), i + 1, frames, BAR_PX))
+            rec["r"].append(path.step_animation())
+            rec["step_wall"].append(path.last_occlusion["wall_ms"])
+            rec["in_frame"].append(path.last_occlusion["in_frame"])
+            rec["offset"].append(path.offset)
+            rec["alpha"].append(path.alpha)
+            path.measure_occlusion()
+            rec["sep_gpu"].append(path.last_occlusion["gpu_ms"])
+            rec["sep_wall"].append(path.last_occlusion["wall_ms"])
         fb.use()
         p_unocc, p_occ, _ = path.measure_occlusion()
         rec["final_r"] = occlusion_ratio(p_unocc, p_occ)
@@ -174,6 +200,7 @@ def animate(ctx, scene, focus, plane, camera, size, frames, keep_images=False):
         rec["ghost_visible"] = shown / alone if alone else None
         rec["o_max"] = path.settings.o_max
         rec["normal"] = np.asarray(path.normal, np.float64)
+        rec["phase"] = path.state.phase
     finally:
         fb.release()
         path.release()
@@ -259,6 +286,47 @@ def most_hidden_part(ctx, scene, size) -> tuple[int, list[dict]]:
 
 
 # ---------------------------------------------------------------------------- rows
+def sweep_row(rec, label, focus, kind, theta, v, frames, exponent) -> dict:
+    """One row of the view sweep from an :func:`animate` record (see the module docstring)."""
+    o_max, normal = rec["o_max"], rec["normal"]
+    plane_angle = math.degrees(math.asin(min(1.0, abs(float(normal @ v)))))
+    hit = next((i for i, r in enumerate(rec["r"]) if r <= REVEALED), None)
+    draw = statistics.median(rec["d_wall"])
+    occlusion = statistics.median(c - d + s for c, d, s in
+                                  zip(rec["c_wall"], rec["d_wall"], rec["step_wall"]))
+    separate = statistics.median(rec["sep_wall"])
+    return dict(scene=label, focus_part=focus, plane=kind, ratio_exponent=exponent,
+                normal=",".join(f"{c:.3f}" for c in normal),
+                view_to_plane_deg=theta if kind == "manual" else round(plane_angle, 2),
+                sweep_deg=theta, frames=frames,
+                frames_to_reveal=hit if hit is not None else f"not within {frames}",
+                offset_at_reveal_over_o_max=((rec["offset"][hit - 1] / o_max if hit else 0.0)
+                                             if hit is not None else None),
+                final_r=rec["final_r"], final_offset_over_o_max=rec["offset"][-1] / o_max,
+                final_phase=rec["phase"], o_max=o_max, final_alpha=rec["alpha"][-1],
+                visible_through_ghost_pct=(None if rec["ghost_visible"] is None
+                                           else 100.0 * rec["ghost_visible"]),
+                draw_gpu_ms=statistics.median(rec["d_gpu"]), draw_wall_ms=draw,
+                counted_in_frame_pct=100.0 * sum(rec["in_frame"]) / len(rec["in_frame"]),
+                occlusion_wall_ms=occlusion,
+                occlusion_over_draw=occlusion / draw if draw > 0 else None,
+                separate_pass_gpu_ms=statistics.median(rec["sep_gpu"]),
+                separate_pass_wall_ms=separate,
+                separate_over_draw=separate / draw if draw > 0 else None)
+
+
+def compare_row(ctx, scene, label, focus, manual, camera, direction, size, theta, rec) -> dict:
+    """The revealed shares at the automatic row's final offset D (see the module docstring)."""
+    d, o_max = rec["offset"][-1], rec["o_max"]
+    ru = r_uniform(ctx, scene, focus, direction, size, d)
+    rf = r_fixed(ctx, scene, focus, manual, camera, size, d)
+    return dict(scene=label, focus_part=focus, sweep_deg=theta,
+                displacement=d, displacement_over_o_max=d / o_max,
+                occlusion_driven_revealed=1.0 - rec["final_r"], uniform_revealed=1.0 - ru,
+                fixed_offset_manual_plane_revealed=1.0 - rf,
+                beats_uniform=ru > rec["final_r"], beats_fixed_offset=rf > rec["final_r"])
+
+
 def sweep_rows(ctx, label, scene, focus, manual, w, size, frames, say, known=None):
     n = {"x": np.array([1.0, 0, 0]), "y": np.array([0, 1.0, 0]), "z": np.array([0, 0, 1.0])}[manual]
     rows, compare = [], []
@@ -267,47 +335,26 @@ def sweep_rows(ctx, label, scene, focus, manual, w, size, frames, say, known=Non
         camera = camera_along(scene, size, direction)
         v = view_dir(camera)
         for kind, plane in (("manual", manual), ("auto", "auto")):
-            rec = animate(ctx, scene, focus, plane, camera, size, frames)
-            o_max = rec["o_max"]
-            normal = rec["normal"]
-            plane_angle = math.degrees(math.asin(min(1.0, abs(float(normal @ v)))))
-            hit = next((i for i, r in enumerate(rec["r"]) if r <= REVEALED), None)
-            q_gpu, d_gpu = statistics.median(rec["q_gpu"]), statistics.median(rec["d_gpu"])
-            q_wall, d_wall = statistics.median(rec["q_wall"]), statistics.median(rec["d_wall"])
-            row = dict(scene=label, focus_part=focus, plane=kind,
-                       normal=",".join(f"{c:.3f}" for c in normal),
-                       view_to_plane_deg=theta if kind == "manual" else round(plane_angle, 2),
-                       sweep_deg=theta, frames=frames,
-                       frames_to_reveal=hit if hit is not None else f"not within {frames}",
-                       offset_at_reveal_over_o_max=(rec["offset"][hit - 1] / o_max if hit
-                                                    else 0.0) if hit is not None else None,
-                       final_r=rec["final_r"], final_offset_over_o_max=rec["offset"][-1] / o_max,
-                       o_max=o_max, final_alpha=rec["alpha"][-1],
-                       visible_through_ghost_pct=(None if rec["ghost_visible"] is None
-                                                  else 100.0 * rec["ghost_visible"]),
-                       query_gpu_ms=q_gpu, draw_gpu_ms=d_gpu,
-                       query_wall_ms=q_wall, draw_wall_ms=d_wall,
-                       query_over_draw_wall=q_wall / d_wall if d_wall > 0 else None)
-            if kind == "manual" and known is not None:
-                row["closed_form_reveal_over_o_max"] = known(theta) / o_max
+            measured = None
             if kind == "manual":
+                o_max = o_max_of(scene)
                 measured = measured_reveal_offset(ctx, scene, focus, plane, camera, size, o_max)
-                row["measured_reveal_over_o_max"] = (None if measured is None
-                                                     else measured / o_max)
-            rows.append(row)
-            say(f"{label} θ={theta:g}° {kind}: reveal frame {row['frames_to_reveal']}, "
-                f"final r {rec['final_r']:.3f}, offset/o_max {row['final_offset_over_o_max']:.3f}")
-            if kind == "auto":
-                d = rec["offset"][-1]
-                ru = r_uniform(ctx, scene, focus, direction, size, d)
-                rf = r_fixed(ctx, scene, focus, manual, camera, size, d)
-                compare.append(dict(scene=label, focus_part=focus, sweep_deg=theta,
-                                    displacement=d, displacement_over_o_max=d / o_max,
-                                    occlusion_driven_revealed=1.0 - rec["final_r"],
-                                    uniform_revealed=1.0 - ru,
-                                    fixed_offset_manual_plane_revealed=1.0 - rf,
-                                    beats_uniform=ru > rec["final_r"],
-                                    beats_fixed_offset=rf > rec["final_r"]))
+            for exponent in EXPONENTS:
+                rec = animate(ctx, scene, focus, plane, camera, size, frames, exponent)
+                row = sweep_row(rec, label, focus, kind, theta, v, frames, exponent)
+                if kind == "manual" and known is not None:
+                    row["closed_form_reveal_over_o_max"] = known(theta) / rec["o_max"]
+                if kind == "manual":
+                    row["measured_reveal_over_o_max"] = (None if measured is None
+                                                         else measured / rec["o_max"])
+                rows.append(row)
+                say(f"{label} θ={theta:g}° {kind} p={exponent:g}: reveal frame "
+                    f"{row['frames_to_reveal']}, final r {rec['final_r']:.3f}, offset/o_max "
+                    f"{row['final_offset_over_o_max']:.3f}, occlusion/draw "
+                    f"{row['occlusion_over_draw']:.2f}")
+                if kind == "auto" and exponent == EXPONENTS[0]:
+                    compare.append(compare_row(ctx, scene, label, focus, manual, camera,
+                                               direction, size, theta, rec))
     return rows, compare
 
 
