@@ -477,12 +477,12 @@ class ExplodedPath(MeshPath):
             return None
         start = time.perf_counter()
         p_occ = self._in_frame.samples
-        p_unocc, _, times = self._counted(frame_size, behind=False)
+        counted = frame["key"] not in self._unoccluded
+        gpu_ms = self._counted(frame_size, behind=False)[2]["gpu_ms"] if counted else 0.0
+        p_unocc = self._unoccluded[frame["key"]]
         wall_ms = (time.perf_counter() - start) * 1e3
-        self.last_occlusion = dict(p_unocc=p_unocc, p_occ=p_occ, in_frame=True,
-                                   gpu_ms=times["gpu_ms"] if times["unoccluded_counted"] else 0.0,
-                                   wall_ms=wall_ms,
-                                   unoccluded_counted=times["unoccluded_counted"])
+        self.last_occlusion = dict(p_unocc=p_unocc, p_occ=p_occ, in_frame=True, gpu_ms=gpu_ms,
+                                   wall_ms=wall_ms, unoccluded_counted=counted)
         return p_unocc, p_occ
 
     def occlusion_ratio(self, size=None) -> float:
