@@ -7,18 +7,28 @@ car itself, generated stamped panels) and each of the paper's parameter sets A a
 
 * ``params`` (Table 1): the parameter sets;
 * ``preprocessing`` (Table 2): seconds per stage -- features + subpatches + lines,
-  retriangulation, textures -- with patch, subpatch and line counts;
+  retriangulation (with the certification of the distance bound, also given alone), textures
+  -- with patch, subpatch and line counts, texture memory and the certified bound, for the
+  new rules (build_model's defaults) and, for set A, before each change (``rules``: "paper",
+  the paper's construction and texture scale; "certified d, paper texture", the distance bound
+  alone);
 * ``table3`` (Table 3; every column in ``table``): per render path, triangles, GPU and wall time per frame, the speed factor
   against original + line overdraw, texture memory in RGBA texels (4 bytes) per element, and
   the errors the paper does not give: the certified one-sided Hausdorff distance original →
-  simplified (upper end of a bracket of width 1e-4 of the bounding-box diagonal, model units
-  and % of the diagonal, beside ``d``), wire-frame fidelity against the line-overdraw image
-  (precision, recall and IoU of wire pixels with a one-pixel tolerance,
+  simplified (upper end of a bracket of width 1e-4 of the bounding-box diagonal or 1 % of
+  ``d``, whichever is smaller, model units and % of the diagonal, beside ``d``), wire-frame
+  fidelity against the line-overdraw image (precision, recall and IoU of wire pixels with a
+  one-pixel tolerance,
   :func:`workbench.experiment.compare.wire_agreement`), and SSIM of the image against the
   original's (shaded paths against "original, shaded", wire paths against the overdraw);
-* ``sweep``: on the car refined 2×2 and displaced, the parameters scaled around sets A and B
-  and the atlas resolution (texels across the smallest element) varied: speed factor against wire IoU and Hausdorff
-  error (``sweep.png``);
+  Set A's rows come also built with the paper's rules (``[paper]``) and with the certified
+  distance bound alone (``[certified d, paper texture]``), so that each change shows its cost:
+  the bound in triangles and speed, the texture rule in texels per element and wire fidelity;
+* ``sweep``: on the car refined 2×2 and displaced, the parameters scaled around sets A and B,
+  and set A under the paper's rules, each change alone and the texture rule varied (texels
+  across the scale-setting element width or extent, its quantile, narrow elements drawn as
+  lines or not, normal map size; every build_model keyword in the row): speed factor against
+  wire IoU and Hausdorff error (``sweep.png``);
 * ``crops.png``: the same crop of original + line overdraw and simplified A + normal map + wire
   texture.
 
@@ -36,7 +46,14 @@ from pathlib import Path
 
 import numpy as np
 
-from workbench.algo.fepatch.pipeline import PARAMETER_SETS, STAGES, FEPatchParams, build_model
+from workbench.algo.fepatch.pipeline import (
+    PAPER_RULES,
+    PAPER_TEXTURE_RULE,
+    PARAMETER_SETS,
+    STAGES,
+    FEPatchParams,
+    build_model,
+)
 from workbench.algo.hausdorff import hausdorff
 from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.compare import compare_images, wire_agreement
@@ -54,10 +71,16 @@ VIEW = {"azimuth": -35.0, "elevation": 25.0, "up": "z"}
 WIRE = (0.0, 0.0, 0.0)
 OVERDRAW = "original + line overdraw"
 SHADED = "original, shaded"
-BRACKET_REL = 1e-4
-TABLE3 = ("renderer", "mesh", "size", "path", "triangles", "line_edges", "gpu_ms", "wall_ms",
-          "speed_vs_overdraw", "rgba_texels_per_element", "hausdorff_mm", "d_mm",
+BRACKET_REL = 1e-4  # of the bounding-box diagonal, ...
+BRACKET_OF_D = 0.01  # ... or of d, whichever is smaller: narrow enough to tell "within d"
+TABLE3 = ("renderer", "mesh", "size", "path", "rules", "triangles", "line_edges", "gpu_ms",
+          "wall_ms", "speed_vs_overdraw", "rgba_texels_per_element", "hausdorff_mm", "d_mm",
           "wire_precision_1px", "wire_recall_1px", "wire_iou_1px", "ssim")
+# build_model keywords of the rows that show each change on its own: the paper's construction
+# (before both), and the certified distance bound with the paper's texture rule (before the
+# texture change); "new" is build_model's defaults
+RULES = {"paper": PAPER_RULES, "certified d, paper texture": PAPER_TEXTURE_RULE, "new": {}}
+NEW = "new"
 
 
 @dataclass
@@ -82,17 +105,24 @@ def params_rows() -> list[dict]:
              "l_inner_mm": p.l_inner} for name, p in PARAMETER_SETS.items()]
 
 
-def preprocessing_row(case: Case, model) -> dict:
-    row = {"mesh": case.label, "set": model.params.label, "elements": model.n_elements,
+def preprocessing_row(case: Case, model, rules: str = NEW) -> dict:
+    row = {"mesh": case.label, "set": model.params.label, "rules": rules,
+           "elements": model.n_elements,
            "patches": model.n_patches, "subpatches": model.n_subpatches,
            "g0_edges": model.features["G0"], "g1_edges": model.features["G1"],
            "closing_edges": model.features["closing"], "line_nodes": model.line_nodes,
            "line_nodes_kept": model.line_nodes_kept, "fallback_subpatches": len(model.fallback),
            "original_triangles": len(model.original.triangles),
            "simplified_triangles": len(model.simplified.triangles),
-           "atlas": f"{model.atlas_size[0]}x{model.atlas_size[1]}"}
+           "atlas": f"{model.atlas_size[0]}x{model.atlas_size[1]}",
+           "rgba_texels_per_element": model.rgba_texels_per_element,
+           "narrow_elements": model.narrow_elements, "fit_share": model.fit_share,
+           "split_subpatches": model.split_subpatches,
+           "kept_subpatches": model.kept_subpatches,
+           "certified_bound_mm": model.distance_bound}
     for stage in STAGES:
         row[f"{stage} s"] = model.seconds[stage]
+    row["certification s"] = model.certify_seconds
     row["total s"] = sum(model.seconds.values())
     return row
 
@@ -102,8 +132,11 @@ def simplification_error(case: Case, model) -> dict:
     orig, simp = model.original, model.simplified
     lo, hi = case.mesh.bounds()
     diag = float(np.linalg.norm(hi - lo))
+    tol = BRACKET_REL * diag
+    if model.params.d > 0:
+        tol = min(tol, BRACKET_OF_D * model.params.d)
     h = hausdorff(orig.positions, orig.triangles, simp.positions, simp.triangles,
-                  one_sided=True, tol=BRACKET_REL * diag)
+                  one_sided=True, tol=tol)
     return {"hausdorff_mm": h.upper, "hausdorff_lower_mm": h.lower,
             "hausdorff_pct_diag": 100.0 * h.upper / diag, "hausdorff_s": h.seconds,
             "within_d": bool(h.upper <= model.params.d)}
@@ -125,31 +158,48 @@ class Drawer:
                        camera=self.camera, size=self.size, repeats=self.repeat)
 
 
-def table_rows(case: Case, models: dict, drawer: Drawer, gl_renderer: str, say):
-    """Table 3 rows of one mesh, and the images by path label."""
+def variant_label(name: str, rules: str, what: str) -> str:
+    """The Table 3 path label of set ``name`` built with ``rules`` (the new rules unnamed)."""
+    return f"simplified {name}{'' if rules == NEW else f' [{rules}]'} {what}"
+
+
+def table_rows(case: Case, models: dict, variants: dict, drawer: Drawer, gl_renderer: str, say):
+    """Table 3 rows of one mesh, and the images by path label. ``models``: {set: the mesh's
+    cached model (new rules)}; ``variants``: {(set, rules): model built with other rules},
+    drawn as textured surfaces."""
     crease = PARAMETER_SETS["A"].alpha_g1_deg
-    configs = [(SHADED, "gouraud", None, Style(crease_deg=crease)),
-               (OVERDRAW, "gouraud", None, Style(crease_deg=crease, wireframe=True,
-                                                 wire_color=WIRE)),
-               ("original + wire texture", "fe_wire_texture", "A", None)]
+    configs = [(SHADED, "gouraud", None, NEW, Style(crease_deg=crease)),
+               (OVERDRAW, "gouraud", None, NEW, Style(crease_deg=crease, wireframe=True,
+                                                      wire_color=WIRE)),
+               ("original + wire texture", "fe_wire_texture", "A", NEW, None)]
     for name in models:
-        configs += [(f"simplified {name} + normal map", "fe_normal_map", name, None),
-                    (f"simplified {name} + normal map + wire texture", "fe_normal_wire", name,
-                     None)]
+        configs += [(variant_label(name, NEW, "+ normal map"), "fe_normal_map", name, NEW, None),
+                    (variant_label(name, NEW, "+ normal map + wire texture"), "fe_normal_wire",
+                     name, NEW, None)]
+    for name, rules in variants:
+        configs.append((variant_label(name, rules, "+ normal map + wire texture"),
+                        "fe_normal_wire", name, rules, None))
     rows, images = [], {}
-    for label, path_name, set_name, style in configs:
-        model = models.get(set_name) if set_name else None
-        if model is not None:  # the mesh's cached model of this set is drawn
+    for label, path_name, set_name, rules, style in configs:
+        model = None
+        scene = None
+        if set_name is not None and rules == NEW:  # the mesh's cached model of this set
+            model = models[set_name]
+        elif set_name is not None:
+            model = variants[(set_name, rules)]
+            scene = model.simplified
+        if model is not None:
             style = Style(fepatch=set_name, crease_deg=model.params.alpha_g1_deg, wire_color=WIRE)
-        m = drawer.draw(path_name, style)
+        m = drawer.draw(path_name, style, scene)
         images[label] = m.image
         row = dict(renderer=gl_renderer, mesh=case.label, size=f"{drawer.size[0]}x{drawer.size[1]}",
-                   path=label, set=set_name or "", triangles=m.row["triangles"],
-                   line_edges=m.row["edges"], **m.timing.as_row())
+                   path=label, set=set_name or "", rules=rules if model is not None else "",
+                   triangles=m.row["triangles"], line_edges=m.row["edges"], **m.timing.as_row())
         if model is not None:
             surface = model.original if path_name == "fe_wire_texture" else model.simplified
             row.update(rgba_texels_per_element=model.rgba_texels_per_element,
-                       texture_mb=surface.texture_bytes / 2**20)
+                       texture_mb=surface.texture_bytes / 2**20,
+                       narrow_elements=model.narrow_elements)
         rows.append(row)
         say(f"  {case.label} {label}: {m.row['triangles']} triangles, "
             f"wall {m.timing.wall_ms:.1f} ms")
@@ -166,43 +216,77 @@ def table_rows(case: Case, models: dict, drawer: Drawer, gl_renderer: str, say):
             r["ssim_against"] = reference
         if wire and r["path"] != OVERDRAW:
             r.update(wire_agreement(images[r["path"]], images[OVERDRAW], WIRE))
-    for name, model in models.items():
+    measured = [(name, NEW, model) for name, model in models.items()]
+    measured += [(name, rules, model) for (name, rules), model in variants.items()]
+    for name, rules, model in measured:
         error = simplification_error(case, model)
-        for label in (f"simplified {name} + normal map",
-                      f"simplified {name} + normal map + wire texture"):
-            by[label].update(d_mm=model.params.d, **error)
-        say(f"  {case.label} set {name}: one-sided Hausdorff <= {error['hausdorff_mm']:.3f} mm "
-            f"(d = {model.params.d} mm)")
+        for label in (variant_label(name, rules, "+ normal map"),
+                      variant_label(name, rules, "+ normal map + wire texture")):
+            if label in by:
+                by[label].update(d_mm=model.params.d, **error)
+        say(f"  {case.label} set {name} ({rules} rules): one-sided Hausdorff <= "
+            f"{error['hausdorff_mm']:.3f} mm (d = {model.params.d} mm)")
     return rows, images
 
 
-def sweep_configs(quick: bool) -> list[tuple[str, FEPatchParams, float]]:
+SWEEP_KEYS = ("fit_share", "certify", "texels_per_edge", "scale_by", "scale_quantile",
+              "atlas_turns", "border", "normal_reduction", "min_width")
+
+
+def sweep_configs(quick: bool) -> list[tuple[str, FEPatchParams, dict]]:
+    """(label, parameters, build_model keywords) of the sweep: the parameter sets scaled, and
+    set A under the paper's rules, each change alone and the texture rule varied."""
     a, b = PARAMETER_SETS["A"], PARAMETER_SETS["B"]
 
     def scaled(p: FEPatchParams, f: float) -> FEPatchParams:
         return FEPatchParams(p.alpha_g1_deg, p.d * f, p.l_outer * f, p.l_inner * f,
                              f"{p.name}x{f:g}")
 
-    configs = [("A", a, 3.0), ("B", b, 3.0), ("A/2", scaled(a, 0.5), 3.0),
-               ("Bx2", scaled(b, 2.0), 3.0), ("A, 2 texels", a, 2.0), ("A, 4 texels", a, 4.0)]
+    configs = [("A", a, {}), ("B", b, {}), ("A/2", scaled(a, 0.5), {}),
+               ("Bx2", scaled(b, 2.0), {}),
+               ("A, paper rules", a, PAPER_RULES),
+               ("A, paper texture rule", a, PAPER_TEXTURE_RULE),
+               ("A, d/2 fit, not certified", a, {"fit_share": 0.5, "certify": False}),
+               ("A, width 2.5 q0.1", a, {"scale_quantile": 0.1}),
+               ("A, width 2 q0.1, no narrow lines", a, {"texels_per_edge": 2.0,
+                                                       "scale_quantile": 0.1,
+                                                       "min_width": None}),
+               ("A, width 3 q0", a, {"texels_per_edge": 3.0, "scale_quantile": 0.0}),
+               ("A, extent 2.5", a, {"scale_by": "extent"}),
+               ("A, no turns", a, {"atlas_turns": 1}),
+               ("A, normal map 1/1", a, {"normal_reduction": 1}),
+               ("A, normal map 1/4", a, {"normal_reduction": 4})]
     if not quick:
-        configs += [("Ax2", scaled(a, 2.0), 3.0), ("A/4", scaled(a, 0.25), 3.0)]
+        configs += [("Ax2", scaled(a, 2.0), {}), ("A/4", scaled(a, 0.25), {}),
+                    ("A, width 2.5 q0.3", a, {"scale_quantile": 0.3}),
+                    ("A, width 2 q0.3, no narrow lines", a, {"texels_per_edge": 2.0,
+                                                            "scale_quantile": 0.3,
+                                                            "min_width": None})]
     return configs
+
+
+def build_settings(kwargs: dict) -> dict:
+    """Every :data:`SWEEP_KEYS` keyword of a build: ``kwargs`` over build_model's defaults."""
+    import inspect
+
+    defaults = inspect.signature(build_model).parameters
+    return {k: kwargs.get(k, defaults[k].default) for k in SWEEP_KEYS}
 
 
 def sweep_rows(case: Case, drawer: Drawer, quick: bool, say) -> list[dict]:
     overdraw = drawer.draw("gouraud", Style(crease_deg=PARAMETER_SETS["A"].alpha_g1_deg,
                                             wireframe=True, wire_color=WIRE))
     rows = []
-    for label, params, texels in sweep_configs(quick):
-        # an atlas resolution of its own: built here, the simplified surface drawn as the scene
-        model = build_model(case.mesh.elements, case.mesh.nodes, params, texels_per_edge=texels)
+    for label, params, kwargs in sweep_configs(quick):
+        # rules of its own: built here, the simplified surface drawn as the scene
+        model = build_model(case.mesh.elements, case.mesh.nodes, params, **kwargs)
         style = Style(crease_deg=params.alpha_g1_deg, wire_color=WIRE)
         m = drawer.draw("fe_normal_wire", style, model.simplified)
         row = dict(mesh=case.label, config=label, alpha_g1_deg=params.alpha_g1_deg, d_mm=params.d,
                    l_outer_mm=params.l_outer, l_inner_mm=params.l_inner,
-                   texels_per_edge=texels, triangles=m.row["triangles"],
-                   line_edges=m.row["edges"], preprocessing_s=sum(model.seconds.values()),
+                   **build_settings(kwargs), triangles=m.row["triangles"],
+                   line_edges=m.row["edges"], narrow_elements=model.narrow_elements,
+                   preprocessing_s=sum(model.seconds.values()),
                    wall_ms=m.timing.wall_ms,
                    speed_vs_overdraw=overdraw.timing.wall_ms / m.timing.wall_ms,
                    rgba_texels_per_element=model.rgba_texels_per_element,
@@ -211,7 +295,8 @@ def sweep_rows(case: Case, drawer: Drawer, quick: bool, say) -> list[dict]:
         rows.append(row)
         say(f"  sweep {label}: {m.row['triangles']} triangles, "
             f"speed x{row['speed_vs_overdraw']:.2f}, "
-            f"wire IoU {row['wire_iou_1px']:.3f}, Hausdorff {row['hausdorff_mm']:.3f} mm")
+            f"wire IoU {row['wire_iou_1px']:.3f}, Hausdorff {row['hausdorff_mm']:.3f} mm, "
+            f"{row['rgba_texels_per_element']:.1f} RGBA texels per element")
     return rows
 
 
@@ -258,14 +343,22 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
     first = True
     for case in cases(quick, say):
         say(f"{case.label}: {case.mesh.n_elements} elements")
-        models = {}
+        models, variants = {}, {}
         for name in PARAMETER_SETS:
             models[name] = case.mesh.fepatch_model(name)  # derived once, cached by the mesh
             pre.append(preprocessing_row(case, models[name]))
             say(f"  set {name}: preprocessing {pre[-1]['total s']:.1f} s, "
                 f"{pre[-1]['simplified_triangles']} of {pre[-1]['original_triangles']} triangles")
+        for rules, kwargs in RULES.items():  # set A before each change
+            if rules == NEW:
+                continue
+            variants[("A", rules)] = build_model(case.mesh.elements, case.mesh.nodes, "A",
+                                                 **kwargs)
+            pre.append(preprocessing_row(case, variants[("A", rules)], rules))
+            say(f"  set A, {rules} rules: preprocessing {pre[-1]['total s']:.1f} s, "
+                f"{pre[-1]['simplified_triangles']} triangles")
         drawer = Drawer(ctx, case.mesh, size, repeat)
-        mesh_rows, images = table_rows(case, models, drawer, gl_renderer, say)
+        mesh_rows, images = table_rows(case, models, variants, drawer, gl_renderer, say)
         rows += mesh_rows
         if first:
             h, w = size[1], size[0]

@@ -61,3 +61,28 @@ def test_preprocessing_times_every_stage(result):
         assert r["total s"] == pytest.approx(sum(stages))
         assert r["simplified_triangles"] < r["original_triangles"]
         assert r["line_nodes_kept"] <= r["line_nodes"]
+
+
+def test_before_and_after_rows_show_the_bound_and_the_texture_memory(result):
+    rows, out_dir = result
+    for mesh in {r["mesh"] for r in rows}:
+        by = {r["path"]: r for r in rows if r["mesh"] == mesh}
+        new = by["simplified A + normal map + wire texture"]
+        paper = by["simplified A [paper] + normal map + wire texture"]
+        bound_only = by["simplified A [certified d, paper texture] + normal map + wire texture"]
+        assert (new["rules"], paper["rules"]) == ("new", "paper")
+        # the certified distance: within d with the new construction, whatever the paper's did
+        for r in (new, bound_only):
+            assert r["within_d"] and r["hausdorff_mm"] <= r["d_mm"]
+        # the texture rule alone changes the memory, not the surface
+        assert bound_only["triangles"] == new["triangles"]
+        assert new["rgba_texels_per_element"] < bound_only["rgba_texels_per_element"]
+    pre = read_table(out_dir / "preprocessing.csv")
+    assert {r["rules"] for r in pre} == {"new", "paper", "certified d, paper texture"}
+    for r in pre:
+        if r["rules"] != "paper":
+            assert r["certified_bound_mm"] <= PARAMETER_SETS[r["set"]].d
+    sweep = read_table(out_dir / "sweep.csv")
+    configs = {r["config"]: r for r in sweep}
+    assert configs["A, paper rules"]["fit_share"] == 1 and not configs["A, paper rules"]["certify"]
+    assert configs["A"]["within_d"] and configs["A"]["hausdorff_mm"] <= configs["A"]["d_mm"]

@@ -12,9 +12,15 @@ Stages (timed separately, as in the paper's Table 2):
    loops are not simple polygons in its plane (a fold, a pinch, a line simplified into its
    neighbour) keeps its original elements, and its border lines are restored in every
    neighbour, so that no crack opens between them; this repeats until no subpatch fails.
+   Then fe2003's bound ``d`` is certified: every subpatch's one-sided distance to the new
+   surface is measured exactly, and a subpatch beyond the bound is regrown with half its fit
+   tolerance (stage 1 again for the changed borders), or, as a last resort, keeps its
+   original elements (see :func:`certified_triangles`).
 3. **textures** -- the atlas of the subpatch planes, the two-component normal map of the
-   original crease-split vertex normals (dilated at subpatch borders) and the wire-frame
-   distance texture of every original element.
+   original crease-split vertex normals (dilated at subpatch borders, coarser than the wire
+   texture by an integer factor) and the wire-frame distance texture of every original
+   element; elements the atlas scale leaves too narrow for the texture get their edges drawn
+   as lines.
 
 Everything is float64 and GL-free; the result is two :class:`TexturedSurface`: ``original``
 (every element, triangulated) and ``simplified``.
@@ -22,6 +28,7 @@ Everything is float64 and GL-free; the result is two :class:`TexturedSurface`: `
 
 from __future__ import annotations
 
+import hashlib
 import time
 from dataclasses import dataclass, field
 
@@ -29,18 +36,24 @@ import numpy as np
 
 from ...scene.derived import as_coords, as_elements, gouraud_split, triangulate
 from .atlas import build_atlas, plane_frames
+from .certify import subpatch_distance_bounds, subpatch_neighbours
 from .features import G0, feature_edges, patches, planar_subpatches
 from .lines import line_tolerance, simplify_polyline
 from .normalmap import dropped_axis
 from .polygon import polygon_area, triangulate_polygon
 from .surface import TexturedSurface
+from .wiretex import MIN_WIDTH
 
 __all__ = [
+    "PAPER_DISTANCE_RULE",
+    "PAPER_RULES",
+    "PAPER_TEXTURE_RULE",
     "PARAMETER_SETS",
     "FEModel",
     "FEPatchParams",
     "border_network",
     "build_model",
+    "certified_triangles",
     "parse_params",
     "simplified_triangles",
 ]
@@ -75,6 +88,16 @@ class FEPatchParams:
 PARAMETER_SETS = {"A": FEPatchParams(12.0, 1.0, 0.5, 8.0, "A"),
                   "B": FEPatchParams(18.0, 3.0, 2.5, 15.0, "B")}
 
+# build_model's keywords for the paper's own construction, which the defaults improve on:
+# the distance bound (subpatch nodes within d of their plane, not certified; the new surface
+# may lie up to 2d from the original) and the texture scale (the smallest element extent
+# spans 3 texels per axis, a full-resolution normal map, a 3-texel border)
+PAPER_DISTANCE_RULE = {"fit_share": 1.0, "certify": False}
+PAPER_TEXTURE_RULE = {"texels_per_edge": 3.0, "border": 3, "scale_quantile": 0.0,
+                      "scale_by": "extent", "atlas_turns": 1, "normal_reduction": 1,
+                      "min_width": None}
+PAPER_RULES = {**PAPER_DISTANCE_RULE, **PAPER_TEXTURE_RULE}
+
 
 def parse_params(spec) -> FEPatchParams:
     """``"A"``, ``"B"``, ``"alpha_g1,d,l_outer,l_inner"`` or an :class:`FEPatchParams`."""
@@ -97,8 +120,15 @@ def parse_params(spec) -> FEPatchParams:
 class FEModel:
     """The result of :func:`build_model`: both surfaces and what each stage did.
 
-    ``seconds`` per stage of :data:`STAGES`; ``subpatch`` (M,) labels; ``fallback`` the labels of
-    subpatches kept as original elements; counts of features, patches, lines and line nodes.
+    ``seconds`` per stage of :data:`STAGES` (the retriangulation includes certifying the
+    distance bound, ``certify_seconds`` of it); ``subpatch`` (M,) labels; ``fallback`` the
+    labels of subpatches kept as original elements; counts of features, patches, lines and line
+    nodes. ``fit_share``: subpatch fit tolerance over ``d``; ``distance_bound``: the largest
+    certified per-subpatch distance original → simplified (model units, NaN when not
+    certified), so the one-sided Hausdorff distance is at most it; ``split_subpatches`` and
+    ``kept_subpatches``: subpatches regrown or kept as original elements for the bound;
+    ``narrow_elements``: elements whose edges are drawn as lines because the atlas scale
+    leaves them narrower than the wire texture can outline.
     """
 
     params: FEPatchParams
@@ -115,6 +145,12 @@ class FEModel:
     fallback: np.ndarray
     atlas_size: tuple[int, int]
     seconds: dict = field(default_factory=dict)
+    fit_share: float = 1.0
+    distance_bound: float = np.nan
+    certify_seconds: float = 0.0
+    split_subpatches: int = 0
+    kept_subpatches: int = 0
+    narrow_elements: int = 0
 
     @property
     def rgba_texels_per_element(self) -> float:
@@ -256,8 +292,20 @@ def _labels_of(sig) -> tuple[int, ...]:
     return (lo, hi) + (-1,) * (count - 2)  # non-manifold: more than two subpatches
 
 
-def _simplify_lines(network: BorderNetwork, coords, frames, params) -> np.ndarray:
-    """(N,) bool: nodes removed from the line network.
+def _digest(*arrays) -> bytes:
+    """A digest of ``arrays``' shapes, types and contents, for memos of repeated work."""
+    h = hashlib.blake2b(digest_size=16)
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        h.update(f"{a.dtype.str}{a.shape}".encode())
+        h.update(a.tobytes())
+    return h.digest()
+
+
+def _simplify_lines(network: BorderNetwork, coords, frames, params, memo=None) -> np.ndarray:
+    """(N,) bool: nodes removed from the line network. ``memo``: a dict kept between calls on
+    the same coordinates and parameters; a line with the same nodes, fixed nodes, bound and
+    planes is not simplified again.
 
     Two lines between the same two fixed nodes would both become the same chord and close
     nothing: each of them keeps at least its node farthest from the chord. A line that returns
@@ -291,8 +339,17 @@ def _simplify_lines(network: BorderNetwork, coords, frames, params) -> np.ndarra
             fixed = np.zeros(len(nodes), bool)
             fixed[int(np.argmax(dist[1:-1])) + 1] = True
         planes = [(n, -float(n @ frames[s][0])) for n, s in zip(normals, labels)]
-        keep = simplify_polyline(points, tol, fixed=fixed, planes=planes, d=params.d,
-                                 closed=closed)
+        key = None
+        if memo is not None:
+            key = _digest(nodes, np.asarray(fixed if fixed is not None else [], bool),
+                          np.array([tol, float(closed), *(v for n, o in planes for v in (*n, o))]))
+        if key is not None and key in memo:
+            keep = memo[key]
+        else:
+            keep = simplify_polyline(points, tol, fixed=fixed, planes=planes, d=params.d,
+                                     closed=closed)
+            if key is not None:
+                memo[key] = keep
         gone = np.ones(len(nodes), bool)
         gone[keep] = False
         removed[nodes[gone]] = True
@@ -353,13 +410,27 @@ def _triangulate_subpatch(loops, removed, coords, frame) -> np.ndarray | None:
     return nodes[tri]
 
 
+def _memo_triangulation(loops, removed, coords, frame, memo):
+    """:func:`_triangulate_subpatch`, looked up in ``memo`` (a dict, or None) first."""
+    if memo is None:
+        return _triangulate_subpatch(loops, removed, coords, frame)
+    kept = [loop[~removed[loop]] for loop in loops]
+    key = _digest(np.array([len(k) for k in kept]), *kept, frame[0], frame[1])
+    if key not in memo:
+        memo[key] = _triangulate_subpatch(loops, removed, coords, frame)
+    return memo[key]
+
+
 def simplified_triangles(elements, coords, labels, network: BorderNetwork,
-                         removed: np.ndarray, frames,
-                         triangulation=None) -> tuple[dict, np.ndarray, np.ndarray]:
+                         removed: np.ndarray, frames, triangulation=None,
+                         keep=(), memo=None) -> tuple[dict, np.ndarray, np.ndarray]:
     """({label: (K, 3) node triangles}, fallback labels, final ``removed``): every subpatch
     retriangulated from its simplified border loops; those that fail keep their original
     element triangles and restore their border nodes, which re-triangulates the neighbours.
-    ``triangulation``: the elements' :func:`triangulate`, computed when not given.
+    ``triangulation``: the elements' :func:`triangulate`, computed when not given; ``keep``:
+    labels that keep their original elements from the start (their border nodes restored);
+    ``memo``: a dict kept between calls on the same coordinates, so that a subpatch with the
+    same simplified loops and plane is not triangulated again.
     """
     e = np.asarray(elements, np.int64)
     lab = np.asarray(labels, np.int64)
@@ -374,14 +445,17 @@ def simplified_triangles(elements, coords, labels, network: BorderNetwork,
             continue
         loops[s] = None if s in set(network.bad.tolist()) else _loops(d[bounds[s]:bounds[s + 1]])
     result: dict = {}
-    failed: set[int] = set()  # kept as original elements
+    failed = {int(s) for s in keep if int(s) in loops}  # kept as original elements
     restored: set[int] = set()  # border lines restored after a failure with simplified ones
-    todo = set(loops)
+    for s in failed:
+        nodes = np.unique(d[bounds[s]:bounds[s + 1], :2])
+        removed[nodes] = False
+    todo = set(loops) - failed
     while todo:
         new_fail = []
         for s in sorted(todo):
-            tri = None if loops[s] is None else _triangulate_subpatch(loops[s], removed, coords,
-                                                                    frames[s])
+            tri = None if loops[s] is None else _memo_triangulation(loops[s], removed, coords,
+                                                                  frames[s], memo)
             if tri is None:
                 new_fail.append(s)
             else:
@@ -413,6 +487,151 @@ def simplified_triangles(elements, coords, labels, network: BorderNetwork,
     return result, fallback, removed
 
 
+# --------------------------------------------------------------------------- distance bound
+@dataclass
+class CertifiedSurface:
+    """The simplified triangles of :func:`certified_triangles` and how they were certified.
+
+    ``labels`` (M,) final subpatch labels; ``triangles`` {label: (K, 3) node triangles};
+    ``fallback`` labels kept as original elements; ``removed`` (N,) bool line nodes left out;
+    ``network`` and ``frames`` of the final labels; ``bound`` the largest certified
+    per-subpatch distance (model units; NaN when not certified); ``rounds`` of splitting;
+    ``split`` subpatches split for the bound and ``kept`` subpatches that keep their original
+    elements for it; ``certify_seconds`` spent measuring.
+    """
+
+    labels: np.ndarray
+    triangles: dict
+    fallback: np.ndarray
+    removed: np.ndarray
+    network: BorderNetwork
+    frames: dict
+    bound: float
+    rounds: int
+    split: int
+    kept: int
+    certify_seconds: float
+
+
+def _lines_and_triangles(e, c, labels, params, triangulation, clock: dict, keep=(),
+                         memo=None):
+    """(network, frames, triangles, fallback, removed) of subpatch ``labels``; seconds are
+    added to ``clock`` under the first two :data:`STAGES`. ``memo``: {"lines": dict,
+    "triangles": dict} kept between calls (see :func:`_simplify_lines` and
+    :func:`simplified_triangles`), or None."""
+    memo = memo or {}
+    t0 = time.perf_counter()
+    frames = plane_frames(c, e, labels)
+    network = border_network(e, labels, len(c))
+    removed = _simplify_lines(network, c, frames, params, memo.get("lines"))
+    t1 = time.perf_counter()
+    tris, fallback, removed = simplified_triangles(e, c, labels, network, removed, frames,
+                                                   triangulation, keep=keep,
+                                                   memo=memo.get("triangles"))
+    clock[STAGES[0]] = clock.get(STAGES[0], 0.0) + t1 - t0
+    clock[STAGES[1]] = clock.get(STAGES[1], 0.0) + time.perf_counter() - t1
+    return network, frames, tris, fallback, removed
+
+
+def _split(e, c, labels, fit, bad) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """(labels, fit, unsplittable): every subpatch of ``bad`` regrown with half its fit
+    tolerance ``fit`` ((M,) per element, model units); subpatches that stay whole are listed
+    as unsplittable (by their new label) and keep their old tolerance."""
+    lab = np.asarray(labels, np.int64).copy()
+    fit = fit.copy()
+    whole = []
+    next_label = int(lab.max()) + 1
+    for s in bad:
+        sel = np.flatnonzero(lab == s)
+        parts = planar_subpatches(e[sel], c, np.zeros(len(sel), np.int64), 0.5 * fit[sel[0]])
+        if parts.max() == 0:
+            whole.append(sel[0])
+            continue
+        lab[sel] = next_label + parts
+        fit[sel] *= 0.5
+        next_label += int(parts.max()) + 1
+    renumbered = unpinched(e, lab, len(c))
+    return renumbered, fit, [int(renumbered[k]) for k in whole]
+
+
+def certified_triangles(e, c, patch_labels, params: FEPatchParams, triangulation, *,
+                        fit_share: float = 1.0, certify: bool = True,
+                        max_splits: int = 3, tol_share: float = 0.01,
+                        clock: dict | None = None) -> CertifiedSurface:
+    """Subpatches, simplified lines and retriangulation whose one-sided distance from the
+    original surface is certified within ``params.d``.
+
+    Subpatches grow with the fit tolerance ``fit_share · d`` (the paper's rule is
+    ``fit_share`` = 1: nodes within ``d`` on either side of the plane, so that the new surface,
+    which spans only the border nodes, may lie up to 2d from the interior). With ``certify``,
+    every subpatch is then measured
+    (:func:`~workbench.algo.fepatch.certify.subpatch_distance_bounds`, exact, bracket width
+    ``tol_share · d``) and each one whose certified bound exceeds
+    ``(1 − tol_share) · d`` is regrown with half its tolerance, for up to ``max_splits`` rounds;
+    a subpatch still above after that, or one that does not split (a single element, or one
+    already within half the tolerance), keeps its original elements (distance 0), and the
+    neighbours that changed with it are measured again. So the returned surface has
+    ``bound <= (1 − tol_share) · d``: an independent certificate with a bracket up to
+    ``tol_share · d`` wide still finds it within ``d``.
+
+    ``e`` (M, 4) int64, ``c`` (N, 3) float64 model units, ``patch_labels`` (M,)
+    feature-divided patches; ``triangulation`` the elements' :func:`triangulate`. ``clock``
+    (a dict) receives seconds: subpatch growth, splitting and lines under ``STAGES[0]``,
+    retriangulation under ``STAGES[1]`` and measuring under "certification". Refuses
+    ``fit_share`` outside (0, 1] and ``tol_share`` outside (0, 1).
+    """
+    if not 0.0 < fit_share <= 1.0:
+        raise ValueError(f"fit_share must be in (0, 1], got {fit_share!r}")
+    clock = {} if clock is None else clock
+    d = params.d
+    fit = np.full(len(e), d * fit_share)
+    t0 = time.perf_counter()
+    labels = unpinched(e, planar_subpatches(e, c, patch_labels, d * fit_share), len(c))
+    clock[STAGES[0]] = clock.get(STAGES[0], 0.0) + time.perf_counter() - t0
+    memo = {"lines": {}, "triangles": {}}  # the work of rounds before, for the next
+    network, frames, tris, fallback, removed = _lines_and_triangles(e, c, labels, params,
+                                                                    triangulation, clock,
+                                                                    memo=memo)
+    if not certify:
+        return CertifiedSurface(labels, tris, fallback, removed, network, frames, np.nan, 0,
+                                0, 0, 0.0)
+    if not 0.0 < tol_share < 1.0:
+        raise ValueError(f"tol_share must be in (0, 1), got {tol_share!r}")
+    cache: dict = {}
+    tol = tol_share * d if d > 0 else 1e-12
+    accept = (1.0 - tol_share) * d
+    keep: set[int] = set()
+    rounds = split = 0
+    seconds = 0.0
+    while True:
+        t0 = time.perf_counter()
+        bounds = subpatch_distance_bounds(
+            c, triangulation.triangles, labels[triangulation.element_of], tris, sorted(tris),
+            subpatch_neighbours(e, labels), tol, cache)
+        seconds += time.perf_counter() - t0
+        bad = sorted(s for s, b in bounds.items() if b > accept)
+        if not bad:
+            break
+        t0 = time.perf_counter()
+        if rounds < max_splits:
+            rounds += 1
+            old = labels
+            labels, fit, whole = _split(e, c, labels, fit, bad)
+            split += len(bad) - len(whole)
+            # a kept subpatch stays kept under its new label
+            kept_elements = np.isin(old, list(keep))
+            keep = set(np.unique(labels[kept_elements]).tolist()) | set(whole)
+        else:
+            keep |= set(bad)
+        clock[STAGES[0]] = clock.get(STAGES[0], 0.0) + time.perf_counter() - t0
+        network, frames, tris, fallback, removed = _lines_and_triangles(
+            e, c, labels, params, triangulation, clock, keep=sorted(keep), memo=memo)
+    clock["certification"] = seconds
+    return CertifiedSurface(labels, tris, fallback, removed, network, frames,
+                            max(bounds.values(), default=0.0), rounds, split, len(keep),
+                            seconds)
+
+
 # --------------------------------------------------------------------------- textures
 def _corner_normals(e: np.ndarray, coords: np.ndarray, crease_deg: float,
                     plane_normal: np.ndarray, triangulation) -> np.ndarray:
@@ -427,18 +646,37 @@ def _corner_normals(e: np.ndarray, coords: np.ndarray, crease_deg: float,
     return n
 
 
-def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, border: int = 3,
-                wire_range: float = 2.0, atlas_scale: str = "subpatch") -> FEModel:
+def build_model(elements, coords, params="A", *, texels_per_edge: float = 2.5, border: int = 2,
+                wire_range: float = 2.0, atlas_scale: str = "subpatch", fit_share: float = 1.0,
+                certify: bool = True, scale_quantile: float = 0.02, normal_reduction: int = 2,
+                min_width: float | None = MIN_WIDTH, scale_by: str = "width",
+                atlas_turns: int = 8) -> FEModel:
     """Run every stage on ``elements`` (M, 4) and ``coords`` (N, 3) float64 (model units).
 
     ``params``: see :func:`parse_params`. ``texels_per_edge``: texels across the smallest element
-    (the paper's Nyquist rule asks for 2; the wire texture's outlines stay whole from about 3,
-    see :mod:`workbench.algo.fepatch.wiretex`); ``border``: texels around each subpatch in the
-    atlas (the wire texture's ring and the normal map's dilation); ``atlas_scale``: "subpatch" (one scale per subpatch and axis, as the
-    paper) or "global". Refuses empty meshes and non-finite coordinates.
+    along each plane axis, or across the ``scale_quantile`` one (the paper's Nyquist rule asks
+    for 2; the wire texture's outlines stay whole from about 2 texels of element width, see
+    :mod:`workbench.algo.fepatch.wiretex`); ``border``: texels around each subpatch in the
+    atlas (the wire texture's ring and the normal map's dilation); ``atlas_scale``:
+    "subpatch" (one scale per subpatch and axis, as the paper) or "global".
+
+    Distance bound: ``fit_share`` and ``certify``, the subpatch fit tolerance over ``d`` and
+    the check-and-repair of the bound, see :func:`certified_triangles` (the paper's
+    construction is :data:`PAPER_DISTANCE_RULE`).
+
+    Texture memory: ``scale_quantile`` q makes the q-quantile of a subpatch's element extents
+    (``scale_by`` "extent") or widths ("width"), not the smallest, span ``texels_per_edge``
+    (see :func:`build_atlas`); every element narrower than ``min_width`` texels at that scale
+    (:func:`element_widths`) has its edges drawn as lines, so that its outline shows although
+    the texture cannot hold it (None: no such lines). ``atlas_turns``: in-plane turns of each
+    subpatch's axes tried for the smallest rectangle (see :func:`build_atlas`).
+    ``normal_reduction`` (a positive integer) makes the normal map that many times coarser per
+    axis than the wire texture; both share the texture coordinates (the atlas size is a
+    multiple of it). The paper's rule is
+    :data:`PAPER_TEXTURE_RULE`. Refuses empty meshes and non-finite coordinates.
     """
     from .bake import normal_map
-    from .wiretex import checkerboard, wire_texture
+    from .wiretex import checkerboard, element_widths, wire_texture
 
     p = parse_params(params)
     e = as_elements(elements).astype(np.int64)
@@ -451,20 +689,21 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
     t0 = time.perf_counter()
     fe = feature_edges(e, c, p.alpha_g1_deg)
     patch = patches(e, fe)
-    sub = unpinched(e, planar_subpatches(e, c, patch, p.d), len(c))
-    frames = plane_frames(c, e, sub)
-    network = border_network(e, sub, len(c))
-    removed = _simplify_lines(network, c, frames, p)
-    seconds[STAGES[0]] = time.perf_counter() - t0
+    clock = {STAGES[0]: time.perf_counter() - t0}
+    cert = certified_triangles(e, c, patch, p, orig_tri, fit_share=fit_share, certify=certify,
+                               clock=clock)
+    sub, frames, network = cert.labels, cert.frames, cert.network
+    tris, fallback, removed = cert.triangles, cert.fallback, cert.removed
+    seconds[STAGES[0]] = clock[STAGES[0]]
+    seconds[STAGES[1]] = clock[STAGES[1]] + clock.get("certification", 0.0)
 
     t0 = time.perf_counter()
-    tris, fallback, removed = simplified_triangles(e, c, sub, network, removed, frames,
-                                                   orig_tri)
-    seconds[STAGES[1]] = time.perf_counter() - t0
-
-    t0 = time.perf_counter()
+    if int(normal_reduction) != normal_reduction or normal_reduction < 1:
+        raise ValueError(f"normal_reduction must be a positive integer, got {normal_reduction!r}")
+    reduction = int(normal_reduction)
     atlas = build_atlas(c, e, sub, texels_per_edge=texels_per_edge, border=border,
-                        per_subpatch=atlas_scale == "subpatch")
+                        per_subpatch=atlas_scale == "subpatch", quantile=scale_quantile,
+                        multiple=reduction, scale_by=scale_by, turns=atlas_turns)
     labels = sorted(atlas.uv)
     # vertices: one per (subpatch, node) of the atlas
     vnodes = [atlas.uv[s][0] for s in labels]
@@ -488,15 +727,20 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
     vertex_normals = np.zeros((len(node_of), 3))
     vertex_normals[corner_vertex.ravel()] = corner_n.reshape(-1, 3)
     size = atlas.size
-    nmap = normal_map(corners_uv, corner_n, axis_of_label[sub], size, dilate=border)
+    nmap = normal_map(corners_uv / reduction, corner_n, axis_of_label[sub],
+                      (size[0] // reduction, size[1] // reduction),
+                      dilate=max(1, -(-border // reduction)))
     colour, line_nodes = checkerboard(e)
     wmap = wire_texture(corners_uv, colour, size, wire_range=wire_range)
+    narrow = np.zeros(len(e), bool) if min_width is None else \
+        element_widths(corners_uv) < min_width
     seconds[STAGES[2]] = time.perf_counter() - t0
 
-    # the line pass: edges the texture cannot show (same-colour neighbours) and the outer
-    # boundary, whose outline the texture could draw only on its inner half
+    # the line pass: edges the texture cannot show (same-colour neighbours, elements too narrow
+    # at the atlas scale) and the outer boundary, whose outline the texture could draw only on
+    # its inner half
     line_nodes = np.concatenate([np.asarray(line_nodes, np.int64).reshape(-1, 2),
-                                 fe.of_kind(G0).astype(np.int64)])
+                                 fe.of_kind(G0).astype(np.int64), _element_edges(e[narrow])])
     line_edges = _edge_vertices(e, corner_vertex, line_nodes, len(c))
     original = TexturedSurface(
         positions=c[node_of], triangles=_element_triangles(corner_vertex, orig_tri),
@@ -519,7 +763,16 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
         n_patches=int(patch.max()) + 1, n_subpatches=int(sub.max()) + 1,
         features=fe.counts(), line_nodes=len(on_lines),
         line_nodes_kept=int(len(on_lines) - removed[on_lines].sum()), n_lines=len(network.lines),
-        fallback=fallback, atlas_size=size, seconds=seconds)
+        fallback=fallback, atlas_size=size, seconds=seconds, fit_share=float(fit_share),
+        distance_bound=cert.bound, certify_seconds=cert.certify_seconds,
+        split_subpatches=cert.split, kept_subpatches=cert.kept,
+        narrow_elements=int(narrow.sum()))
+
+
+def _element_edges(e: np.ndarray) -> np.ndarray:
+    """(K, 2) node pairs of the non-degenerate edges of elements ``e`` (M, 4)."""
+    pairs = np.stack([e, np.roll(e, -1, axis=1)], axis=2).reshape(-1, 2).astype(np.int64)
+    return pairs[pairs[:, 0] != pairs[:, 1]]
 
 
 def _edge_vertices(e: np.ndarray, corner_vertex: np.ndarray, pairs: np.ndarray,

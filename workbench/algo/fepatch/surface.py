@@ -9,7 +9,8 @@ Texture conventions (shared with the shaders):
 
 * ``uv`` is in texel units: texel (row i, column j) has its centre at (j + ½, i + ½); the GL
   texture coordinate is ``uv / (W, H)`` with row 0 of the arrays uploaded first.
-* ``normal_map`` (H, W, 2) uint8 holds two components of the unit normal in model coordinates,
+* ``normal_map`` (H/k, W/k, 2) uint8, k a positive integer (the normal map may be coarser than
+  the wire map; both are sampled at ``uv / (W, H)``, the wire map's size), holds two components of the unit normal in model coordinates,
   ``q = round((c + 1)·127.5)``, see :mod:`workbench.algo.fepatch.normalmap`; the vertex's
   ``normal_axis`` says which component was dropped (0, 1, 2) and is restored as the positive
   square root.
@@ -84,9 +85,11 @@ class TexturedSurface:
                     raise ValueError(f"{name} must be (H, W, {channels}) uint8, got "
                                      f"{tex.shape} {tex.dtype}")
                 setattr(self, name, tex)
-        if self.normal_map is not None and self.wire_map is not None and \
-                self.normal_map.shape[:2] != self.wire_map.shape[:2]:
-            raise ValueError("normal_map and wire_map must share the atlas size")
+        if self.normal_map is not None and self.wire_map is not None:
+            (nh, nw), (wh, ww) = self.normal_map.shape[:2], self.wire_map.shape[:2]
+            if ww % nw or wh % nh or ww // nw != wh // nh:
+                raise ValueError("the wire_map size must be the normal_map size times one "
+                                 f"integer for both axes, got {ww}x{wh} and {nw}x{nh}")
         if self.line_edges is None:
             self.line_edges = np.zeros((0, 2), np.int32)
         self.line_edges = np.asarray(self.line_edges, np.int32).reshape(-1, 2)
@@ -95,7 +98,8 @@ class TexturedSurface:
 
     @property
     def size(self) -> tuple[int, int] | None:
-        """(W, H) of the atlas, None without textures."""
+        """(W, H) of the atlas, the wire map's where there is one (``uv`` is in its texels);
+        None without textures."""
         tex = self.wire_map if self.wire_map is not None else self.normal_map
         return None if tex is None else (tex.shape[1], tex.shape[0])
 

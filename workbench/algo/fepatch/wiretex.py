@@ -20,7 +20,9 @@ Where elements of one pair meet (diagonal neighbours on a grid), a texel inside 
 that element's values and a texel outside all of them the smallest value per channel among those
 that reach it: a channel is then positive only inside the strip of an element's own edges, and
 the diagonal neighbours' fields never make a zero crossing between them. This needs elements
-about three texels across; at two, the rings of opposite edges overlap and outlines break up.
+about two and a half texels wide (:data:`MIN_WIDTH`, an element's smaller height,
+:func:`element_widths`); narrower, the rings of opposite edges overlap and outlines break up,
+first near acute corners.
 
 A triangle (a, b, c, c) has edges ab and ca in the first channel and bc alone in the second; the
 two lines in the first channel meet at a, where the bilinear lookup rounds the corner slightly.
@@ -37,11 +39,16 @@ from numba import njit
 
 from workbench.algo.fepatch.surface import WIRE_PAIRS
 
-__all__ = ["RING", "WIRE_RANGE", "checkerboard", "decode_wire", "on_outline", "wire_texture"]
+__all__ = ["MIN_WIDTH", "RING", "WIRE_RANGE", "checkerboard", "decode_wire", "element_widths",
+           "on_outline", "wire_texture"]
 
 RING = 1.5  # texels written outside an element: a bilinear lookup across its edges needs > 1
 WIRE_RANGE = 2.0  # texels of byte 0 / 255
 _DEGENERATE = 1e-9  # texels: an edge shorter than this is a repeated corner
+# texels: elements at least this wide (some corner this far from each edge's line) decode their
+# whole outline on sheared and graded meshes; at 2 a sheared element's acute corners already
+# lose parts of it. Narrower ones are drawn as lines where the texture scale leaves them so.
+MIN_WIDTH = 2.5
 
 
 def _edge_table(elements: np.ndarray):
@@ -158,6 +165,23 @@ def _edge_lines(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     ny = d[:, :, 0] / safe * sign
     off = -(nx * start[:, :, 0] + ny * start[:, :, 1])
     return np.stack([nx, ny, off], axis=2), valid
+
+
+def element_widths(corners_uv) -> np.ndarray:
+    """(M,) float64 width of each element in texels: the smallest, over its edges, of the
+    largest distance of its corners from the edge's line (a parallelogram's smaller height, a
+    triangle's smallest height). ``corners_uv`` (M, 4, 2) in texel units; a triangle repeats a
+    corner, whose zero-length edge is no edge. Elements with fewer than two edges get 0.
+    Refuses bad shapes and non-finite corners."""
+    c = _check_corners(corners_uv)
+    d = np.roll(c, -1, axis=1) - c
+    length = np.linalg.norm(d, axis=2)
+    edge = length > _DEGENERATE
+    n = np.stack([-d[..., 1], d[..., 0]], axis=-1) / np.where(edge, length, 1.0)[..., None]
+    # distance of corner i from the line of edge k: |n_k · (c_i − c_k)|
+    dist = np.abs(np.einsum("mkj,mij->mki", n, c) - np.einsum("mkj,mkj->mk", n, c)[..., None])
+    height = np.where(edge, dist.max(axis=2), np.inf).min(axis=1)
+    return np.where(edge.sum(axis=1) >= 2, height, 0.0)
 
 
 @njit(cache=True)
