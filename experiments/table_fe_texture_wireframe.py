@@ -247,18 +247,19 @@ def sweep_configs(quick: bool) -> list[tuple[str, FEPatchParams, dict]]:
                ("A, paper rules", a, PAPER_RULES),
                ("A, paper texture rule", a, PAPER_TEXTURE_RULE),
                ("A, d/2 fit, not certified", a, {"fit_share": 0.5, "certify": False}),
-               ("A, width 2.5 q0.1", a, {"scale_quantile": 0.1}),
+               ("A, width 3 q0.1", a, {"scale_quantile": 0.1}),
+               ("A, width 2.5 q0.02", a, {"texels_per_edge": 2.5, "min_width": 2.5}),
                ("A, width 2 q0.1, no narrow lines", a, {"texels_per_edge": 2.0,
                                                        "scale_quantile": 0.1,
                                                        "min_width": None}),
-               ("A, width 3 q0", a, {"texels_per_edge": 3.0, "scale_quantile": 0.0}),
-               ("A, extent 2.5", a, {"scale_by": "extent"}),
+               ("A, width 3 q0", a, {"scale_quantile": 0.0}),
+               ("A, extent 3", a, {"scale_by": "extent"}),
                ("A, no turns", a, {"atlas_turns": 1}),
                ("A, normal map 1/1", a, {"normal_reduction": 1}),
                ("A, normal map 1/4", a, {"normal_reduction": 4})]
     if not quick:
         configs += [("Ax2", scaled(a, 2.0), {}), ("A/4", scaled(a, 0.25), {}),
-                    ("A, width 2.5 q0.3", a, {"scale_quantile": 0.3}),
+                    ("A, width 3 q0.3", a, {"scale_quantile": 0.3}),
                     ("A, width 2 q0.3, no narrow lines", a, {"texels_per_edge": 2.0,
                                                             "scale_quantile": 0.3,
                                                             "min_width": None})]

@@ -646,7 +646,7 @@ def _corner_normals(e: np.ndarray, coords: np.ndarray, crease_deg: float,
     return n
 
 
-def build_model(elements, coords, params="A", *, texels_per_edge: float = 2.5, border: int = 2,
+def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, border: int = 2,
                 wire_range: float = 2.0, atlas_scale: str = "subpatch", fit_share: float = 1.0,
                 certify: bool = True, scale_quantile: float = 0.02, normal_reduction: int = 2,
                 min_width: float | None = MIN_WIDTH, scale_by: str = "width",
@@ -655,8 +655,8 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 2.5, b
 
     ``params``: see :func:`parse_params`. ``texels_per_edge``: texels across the smallest element
     along each plane axis, or across the ``scale_quantile`` one (the paper's Nyquist rule asks
-    for 2; the wire texture's outlines stay whole from about 2 texels of element width, see
-    :mod:`workbench.algo.fepatch.wiretex`); ``border``: texels around each subpatch in the
+    for 2; the wire texture's outlines stay whole, magnified too, from about 3 texels of
+    width, see :mod:`workbench.algo.fepatch.wiretex`); ``border``: texels around each subpatch in the
     atlas (the wire texture's ring and the normal map's dilation); ``atlas_scale``:
     "subpatch" (one scale per subpatch and axis, as the paper) or "global".
 

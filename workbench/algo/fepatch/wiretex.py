@@ -20,9 +20,10 @@ Where elements of one pair meet (diagonal neighbours on a grid), a texel inside 
 that element's values and a texel outside all of them the smallest value per channel among those
 that reach it: a channel is then positive only inside the strip of an element's own edges, and
 the diagonal neighbours' fields never make a zero crossing between them. This needs elements
-about two and a half texels wide (:data:`MIN_WIDTH`, an element's smaller height,
-:func:`element_widths`); narrower, the rings of opposite edges overlap and outlines break up,
-first near acute corners.
+about three texels wide (:data:`MIN_WIDTH`, an element's smaller height,
+:func:`element_widths`); narrower, the rings of opposite edges overlap and outlines break up:
+at two and a half texels the outline still decodes at the texel centres, but a magnified view
+shows interior lines doubled and broken between the nodes.
 
 A triangle (a, b, c, c) has edges ab and ca in the first channel and bc alone in the second; the
 two lines in the first channel meet at a, where the bilinear lookup rounds the corner slightly.
@@ -45,10 +46,11 @@ __all__ = ["MIN_WIDTH", "RING", "WIRE_RANGE", "checkerboard", "decode_wire", "el
 RING = 1.5  # texels written outside an element: a bilinear lookup across its edges needs > 1
 WIRE_RANGE = 2.0  # texels of byte 0 / 255
 _DEGENERATE = 1e-9  # texels: an edge shorter than this is a repeated corner
-# texels: elements at least this wide (some corner this far from each edge's line) decode their
-# whole outline on sheared and graded meshes; at 2 a sheared element's acute corners already
-# lose parts of it. Narrower ones are drawn as lines where the texture scale leaves them so.
-MIN_WIDTH = 2.5
+# texels: elements at least this wide (some corner this far from each edge's line) keep their
+# whole outline, magnified too; at 2.5 the texel centres still decode it but a magnified view
+# breaks interior lines, at 2 a sheared element's acute corners lose parts of it. Narrower
+# elements are drawn as lines where the texture scale leaves them so.
+MIN_WIDTH = 3.0
 
 
 def _edge_table(elements: np.ndarray):
