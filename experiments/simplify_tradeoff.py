@@ -2,9 +2,16 @@
 
 **Trade-off table** (``table.md``): for every mesh of the suite, our decimator
 (:func:`workbench.algo.simplify.hausdorff_decimate`, per part, tolerance a share of each part's
-bounding-sphere diameter) at several tolerances, and at each of our triangle counts pymeshlab's
-quadric edge collapse, libigl's ``qslim`` and ``decimate``, open3d's quadric decimation and
-meshoptimizer's ``simplify``. Every result is measured with the certified metric
+bounding-sphere diameter) at several tolerances -- with shared vertices sliding along the common
+boundary of two parts (the default) and, for reference, locked -- and at each of our triangle
+counts pymeshlab's quadric edge collapse (also with its vertices kept), libigl's ``qslim`` and
+``decimate``, open3d's quadric decimation and meshoptimizer's ``simplify``, each run two ways:
+on the whole mesh (free to collapse across part borders) and per part (each part asked for our
+count of that part) with the part borders locked where the tool can lock them (see
+:mod:`workbench.experiment.simplifiers`). Every row states its constraints (``scope``,
+``borders``, ``vertices`` kept or moved), the share of the parts' border vertices it kept in
+place, and ``stopped_at`` when the tool could not reach our count. Every result is measured
+with the certified metric
 (:func:`workbench.algo.hausdorff.hausdorff`): the one-sided distance original → simplified as a
 bracket ``lower ≤ H ≤ upper`` (model units and % of the bounding-box diagonal), the symmetric
 distance, and pymeshlab's sampled one-sided value beside it, flagged when it falls outside the
@@ -16,8 +23,15 @@ our bracket and time at several bracket widths beside pymeshlab's sampled value 
 and 1 M samples, libigl's ``hausdorff`` and open3d's float32 distance, each flagged when outside
 our bracket.
 
+**Equal-error table** (``equal_error.md``, figure ``equal_error.png``): the other view of the
+trade-off. At tolerances from 0.05 % to 2 % of each part's bounding-sphere diameter, our
+triangles and certified one-sided distance E (exact metric, original → simplified, whole mesh),
+and for each peer, whole mesh and per part, the fewest triangles it needs for a certified
+distance ≤ E, found by bisection on its target count (per part, each part's share of the count
+is ours). Also our decimator without feature lines, at its own distance.
+
 Figures (``<mesh>_tradeoff.png``): one-sided Hausdorff against triangles and against time, one
-line per method, log axes.
+line per method and scope, log axes.
 
 Run: ``workbench run simplify_tradeoff [--quick]`` or
 ``python experiments/simplify_tradeoff.py [--quick]``.
@@ -36,8 +50,10 @@ from workbench.algo.hausdorff import hausdorff
 from workbench.algo.simplify import hausdorff_decimate
 from workbench.data import CAR_DECK, D3PLOT, shared_file
 from workbench.experiment.registry import experiment, main
-from workbench.experiment.simplifiers import (SIMPLIFIERS, igl_hausdorff, open3d_distances,
-                                              pymeshlab_hausdorff, simplify_with)
+from workbench.experiment.simplifiers import (PART_SIMPLIFIERS, SIMPLIFIERS, igl_hausdorff,
+                                              open3d_distances, part_border_vertices,
+                                              pymeshlab_hausdorff, simplify_per_part,
+                                              simplify_with)
 from workbench.experiment.tables import atomic_open, write_table
 from workbench.scene import generators
 from workbench.scene.builtin import builtin_scene
@@ -142,41 +158,271 @@ def per_part_check(model: Model, decimation) -> float:
     return worst
 
 
+OURS = "ours (Hausdorff-bounded)"
+OURS_LOCKED = "ours, shared vertices locked"
+OURS_NO_FEATURES = "ours, no feature lines"
+# the constraints each of our rows ran under: scope, part borders, vertices. Border vertices
+# slide along their border (open boundary and, by default, the common boundary of two parts in
+# both parts at once); corners and vertices of three or more parts stay
+OURS_CONSTRAINTS = {OURS: ("per part", "slide (shared: in both parts)", "kept"),
+                    OURS_LOCKED: ("per part", "slide (shared: locked)", "kept")}
+
+
+def present_share(v_in: np.ndarray, ids: np.ndarray, v_out: np.ndarray,
+                  f_out: np.ndarray) -> float:
+    """Share of the input vertices ``ids`` that a result still uses at exactly their input
+    coordinates (1.0 when there are none)."""
+    if not len(ids):
+        return 1.0
+    fields = [("x", "f8"), ("y", "f8"), ("z", "f8")]
+    used = np.ascontiguousarray(np.asarray(v_out, np.float64)[np.unique(f_out)])
+    used = used.view(fields).ravel()
+    wanted = np.ascontiguousarray(v_in[ids], np.float64).view(fields).ravel()
+    return float(np.isin(wanted, used).mean())
+
+
+def reached(target: int, triangles: int) -> bool:
+    """Whether a tool reached a target count (within 1 %, at least one triangle)."""
+    return triangles <= target + max(1, target // 100)
+
+
+def part_targets(model: Model, decimation) -> dict:
+    """Our triangle count of each part: what a per-part peer is asked for at equal count."""
+    return {int(p): int((decimation.parts == p).sum()) for p in np.unique(model.parts)}
+
+
+def ours_row(model: Model, method: str, pct: float, samples: int, bracket: float,
+             borders: np.ndarray):
+    """Our decimation at ``pct`` % and its row (constraints, count, distances, per-part check)."""
+    ours = hausdorff_decimate(model.vertices, model.triangles, pct / 100.0, relative=True,
+                              parts=model.parts, slide_shared=(method == OURS))
+    scope, border_rule, kept = OURS_CONSTRAINTS[method]
+    row = dict(mesh=model.label, method=method, scope=scope, borders=border_rule, vertices=kept,
+               tol_pct=pct, input_triangles=len(model.triangles),
+               triangles=len(ours.triangles), seconds=ours.seconds,
+               certified_max=ours.certified_max,
+               within_tol_per_part=per_part_check(model, ours),
+               border_vertices_kept=present_share(model.vertices, borders, model.vertices,
+                                                  ours.triangles),
+               bytes_saved_by_sharing=ours.bytes_saved,
+               **measure(model, model.vertices, ours.triangles, samples, bracket))
+    return ours, row
+
+
+def peer_row(model: Model, out, target: int, pct: float, samples: int, bracket: float,
+             borders: np.ndarray) -> dict:
+    """A reference simplifier's row at our count ``target``: its constraints, the count it
+    reached (``stopped_at`` when it could not reach ours), distances."""
+    row = dict(mesh=model.label, method=out.method, scope=out.scope, borders=out.borders,
+               vertices=out.vertices_kept, tol_pct=pct, input_triangles=len(model.triangles),
+               target_triangles=target, triangles=len(out.triangles),
+               stopped_at=(None if out.failure or reached(target, len(out.triangles))
+                           else len(out.triangles)),
+               seconds=out.seconds, failure=out.failure,
+               border_vertices_kept=(present_share(model.vertices, borders, out.vertices,
+                                                   out.triangles) if not out.failure else None),
+               bytes_saved_by_sharing=(out.vertices.nbytes if out.shares_vertices else 0))
+    row.update(measure(model, out.vertices, out.triangles, samples, bracket))
+    return row
+
+
 def tradeoff_rows(model: Model, tolerances, samples: int, say) -> list[dict]:
+    """At each tolerance: ours (shared borders sliding, and locked for reference), then every
+    peer at our triangle count on the whole mesh (part borders free) and per part (each part
+    asked for our count of that part, under the tool's border constraint)."""
+    rows = []
+    diag = _diagonal(model.vertices, model.triangles)
+    bracket = BRACKET_REL * diag
+    borders = part_border_vertices(model.triangles, model.parts)
+    for pct in tolerances:
+        ours, row = ours_row(model, OURS, pct, samples, bracket, borders)
+        target = len(ours.triangles)
+        rows.append(row)
+        say(f"  {model.label} ours {pct} %: {target} triangles in {ours.seconds:.2f} s, "
+            f"H ≤ {row['h_upper']:.4g}")
+        _, row = ours_row(model, OURS_LOCKED, pct, samples, bracket, borders)
+        rows.append(row)
+        say(f"  {model.label} ours locked {pct} %: {row['triangles']} triangles, "
+            f"H ≤ {row['h_upper']:.4g}")
+        targets = part_targets(model, ours)
+        runs = [simplify_with(method, model.vertices, model.triangles, target)
+                for method in SIMPLIFIERS]
+        runs += [simplify_per_part(method, model.vertices, model.triangles, model.parts, targets)
+                 for method in PART_SIMPLIFIERS]
+        for out in runs:
+            row = peer_row(model, out, target, pct, samples, bracket, borders)
+            rows.append(row)
+            say(f"  {model.label} {out.method} ({out.scope}): {len(out.triangles)} triangles in "
+                f"{out.seconds:.2f} s" + (f" ({out.failure})" if out.failure
+                                           else f", H ≤ {row.get('h_upper', 0):.4g}"))
+    ours_rows = {r["tol_pct"]: r for r in rows if r["method"] == OURS}
+    for r in rows:
+        mine = ours_rows[r["tol_pct"]]
+        if r["method"] != OURS and r.get("h_upper"):
+            r["h_over_ours"] = r["h_lower"] / mine["h_upper"]
+            r["time_over_ours"] = r["seconds"] / mine["seconds"]
+    return rows
+
+
+# --------------------------------------------------------------------------- equal error
+SWEEP_PCT = (0.05, 0.1, 0.25, 0.5, 1.0, 2.0)
+QUICK_SWEEP_PCT = (0.5,)
+SEARCH_STEP = 0.02   # the count search stops when its bracket is within 2 % of the count
+SEARCH_BRACKET = 1e-3  # metric bracket width for the search's decisions, share of the error
+SEARCH_FLOOR_REL = 1e-6  # smallest error searched for, share of the bounding-box diagonal
+
+
+def sweep_models(quick: bool, say):
+    """The meshes of the equal-error sweep: the car deck and the small generated meshes (a
+    search runs a peer and the exact metric some ten times per point); quick: the car deck,
+    or the panels without it."""
+    if shared_file(CAR_DECK) is not None:
+        yield _from_mesh("car (per part)", builtin_scene("car"))
+    else:
+        say(f"car skipped in the sweep: {CAR_DECK} not found")
+        if quick:
+            yield _from_mesh("stamped panels", generators.stamped_panels(2_215))
+    if not quick:
+        yield _from_mesh("stamped panels", generators.stamped_panels(2_215))
+        yield _from_mesh("semicylinders", generators.semicylinders(n=16))
+
+
+def peer_runner(model: Model, method: str, scope: str, shares: dict):
+    """A function count → Simplified for one peer: the whole mesh, or per part with the count
+    shared out as ``shares`` (part → share of the total, ours at the same error)."""
+    if scope == "whole mesh":
+        return lambda n: simplify_with(method, model.vertices, model.triangles, n)
+
+    def per_part(n):
+        targets = {p: max(1, int(round(n * share))) for p, share in shares.items()}
+        return simplify_per_part(method, model.vertices, model.triangles, model.parts, targets)
+    return per_part
+
+
+def fewest_triangles_within(model: Model, run, error: float) -> dict:
+    """Search the target count (bisection on its logarithm) for the fewest triangles whose
+    certified one-sided distance (upper bound of the exact metric) is ≤ ``error``. Returns the
+    count reached, its distance, the number of tool runs, and ``failure`` when even the input
+    count does not get within ``error``."""
+    k = len(model.triangles)
+    calls = 0
+
+    def within(n):
+        nonlocal calls
+        calls += 1
+        out = run(n)
+        if out.failure or not len(out.triangles):
+            return False, out, None
+        h = hausdorff(model.vertices, model.triangles, out.vertices, out.triangles,
+                      tol=SEARCH_BRACKET * error)
+        return h.upper <= error, out, h.upper
+
+    ok, best, best_h = within(k)
+    if not ok:
+        return dict(triangles=len(best.triangles), h_upper=best_h, calls=calls,
+                    failure=best.failure or "not within the error even at the input count")
+    lo, hi = 1, k
+    while hi - lo > max(1, SEARCH_STEP * hi):
+        mid = max(lo + 1, min(hi - 1, int(round(np.sqrt(lo * hi)))))
+        ok, out, h = within(mid)
+        if ok:
+            hi, best, best_h = mid, out, h
+        else:
+            lo = mid
+    return dict(triangles=len(best.triangles), h_upper=best_h, calls=calls, failure=None,
+                seconds=best.seconds, scope=best.scope, borders=best.borders,
+                vertices=best.vertices_kept)
+
+
+def equal_error_rows(model: Model, tolerances, say) -> list[dict]:
+    """At each tolerance our triangles and certified distance E (exact metric, original →
+    simplified, whole mesh; at least 1e-6 of the diagonal), then for every peer (whole mesh, and per part with each part's
+    share of the count as ours) the fewest triangles it needs for a distance ≤ E."""
     rows = []
     diag = _diagonal(model.vertices, model.triangles)
     for pct in tolerances:
         ours = hausdorff_decimate(model.vertices, model.triangles, pct / 100.0, relative=True,
                                   parts=model.parts)
-        target = len(ours.triangles)
-        bracket = BRACKET_REL * diag
-        row = dict(mesh=model.label, method="ours (Hausdorff-bounded)", tol_pct=pct,
-                   input_triangles=len(model.triangles), triangles=target,
-                   seconds=ours.seconds, certified_max=ours.certified_max,
-                   within_tol_per_part=per_part_check(model, ours),
-                   bytes_saved_by_sharing=ours.bytes_saved,
-                   **measure(model, model.vertices, ours.triangles, samples, bracket))
-        rows.append(row)
-        say(f"  {model.label} ours {pct} %: {target} triangles in {ours.seconds:.2f} s, "
-            f"H ≤ {row['h_upper']:.4g}")
-        for method in SIMPLIFIERS:
-            out = simplify_with(method, model.vertices, model.triangles, target)
-            row = dict(mesh=model.label, method=method, tol_pct=pct,
-                       input_triangles=len(model.triangles), target_triangles=target,
-                       triangles=len(out.triangles),
-                       seconds=out.seconds, failure=out.failure,
-                       bytes_saved_by_sharing=(out.vertices.nbytes if out.shares_vertices else 0))
-            row.update(measure(model, out.vertices, out.triangles, samples, bracket))
+        h = hausdorff(model.vertices, model.triangles, model.vertices, ours.triangles,
+                      tol=BRACKET_REL * diag)
+        # below 1e-6 of the diagonal a float32 tool cannot resolve a distance: search to that
+        error = max(h.upper, SEARCH_FLOOR_REL * diag)
+        scope, border_rule, kept = OURS_CONSTRAINTS[OURS]
+        rows.append(dict(mesh=model.label, tol_pct=pct, method=OURS, scope=scope,
+                         borders=border_rule, vertices=kept, error=error,
+                         error_pct_diag=100 * error / diag, triangles=len(ours.triangles),
+                         over_ours=1.0, seconds=ours.seconds, calls=1))
+        # our decimator without feature lines (feature_deg 180: only the tolerance, the open
+        # boundary and the part structure constrain it), at its own certified distance
+        free = hausdorff_decimate(model.vertices, model.triangles, pct / 100.0, relative=True,
+                                  parts=model.parts, feature_deg=180.0)
+        h_free = max(hausdorff(model.vertices, model.triangles, model.vertices, free.triangles,
+                               tol=BRACKET_REL * diag).upper, SEARCH_FLOOR_REL * diag)
+        rows.append(dict(mesh=model.label, tol_pct=pct, method=OURS_NO_FEATURES, scope=scope,
+                         borders=border_rule, vertices=kept, error=h_free,
+                         error_pct_diag=100 * h_free / diag, triangles=len(free.triangles),
+                         over_ours=len(free.triangles) / max(len(ours.triangles), 1),
+                         seconds=free.seconds, calls=1))
+        shares = {p: n / max(len(ours.triangles), 1) for p, n in part_targets(model, ours).items()}
+        peers = ([(m, "whole mesh") for m in SIMPLIFIERS]
+                 + [(m, "per part") for m in PART_SIMPLIFIERS])
+        for method, scope in peers:
+            found = fewest_triangles_within(model, peer_runner(model, method, scope, shares), error)
+            borders = "free" if scope == "whole mesh" else PART_SIMPLIFIERS[method][1]
+            vertices = ("kept" if method.startswith("meshoptimizer") or "vertices kept" in method
+                        else "moved")
+            row = dict(mesh=model.label, tol_pct=pct, method=method, scope=scope,
+                       borders=borders, vertices=vertices, error=error,
+                       error_pct_diag=100 * error / diag, triangles=found["triangles"],
+                       h_upper=found["h_upper"],
+                       over_ours=found["triangles"] / max(len(ours.triangles), 1),
+                       seconds=found.get("seconds"), calls=found["calls"],
+                       failure=found["failure"])
             rows.append(row)
-            say(f"  {model.label} {method}: {len(out.triangles)} triangles in {out.seconds:.2f} s"
-                + (f" ({out.failure})" if out.failure else f", H ≤ {row.get('h_upper', 0):.4g}"))
-    ours_rows = {r["tol_pct"]: r for r in rows if r["method"].startswith("ours")}
-    for r in rows:
-        mine = ours_rows[r["tol_pct"]]
-        if not r["method"].startswith("ours") and r.get("h_upper"):
-            r["h_over_ours"] = r["h_lower"] / mine["h_upper"]
-            r["time_over_ours"] = r["seconds"] / mine["seconds"]
+            say(f"  equal error {model.label} {pct} %: {method} ({scope}) "
+                + (f"fails ({found['failure']})" if found["failure"]
+                   else f"{found['triangles']} triangles vs ours {len(ours.triangles)}"))
     return rows
+
+
+def save_equal_error_figure(path: Path, rows: list[dict]) -> None:
+    """Triangles against the certified one-sided distance, one panel per mesh, one line per
+    method and scope (log axes)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    meshes = list(dict.fromkeys(r["mesh"] for r in rows))
+    series = list(dict.fromkeys((r["method"], r["scope"]) for r in rows))
+    colours = plt.get_cmap("tab20")
+    fig, axes = plt.subplots(1, len(meshes), figsize=(5.5 * len(meshes) + 3, 4.6), dpi=100,
+                             squeeze=False)
+    handles = {}
+    for ax, mesh in zip(axes[0], meshes):
+        mine = [r for r in rows if r["mesh"] == mesh]
+        for i, (method, scope) in enumerate(series):
+            sel = sorted((r for r in mine if r["method"] == method and r["scope"] == scope
+                          and not r.get("failure")), key=lambda r: r["error"])
+            if not sel:
+                continue
+            style = "o-" if method.startswith("ours") else ("x--" if scope == "whole mesh"
+                                                            else "s:")
+            line, = ax.plot([r["error"] for r in sel], [r["triangles"] for r in sel], style,
+                            color=colours(i % 20), label=f"{method} ({scope})", markersize=4)
+            handles.setdefault(line.get_label(), line)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("certified one-sided Hausdorff distance, original → simplified\n"
+                      "(model units: mm for the car and the panels)")
+        ax.set_ylabel("triangles reached")
+        ax.set_title(mesh)
+        ax.grid(True, which="both", alpha=0.3)
+    fig.legend(list(handles.values()), list(handles), fontsize=7, loc="center right")
+    fig.tight_layout(rect=(0, 0, 1 - 3 / (5.5 * len(meshes) + 3), 1))
+    with atomic_open(path, "wb") as fh:
+        fig.savefig(fh, format="png")
+    plt.close(fig)
 
 
 def metric_rows(quick: bool, say) -> list[dict]:
@@ -232,21 +478,23 @@ def save_tradeoff_figure(path: Path, rows: list[dict], title: str) -> None:
     import matplotlib.pyplot as plt
 
     fig, (ax_n, ax_t) = plt.subplots(1, 2, figsize=(11, 4.2), dpi=100)
-    for method in dict.fromkeys(r["method"] for r in rows):
-        sel = sorted((r for r in rows if r["method"] == method and r.get("h_upper")),
-                     key=lambda r: r["triangles"])
+    for method, scope in dict.fromkeys((r["method"], r["scope"]) for r in rows):
+        sel = sorted((r for r in rows if r["method"] == method and r["scope"] == scope
+                      and r.get("h_upper")), key=lambda r: r["triangles"])
         if not sel:
             continue
-        style = "o-" if method.startswith("ours") else "x--"
+        style = "o-" if method.startswith("ours") else ("x--" if scope == "whole mesh" else "s:")
         error = [max(r["h_upper"], 1e-12) for r in sel]
-        ax_n.plot([r["triangles"] for r in sel], error, style, label=method)
-        ax_t.plot([r["seconds"] for r in sel], error, style, label=method)
+        label = f"{method} ({scope})"
+        ax_n.plot([r["triangles"] for r in sel], error, style, label=label, markersize=4)
+        ax_t.plot([r["seconds"] for r in sel], error, style, label=label, markersize=4)
     ax_n.set_xlabel("triangles")
     ax_t.set_xlabel("simplification time (s)")
     for ax in (ax_n, ax_t):
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_ylabel("one-sided Hausdorff, original → simplified (model units, upper bound)")
+        ax.set_ylabel("one-sided Hausdorff, original → simplified\n"
+                      "(upper bound; model units, mm for the car and panels)")
         ax.grid(True, which="both", alpha=0.3)
     ax_n.legend(fontsize=7)
     fig.suptitle(title)
@@ -273,6 +521,12 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
                              f"{model.label}: error against triangles and time")
     write_table(metric_rows(quick, say), out_dir, "metric",
                 title="The certified metric beside pymeshlab, libigl and open3d")
+    sweep = []
+    for model in sweep_models(quick, say):
+        sweep += equal_error_rows(model, QUICK_SWEEP_PCT if quick else SWEEP_PCT, say)
+    write_table(sweep, out_dir, "equal_error",
+                title="Triangles reached at equal certified one-sided distance")
+    save_equal_error_figure(out_dir / "equal_error.png", sweep)
     return rows
 
 

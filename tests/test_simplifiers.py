@@ -4,8 +4,10 @@ import numpy as np
 import pytest
 import trimesh
 
-from workbench.experiment.simplifiers import (SIMPLIFIERS, igl_hausdorff, open3d_distances,
-                                              pymeshlab_hausdorff, simplify_with)
+from workbench.experiment.simplifiers import (PART_SIMPLIFIERS, SIMPLIFIERS, Simplified,
+                                              igl_hausdorff, open3d_distances,
+                                              part_border_vertices, pymeshlab_hausdorff,
+                                              simplify_per_part, simplify_with)
 
 
 @pytest.fixture(scope="module")
@@ -47,3 +49,78 @@ def test_distance_tools_on_a_lifted_copy():
     assert igl_hausdorff(v, f, lifted, f)["value"] == pytest.approx(0.25, abs=1e-9)
     d = open3d_distances(v, lifted, f)
     assert d["max"] == pytest.approx(0.25, abs=1e-6) and len(d["distances"]) == 4
+
+
+# --------------------------------------------------------------------------- per part
+@pytest.fixture(scope="module")
+def two_parts():
+    """A curved 16×16 grid split into two parts along x = 0.5 (they share 17 vertices)."""
+    n = 16
+    x, y = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1))
+    z = 0.2 * np.sin(3 * x) * np.cos(2 * y)
+    v = np.stack([x.ravel(), y.ravel(), z.ravel()], 1)
+    i, j = np.meshgrid(np.arange(n), np.arange(n))
+    base = (i + (n + 1) * j).ravel()
+    f = np.concatenate([np.stack([base, base + 1, base + n + 2], 1),
+                        np.stack([base, base + n + 2, base + n + 1], 1)])
+    parts = (np.tile(i.ravel(), 2) >= n // 2).astype(np.int32)
+    return v, f, parts
+
+
+def rows_present(v, ids, out):
+    """Which of the vertices ``ids`` of v the output uses at exactly their coordinates."""
+    used = out.vertices[np.unique(out.triangles)]
+    return np.array([(used == v[i]).all(axis=1).any() for i in ids])
+
+
+@pytest.mark.parametrize("method", sorted(PART_SIMPLIFIERS))
+def test_per_part_runs_keep_their_claims(two_parts, method):
+    v, f, parts = two_parts
+    out = simplify_per_part(method, v, f, parts, {0: 40, 1: 40})
+    assert out.scope == "per part" and out.borders in ("locked", "free", "weighted")
+    assert out.failure is None, out.failure
+    assert out.parts is not None and len(out.parts) == len(out.triangles)
+    assert set(np.unique(out.parts).tolist()) == {0, 1}
+    assert out.triangles.max() < len(out.vertices)
+    border = part_border_vertices(f, parts)
+    # the 64 outer-boundary vertices plus the 15 inner ones of the shared line
+    assert len(border) == 4 * 16 + 15
+    present = rows_present(v, border, out)
+    if out.borders == "locked":
+        # every border vertex of every part is still there, in both parts where shared
+        assert present.all()
+        shared = np.intersect1d(f[parts == 0], f[parts == 1])
+        for p in (0, 1):
+            assert rows_present(v, shared, Simplified(
+                method, out.vertices, out.triangles[out.parts == p], 0.0, False)).all()
+    if out.shares_vertices:
+        assert out.vertices_kept == "kept" and np.array_equal(out.vertices, v)
+        assert np.isin(out.triangles, f).all()
+    if out.borders == "locked":
+        # locked borders cost triangles: neither part can drop to 40
+        assert (out.parts == 0).sum() > 40 and (out.parts == 1).sum() > 40
+
+
+def test_pymeshlab_vertices_kept_is_an_index_array(two_parts):
+    v, f, parts = two_parts
+    out = simplify_per_part("pymeshlab quadric, vertices kept", v, f, parts, {0: 100, 1: 100})
+    assert out.shares_vertices and out.vertices_kept == "kept"
+    assert np.isin(out.triangles, f).all()
+    moved = simplify_per_part("pymeshlab quadric", v, f, parts, {0: 100, 1: 100})
+    assert moved.vertices_kept == "moved"
+
+
+def test_open3d_boundary_weight_does_not_lock(two_parts):
+    # why open3d's per-part row says "weighted": its border vertices still move
+    v, f, parts = two_parts
+    out = simplify_per_part("open3d quadric", v, f, parts, {0: 40, 1: 40})
+    assert out.borders == "weighted"
+    assert not rows_present(v, part_border_vertices(f, parts), out).all()
+
+
+def test_per_part_refusals(two_parts):
+    v, f, parts = two_parts
+    with pytest.raises(ValueError, match="known"):
+        simplify_per_part("vertex clustering", v, f, parts, {0: 1, 1: 1})
+    with pytest.raises(ValueError, match="no target"):
+        simplify_per_part("meshoptimizer simplify", v, f, parts, {0: 10})

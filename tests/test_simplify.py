@@ -269,9 +269,18 @@ def test_parts_keep_their_shared_border():
         r.tol_for(5)
     shared = np.intersect1d(t[parts == 3], t[parts == 7])
     assert len(shared) == 13
+    # shared vertices slide along the common border in both parts at once: those left are
+    # used by both parts, and the border's two ends (on the open boundary) never move
+    kept = np.intersect1d(shared, r.triangles)
+    assert len(kept) < len(shared) and np.isin(shared[[0, -1]], kept).all()
     for label in (3, 7):
-        assert np.isin(shared, r.triangles[r.parts == label]).all()
+        assert np.isin(kept, r.triangles[r.parts == label]).all()
         assert np.isin(r.triangles[r.parts == label], t[parts == label]).all()
+    # with sliding off, every shared vertex stays in both parts
+    locked = hausdorff_decimate(v, t, 0.02, parts=parts, slide_shared=False)
+    check_result(v, t, locked, parts=parts)
+    for label in (3, 7):
+        assert np.isin(shared, locked.triangles[locked.parts == label]).all()
     # each part's tolerance is relative to its own box
     for label in (3, 7):
         own = np.unique(t[parts == label])

@@ -26,18 +26,60 @@ def test_our_results_are_certified_within_the_tolerance(result):
         assert r["triangles"] < r["input_triangles"]
 
 
+OURS = "ours (Hausdorff-bounded)"
+PEERS = {"pymeshlab quadric", "libigl qslim", "libigl decimate", "open3d quadric",
+         "meshoptimizer simplify"}
+
+
 def test_every_reference_runs_at_our_triangle_count(result):
     rows, _ = result
-    methods = {r["method"] for r in rows}
-    assert {"pymeshlab quadric", "libigl qslim", "libigl decimate", "open3d quadric",
-            "meshoptimizer simplify"} <= methods
-    ours = {(r["mesh"], r["tol_pct"]): r["triangles"] for r in rows if r["method"].startswith("ours")}
+    whole = {r["method"] for r in rows if r["scope"] == "whole mesh"}
+    per_part = {r["method"] for r in rows if r["scope"] == "per part"
+                and not r["method"].startswith("ours")}
+    assert PEERS <= whole and PEERS <= per_part
+    ours = {(r["mesh"], r["tol_pct"]): r["triangles"] for r in rows if r["method"] == OURS}
     for r in rows:
+        assert r["scope"] in ("whole mesh", "per part")
+        assert r["vertices"] in ("kept", "moved")
         if r["method"].startswith("ours"):
+            assert r["scope"] == "per part" and r["vertices"] == "kept"
             continue
         assert r["target_triangles"] == ours[(r["mesh"], r["tol_pct"])]
+        if r["scope"] == "whole mesh":
+            assert r["borders"] == "free"
+        else:
+            assert r["borders"] in ("locked", "weighted", "free")
         if not r.get("failure"):
             assert r["h_lower"] <= r["h_upper"]
+            # a row either reached our count or says where it stopped
+            if r.get("stopped_at") is not None:
+                assert r["stopped_at"] == r["triangles"] > r["target_triangles"]
+            else:
+                assert r["triangles"] <= r["target_triangles"] + max(1, r["target_triangles"] // 100)
+
+
+def test_locked_rows_keep_every_border_vertex(result):
+    rows, _ = result
+    locked = [r for r in rows if r["borders"] == "locked" and not r.get("failure")]
+    assert {r["method"] for r in locked} >= {"pymeshlab quadric", "meshoptimizer simplify"}
+    for r in locked:
+        assert r["border_vertices_kept"] == 1.0, (r["mesh"], r["method"])
+
+
+def test_equal_error_table(result):
+    _, out_dir = result
+    sweep = read_table(out_dir / "equal_error.csv")
+    ours = {(r["mesh"], r["tol_pct"]): r for r in sweep if r["method"] == OURS}
+    assert ours and (out_dir / "equal_error.png").stat().st_size > 1000
+    for r in sweep:
+        mine = ours[(r["mesh"], r["tol_pct"])]
+        if r["method"].startswith("ours"):
+            continue
+        assert r["error"] == mine["error"]
+        if not r.get("failure"):
+            # the peer's count was searched to the same certified error
+            assert r["h_upper"] <= r["error"]
+            assert r["over_ours"] == pytest.approx(r["triangles"] / mine["triangles"])
 
 
 def test_a_flagged_sampled_value_is_the_tool_s_error_not_ours(result):

@@ -15,7 +15,10 @@ faces of the current mesh, so every point of T is within tol of the simplified s
 collapse u → v changes or removes the faces around u; every original triangle supported by one
 of them is re-certified against its remaining support plus the new faces around v, and the
 collapse is undone unless all pass. The new support is the set of faces that certified at least
-one leaf piece, so supports stay small.
+one leaf piece, so supports stay small. A piece that straddles the edge between two faces is
+covered only once it is about tol wide, so the subdivision depth is chosen per original
+triangle from its longest edge over its tolerance (:func:`certification_depths`): a fixed
+shallow depth refuses even exact collapses on a flat plate of large elements.
 
 Collapse order: a priority queue of half-edges by a quadric error (the mean squared distance of
 v from the planes of the original triangles around u and around the vertices already collapsed
@@ -30,10 +33,11 @@ Topology and shape rules (a collapse that breaks one is rejected and counted by 
 * ``topology`` -- the edge has more than two faces, u is a non-manifold vertex (its faces do not
   form one fan), the link condition fails (u and v share a neighbour that is not opposite the
   edge), or an interior edge joins two boundary vertices;
-* ``fixed`` -- u never moves: it is used by faces of more than one part, by a zero-area input
-  face, touches a non-manifold edge, or is a corner (on 1 or >= 3 feature/boundary edges, or
-  where its feature/boundary polyline turns by more than ``feature_deg``). Such vertices are
-  not queued at all; the count is of vertices that became corners on the way;
+* ``fixed`` -- u never moves: it is used by faces of three or more parts (or of two parts
+  anywhere but inside their common boundary, see below), by a zero-area input face, touches a
+  non-manifold edge, or is a corner (on 1 or >= 3 feature/boundary edges, or where its
+  feature/boundary polyline turns by more than ``feature_deg``). Such vertices are not queued
+  at all; the count is of vertices that became corners on the way;
 * ``feature`` -- u lies on two feature/boundary edges and uv is not one of them (u may only
   slide along its feature line);
 * ``normal`` -- a changed face would turn by more than ``max_normal_deg`` from its normal
@@ -42,6 +46,17 @@ Topology and shape rules (a collapse that breaks one is rejected and counted by 
 * ``duplicate`` -- a changed face would repeat an existing face;
 * ``hausdorff`` -- an original triangle could not be re-certified within tol;
 * ``support`` -- a re-certification needs more than 12 support faces.
+
+The common boundary of two parts (edges with one face of each part) is a feature polyline of
+both. A vertex inside it -- used by exactly those two parts, on exactly two constrained edges
+which are both common edges, on no open edge -- slides along it in both parts at once: the
+half-edge collapse u → v along the common boundary is applied to the faces of both parts
+together, so the shared vertex buffer stays shared and no crack opens. Such a collapse must
+also keep the link condition within each part on its own, and re-certifies the original
+triangles of both parts, each against the faces of its own part and its own part's tolerance.
+Where three or more parts meet, where the common boundary ends or turns by more than
+``feature_deg``, or where a part's own boundary or feature lines meet it, the vertex is a
+corner and stays.
 """
 
 from __future__ import annotations
@@ -56,7 +71,7 @@ from numba.typed import Dict
 
 from .distance import closest_point_on_triangle, triangle_bounds
 
-__all__ = ["Decimation", "hausdorff_decimate"]
+__all__ = ["Decimation", "certification_depths", "hausdorff_decimate"]
 
 REJECT_REASONS = ("fixed", "feature", "topology", "normal", "degenerate", "duplicate",
                   "hausdorff", "support")
@@ -68,6 +83,9 @@ _AREA_REL = 1e-6
 _MAX_SUPPORT = 12
 # weight of the squared edge length in the collapse cost (orders flat regions)
 _LENGTH_WEIGHT = 1e-3
+# bounds of the automatic certification depth (see certification_depths)
+MIN_DEPTH = 5
+MAX_AUTO_DEPTH = 10
 
 
 @dataclass
@@ -203,6 +221,33 @@ def _one_fan(u, faces, nf, F, seen, queue):
                 queue[top] = j
                 top += 1
     return top == nf
+
+
+@numba.njit(cache=True)
+def _part_link_ok(u, v, fu, nfu, fv, nfv, F, fpart, part, nb_u, cnt_u, nb_v, cnt_v, pos):
+    """Link condition of the edge uv within the faces of ``part`` only: the neighbours u and v
+    share in that part are the vertices opposite uv in that part's faces. ``pos`` (N,) is -1
+    everywhere on entry and on return."""
+    n_u = _neighbours(u, fu, nfu, F, fpart, part, nb_u, cnt_u, pos)
+    n_v = _neighbours(v, fv, nfv, F, fpart, part, nb_v, cnt_v, pos)
+    for i in range(n_v):
+        pos[nb_v[i]] = 0
+    ok = True
+    for j in range(n_u):
+        w = nb_u[j]
+        if w == v or pos[w] != 0:
+            continue
+        opposite = False
+        for i in range(nfu):
+            f = fu[i]
+            if fpart[f] == part and (F[f, 0] == v or F[f, 1] == v or F[f, 2] == v) and \
+                    (F[f, 0] == w or F[f, 1] == w or F[f, 2] == w):
+                opposite = True
+        if not opposite:
+            ok = False
+    for i in range(n_v):
+        pos[nb_v[i]] = -1
+    return ok
 
 
 @numba.njit(cache=True, inline="always")
@@ -386,7 +431,7 @@ def _cost(Q, area, V, a, b):
 # --------------------------------------------------------------------------- the decimator
 @numba.njit(cache=True)
 def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ckeys, cdeg, Q,
-              area, cos_max, max_depth, max_passes):
+              area, cos_max, orig_depth, max_passes):
     """Greedy certified half-edge collapses; changes F, alive, cdeg, Q and area in place.
 
     Returns (support (K, S), support counts (K,), collapses, rejections (8,), passes).
@@ -448,9 +493,14 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
     cntu = np.empty(2 * m + 2, np.int64)
     nbv = np.empty(2 * m + 2, np.int64)
     cntv = np.empty(2 * m + 2, np.int64)
+    nbp = np.empty(2 * m + 2, np.int64)
+    cntp = np.empty(2 * m + 2, np.int64)
+    nbq = np.empty(2 * m + 2, np.int64)
+    cntq = np.empty(2 * m + 2, np.int64)
     seen = np.empty(m, np.bool_)
     queue = np.empty(m, np.int64)
     aff = np.empty(k_orig, np.int64)
+    max_depth = orig_depth.max() if k_orig > 0 else 0
     stack = np.empty((4 * max_depth + 4, 3, 3))
     depth = np.empty(4 * max_depth + 4, np.int64)
     piece = np.empty((3, 3))
@@ -538,6 +588,33 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
                         ok = False
                 for i in range(nnv):
                     pos[nbv[i]] = -1
+            other_part = np.int32(-1)
+            for i in range(nfu):
+                if fpart[fu[i]] != part:
+                    other_part = fpart[fu[i]]
+            if ok and other_part >= 0:
+                # u lies on the common boundary of two parts and slides along it in both: uv
+                # must be that boundary (one face of each part on it), u's faces only of the
+                # two parts, and the link condition must hold within each part on its own
+                n_part = 0
+                n_other = 0
+                for i in range(nfu):
+                    f = fu[i]
+                    if fpart[f] != part and fpart[f] != other_part:
+                        ok = False
+                    if F[f, 0] == v or F[f, 1] == v or F[f, 2] == v:
+                        if fpart[f] == part:
+                            n_part += 1
+                        else:
+                            n_other += 1
+                if n_part != 1 or n_other != 1:
+                    ok = False
+                if ok:
+                    ok = _part_link_ok(u, v, fu, nfu, fv, nfv, F, fpart, part, nbp, cntp, nbq,
+                                       cntq, pos)
+                if ok:
+                    ok = _part_link_ok(u, v, fu, nfu, fv, nfv, F, fpart, other_part, nbp, cntp,
+                                       nbq, cntq, pos)
             if ok and n_uv == 2 and u_boundary:
                 # an interior edge between two boundary vertices would pinch the surface
                 mixed = False
@@ -608,11 +685,12 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
                 retry[u] = True
                 continue
 
-            # --- the new fan around v (faces of u's part): unchanged faces of v, changed faces of u
+            # --- the new fan around v: unchanged faces of v, changed faces of u (of every part;
+            # an original triangle is certified against the faces of its own part only)
             n_fan = 0
             for j in range(nfv):
                 g = fv[j]
-                if fpart[g] != part or F[g, 0] == u or F[g, 1] == u or F[g, 2] == u:
+                if F[g, 0] == u or F[g, 1] == u or F[g, 2] == u:
                     continue
                 fw[n_fan] = g
                 n_fan += 1
@@ -691,7 +769,10 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
                     _set_record(cand, nc, V[F[g, 0]], V[F[g, 1]], V[F[g, 2]])
                     cand_id[nc] = g
                     nc += 1
+                t_part = fpart[orig_face[t]]
                 for q in range(n_fan):
+                    if fpart[fw[q]] != t_part:
+                        continue
                     reach = t_rad + fan[q, 12] + tol
                     if (fan[q, 9] - tc[0]) ** 2 + (fan[q, 10] - tc[1]) ** 2 + \
                             (fan[q, 11] - tc[2]) ** 2 > reach * reach:
@@ -701,7 +782,7 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
                     nc += 1
                 for j in range(nc):
                     used[j] = False
-                if nc == 0 or not _certify(orig[t], cand, nc, tol, max_depth, used, stack,
+                if nc == 0 or not _certify(orig[t], cand, nc, tol, orig_depth[t], used, stack,
                                            depth, piece, corners):
                     reason = _HAUSDORFF
                     break
@@ -823,7 +904,7 @@ def _decimate(V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ck
 
 
 @numba.njit(cache=True)
-def _final_bounds(V, F, orig, orig_tol, sup, sup_n, max_depth):
+def _final_bounds(V, F, orig, orig_tol, sup, sup_n, orig_depth):
     """Per original triangle, the upper bound of :func:`triangle_bounds` against its support
     (split while above tol). The certificate: each is <= tol by construction."""
     k_orig = orig.shape[0]
@@ -839,7 +920,7 @@ def _final_bounds(V, F, orig, orig_tol, sup, sup_n, max_depth):
             for k in range(3):
                 for c in range(3):
                     faces[j, k, c] = V[F[g, k], c]
-        out[t] = triangle_bounds(orig[t], faces, orig_tol[t], max_depth)[1]
+        out[t] = triangle_bounds(orig[t], faces, orig_tol[t], orig_depth[t])[1]
     return out
 
 
@@ -876,7 +957,7 @@ def _check_inputs(vertices, triangles, tol, parts, feature_deg, max_normal_deg, 
         raise ValueError(f"feature_deg must be within [0, 180] degrees, got {feature_deg}")
     if not 0.0 < float(max_normal_deg) <= 180.0:
         raise ValueError(f"max_normal_deg must be within (0, 180] degrees, got {max_normal_deg}")
-    if int(max_depth) != max_depth or not 0 <= max_depth <= 12:
+    if max_depth is not None and (int(max_depth) != max_depth or not 0 <= max_depth <= 12):
         raise ValueError(f"max_depth must be an integer within [0, 12], got {max_depth}")
     if int(passes) != passes or passes < 1:
         raise ValueError(f"passes must be a positive integer, got {passes}")
@@ -915,10 +996,43 @@ def _edges_of(F: np.ndarray, n_vert: int):
     return a, b, face, key, a < b
 
 
+def certification_depths(corners: np.ndarray, tol: np.ndarray, max_depth=None) -> np.ndarray:
+    """(K,) int64 subdivision depth of the certification of each original triangle.
+
+    ``corners`` (K, 3, 3), ``tol`` (K,) in the same units. A piece of a triangle that straddles
+    the edge between two simplified faces is certified only once it is narrow enough for one
+    face to reach all of its corners, about ``tol`` across: the depth that takes the longest
+    edge L of the triangle down to that, ``ceil(log2(L / tol)) + 1``, at least
+    ``MIN_DEPTH`` and at most ``MAX_AUTO_DEPTH``. An integer ``max_depth`` fixes every depth
+    to it instead.
+    """
+    if max_depth is not None:
+        return np.full(len(corners), int(max_depth), np.int64)
+    edges = corners[:, [1, 2, 0]] - corners
+    longest = np.sqrt((edges ** 2).sum(axis=2).max(axis=1))
+    ratio = np.maximum(longest / tol, 1.0)
+    return np.clip(np.ceil(np.log2(ratio)) + 1, MIN_DEPTH, MAX_AUTO_DEPTH).astype(np.int64)
+
+
+def _sliding_shared(key, common, union_boundary, cdeg, parts_at) -> np.ndarray:
+    """(N,) True for the vertices that may slide along the common boundary of two parts:
+    used by exactly two parts, on exactly two constrained edges which are both common-boundary
+    edges (one face of each part), and on no edge with a single face over all parts. Every
+    other vertex used by several parts is a corner of the part structure."""
+    n_vert = len(cdeg)
+    common_keys = np.unique(key[common])
+    common_deg = (np.bincount(common_keys // n_vert, minlength=n_vert)
+                  + np.bincount(common_keys % n_vert, minlength=n_vert))
+    open_keys = np.unique(key[union_boundary])
+    open_deg = (np.bincount(open_keys // n_vert, minlength=n_vert)
+                + np.bincount(open_keys % n_vert, minlength=n_vert))
+    return (parts_at == 2) & (cdeg == 2) & (common_deg == 2) & (open_deg == 0)
+
+
 def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: bool = True,
                        parts=None, feature_deg: float = 30.0, keep_boundary: bool = True,
-                       max_normal_deg: float = 60.0, max_depth: int = 5,
-                       passes: int = 2) -> Decimation:
+                       max_normal_deg: float = 60.0, max_depth: int | None = None,
+                       passes: int = 2, slide_shared: bool = True) -> Decimation:
     """Decimate a triangle mesh by half-edge collapses within a certified one-sided Hausdorff
     distance from the original surface (crash2000, section 3.2).
 
@@ -930,14 +1044,20 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     0.005 is the paper's 0.5 %. With ``relative=False`` it is a length in model units.
 
     ``parts`` (K,) labels decimate each part on its own, against its own tolerance: a part's
-    original triangles are certified against that part's faces only, and vertices used by more
-    than one part never move. Feature edges (the angle between the orientation-corrected
-    normals of their two faces above ``feature_deg`` degrees) and, with ``keep_boundary``,
+    original triangles are certified against that part's faces only. With ``slide_shared``
+    (default) a vertex inside the common boundary of two parts slides along it in both parts at
+    once (the module notes say which vertices are corners); without it, and always where three
+    or more parts meet, vertices used by more than one part never move. Either way every part
+    stays drawable on its own and shares the vertices along its borders with its neighbours.
+    Feature edges (the angle between the orientation-corrected normals of their two faces above
+    ``feature_deg`` degrees), the common boundaries of parts and, with ``keep_boundary``,
     boundary edges are kept as polylines: a vertex on two of them only slides along them, a
     vertex on one or on three or more, or where its polyline turns by more than
     ``feature_deg``, never moves. ``max_normal_deg`` bounds how far a changed
     face may turn per collapse and from the face it descends from; ``max_depth`` is the
-    subdivision depth of the certification (deeper certifies closer to tol, slower);
+    subdivision depth of the certification (deeper certifies closer to tol, slower): None
+    (default) picks it per input triangle from its longest edge and its tolerance
+    (:func:`certification_depths`, 5 to 10), an integer fixes it;
     ``passes`` is how often the queue is refilled with every remaining half-edge.
 
     Guarantee: every point of every input triangle is within its part's tolerance of the
@@ -1005,7 +1125,7 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     fixed = np.zeros(n_vert, bool)
     _, fpart_index = np.unique(fpart, return_inverse=True)
     vp = np.unique(F.ravel().astype(np.int64) * len(labels) + np.repeat(fpart_index.ravel(), 3))
-    fixed[np.flatnonzero(np.bincount(vp // len(labels), minlength=n_vert) > 1)] = True
+    parts_at = np.bincount(vp // len(labels), minlength=n_vert)
     fixed[F[degenerate].ravel()] = True
 
     a, b, face, key, forward = _edges_of(F, n_vert)
@@ -1032,6 +1152,9 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
         crease = cos < np.cos(np.radians(float(feature_deg))) - 1e-12
         constrained[g1[crease]] = True
         constrained[g2[crease]] = True
+    # the common boundary of two parts (edges with one face of each) is always a polyline
+    common = (uc[ui] == 2) & (per_part == 1)
+    constrained |= common
     ckeys = np.unique(key[constrained])
     cdeg = np.zeros(n_vert, np.int32)
     lo_v, hi_v = ckeys // n_vert, ckeys % n_vert
@@ -1054,6 +1177,8 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
         cos_turn = -np.einsum("ij,ij->i", d1, d2) / np.where(lengths > 0, lengths, 1.0)
         cos_turn[lengths == 0] = -1.0
         fixed[mid[cos_turn < np.cos(np.radians(float(feature_deg))) - 1e-12]] = True
+    fixed[(parts_at > 1) & ~(_sliding_shared(key, common, uc[ui] == 1, cdeg, parts_at)
+                             & bool(slide_shared))] = True
 
     # plane quadrics of the original faces, area weighted, accumulated per vertex
     d = -np.einsum("ij,ij->i", n_origin, V[F[:, 0]])
@@ -1068,11 +1193,12 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
 
     alive = np.ones(m, np.bool_)
     orig_tol = tol_of_label[part_index]
+    orig_depth = certification_depths(orig, orig_tol, max_depth)
     cos_max = float(np.cos(np.radians(float(max_normal_deg))))
     sup, sup_n, collapses, rejected, n_passes = _decimate(
         V, F, fpart, alive, n_origin, orig, orig_tol, orig_face, fixed, ckeys, cdeg, Q, area,
-        cos_max, int(max_depth), int(passes))
-    kept_bounds = _final_bounds(V, F, orig, orig_tol, sup, sup_n, int(max_depth))
+        cos_max, orig_depth, int(passes))
+    kept_bounds = _final_bounds(V, F, orig, orig_tol, sup, sup_n, orig_depth)
 
     bounds = np.full(k_in, np.nan)
     bounds[keep] = kept_bounds
