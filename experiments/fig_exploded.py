@@ -114,17 +114,15 @@ def view_angles(direction) -> tuple[float, float]:
     return az, el
 
 
-def deep(camera, scene):
-    """``camera`` whose depth range holds the exploded halves (:func:`exploded_camera`)."""
-    return exploded_camera(camera, scene)
-
-
 def camera_along(scene, size, direction):
-    return deep(default_camera(scene, size, view=view_angles(direction), up="z"), scene)
+    """The default camera looking along ``direction``, its depth range widened for the
+    exploded halves (:func:`exploded_camera`)."""
+    return exploded_camera(default_camera(scene, size, view=view_angles(direction), up="z"),
+                           scene)
 
 
 def default_view_camera(scene, size):
-    return deep(default_camera(scene, size, view=DEFAULT_VIEW, up="z"), scene)
+    return exploded_camera(default_camera(scene, size, view=DEFAULT_VIEW, up="z"), scene)
 
 
 def view_dir(camera) -> np.ndarray:

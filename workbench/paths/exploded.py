@@ -135,10 +135,7 @@ class ExplodeStyle(Style):
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be positive and finite, got {getattr(self, name)}")
             setattr(self, name, value)
-        if not 0.0 <= float(self.ghost_start) < 1.0:
-            raise ValueError(f"ghost_start must be in [0, 1), got {self.ghost_start}")
-        if not 0.0 < float(self.ratio_exponent) <= 1.0:
-            raise ValueError(f"ratio_exponent must be in (0, 1], got {self.ratio_exponent}")
+        self.animation_settings(1.0 if self.o_max is None else self.o_max)  # checks the rest
         if self.strips != "none" or self.quad_diagonal == "strip":
             raise ValueError("the exploded path draws a triangle list: strips='none' and "
                              "quad_diagonal 'auto' or 'shorter'")
@@ -149,6 +146,13 @@ class ExplodeStyle(Style):
             raise ValueError(f"focus_color must be 3 numbers in [0, 1], got {self.focus_color}")
         self.focus_color = color
         super().__post_init__()
+
+    def animation_settings(self, o_max: float):
+        """The dynamics' :class:`~workbench.algo.explode.ExplodeSettings` for ``o_max`` (model
+        units): ``speed``, ``dt``, ``ghost_start`` and ``ratio_exponent``, checked there."""
+        return _explode().ExplodeSettings(o_max=o_max, speed=self.speed, dt=self.dt,
+                                          ghost_start=self.ghost_start,
+                                          ratio_exponent=self.ratio_exponent)
 
 
 class ExplodedPath(MeshPath):
@@ -212,9 +216,7 @@ class ExplodedPath(MeshPath):
         self._plane_spec = parse_plane(style.plane)
         self._choose_plane(camera)
         o_max = style.o_max if style.o_max is not None else float(algo.o_max_of(mesh))
-        self.settings = algo.ExplodeSettings(o_max=o_max, speed=style.speed, dt=style.dt,
-                                             ghost_start=style.ghost_start,
-                                             ratio_exponent=style.ratio_exponent)
+        self.settings = style.animation_settings(o_max)
         self.state = algo.ExplodeState(offset=style.offset)
         self.offset, self.alpha = style.offset, style.alpha
         super()._build(ctx, mesh, camera)

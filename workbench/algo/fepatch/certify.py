@@ -19,7 +19,7 @@ from scipy.sparse import coo_matrix
 
 from ..hausdorff import hausdorff
 
-__all__ = ["subpatch_distance_bounds", "subpatch_neighbours"]
+__all__ = ["array_digest", "subpatch_distance_bounds", "subpatch_neighbours"]
 
 
 def subpatch_neighbours(elements, labels) -> dict[int, np.ndarray]:
@@ -94,12 +94,20 @@ def subpatch_distance_bounds(coords, original, original_label, simplified: dict,
     return out
 
 
+def array_digest(*arrays) -> bytes:
+    """A 16-byte digest of ``arrays``' types, shapes and contents: the key of a memo of
+    repeated work."""
+    h = hashlib.blake2b(digest_size=16)
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        h.update(f"{a.dtype.str}{a.shape}".encode())
+        h.update(a.tobytes())
+    return h.digest()
+
+
 def _digest(a: np.ndarray, b: np.ndarray) -> bytes:
     """A digest of the triangle sets ``a`` (in order) and ``b`` (in any order)."""
-    digest = hashlib.blake2b(len(a).to_bytes(8, "little"), digest_size=16)
-    digest.update(np.ascontiguousarray(a, np.int64).tobytes())
-    digest.update(_sorted_rows(b).tobytes())
-    return digest.digest()
+    return array_digest(np.asarray(a, np.int64), _sorted_rows(b))
 
 
 def _sorted_rows(t: np.ndarray) -> np.ndarray:

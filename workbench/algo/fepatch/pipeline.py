@@ -28,7 +28,6 @@ Everything is float64 and GL-free; the result is two :class:`TexturedSurface`: `
 
 from __future__ import annotations
 
-import hashlib
 import time
 from dataclasses import dataclass, field
 
@@ -36,7 +35,7 @@ import numpy as np
 
 from ...scene.derived import as_coords, as_elements, gouraud_split, triangulate
 from .atlas import build_atlas, plane_frames
-from .certify import subpatch_distance_bounds, subpatch_neighbours
+from .certify import array_digest, subpatch_distance_bounds, subpatch_neighbours
 from .features import G0, feature_edges, patches, planar_subpatches
 from .lines import line_tolerance, simplify_polyline
 from .normalmap import dropped_axis
@@ -292,16 +291,6 @@ def _labels_of(sig) -> tuple[int, ...]:
     return (lo, hi) + (-1,) * (count - 2)  # non-manifold: more than two subpatches
 
 
-def _digest(*arrays) -> bytes:
-    """A digest of ``arrays``' shapes, types and contents, for memos of repeated work."""
-    h = hashlib.blake2b(digest_size=16)
-    for a in arrays:
-        a = np.ascontiguousarray(a)
-        h.update(f"{a.dtype.str}{a.shape}".encode())
-        h.update(a.tobytes())
-    return h.digest()
-
-
 def _simplify_lines(network: BorderNetwork, coords, frames, params, memo=None) -> np.ndarray:
     """(N,) bool: nodes removed from the line network. ``memo``: a dict kept between calls on
     the same coordinates and parameters; a line with the same nodes, fixed nodes, bound and
@@ -341,8 +330,9 @@ def _simplify_lines(network: BorderNetwork, coords, frames, params, memo=None) -
         planes = [(n, -float(n @ frames[s][0])) for n, s in zip(normals, labels)]
         key = None
         if memo is not None:
-            key = _digest(nodes, np.asarray(fixed if fixed is not None else [], bool),
-                          np.array([tol, float(closed), *(v for n, o in planes for v in (*n, o))]))
+            key = array_digest(nodes, np.asarray(fixed if fixed is not None else [], bool),
+                               np.array([tol, float(closed),
+                                         *(v for n, o in planes for v in (*n, o))]))
         if key is not None and key in memo:
             keep = memo[key]
         else:
@@ -415,7 +405,7 @@ def _memo_triangulation(loops, removed, coords, frame, memo):
     if memo is None:
         return _triangulate_subpatch(loops, removed, coords, frame)
     kept = [loop[~removed[loop]] for loop in loops]
-    key = _digest(np.array([len(k) for k in kept]), *kept, frame[0], frame[1])
+    key = array_digest(np.array([len(k) for k in kept]), *kept, frame[0], frame[1])
     if key not in memo:
         memo[key] = _triangulate_subpatch(loops, removed, coords, frame)
     return memo[key]
