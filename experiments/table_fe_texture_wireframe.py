@@ -11,7 +11,8 @@ car itself, generated stamped panels) and each of the paper's parameter sets A a
   -- with patch, subpatch and line counts, texture memory and the certified bound, for the
   new rules (build_model's defaults) and, for set A, before each change (``rules``: "paper",
   the paper's construction and texture scale; "certified d, paper texture", the distance bound
-  alone);
+  alone; "distance texture", the width scale rule with fe2003's distance texture, before the
+  element-id wire frame);
 * ``table3`` (Table 3; every column in ``table``): per render path, triangles, GPU and wall time per frame, the speed factor
   against original + line overdraw, texture memory in RGBA texels (4 bytes) per element, and
   the errors the paper does not give: the certified one-sided Hausdorff distance original →
@@ -21,14 +22,20 @@ car itself, generated stamped panels) and each of the paper's parameter sets A a
   one-pixel tolerance,
   :func:`workbench.experiment.compare.wire_agreement`), and SSIM of the image against the
   original's (shaded paths against "original, shaded", wire paths against the overdraw);
-  Set A's rows come also built with the paper's rules (``[paper]``) and with the certified
-  distance bound alone (``[certified d, paper texture]``), so that each change shows its cost:
-  the bound in triangles and speed, the texture rule in texels per element and wire fidelity;
+  Set A's rows come also built with the paper's rules (``[paper]``), with the certified
+  distance bound alone (``[certified d, paper texture]``) and with the distance texture under
+  the width rule (``[distance texture]``), so that each change shows its cost: the bound in
+  triangles and speed, the texture rule and the encoding in texels per element, speed and
+  wire fidelity;
 * ``sweep``: on the car refined 2×2 and displaced, the parameters scaled around sets A and B,
-  and set A under the paper's rules, each change alone and the texture rule varied (texels
-  across the scale-setting element width or extent, its quantile, narrow elements drawn as
-  lines or not, normal map size; every build_model keyword in the row): speed factor against
+  and set A under the paper's rules, each change alone and the texture rule varied (wire
+  encoding, texels across the scale-setting element width or extent, its quantile, narrow
+  elements drawn as lines or not, normal map size; every build_model keyword in the row):
+  speed factor against
   wire IoU and Hausdorff error (``sweep.png``);
+* ``closeup`` and ``closeup.png``: wire fidelity magnified, some six elements across the view's
+  radius (:func:`closeup_camera`), set A's wire frames (new rules and each rule before a
+  change) against line overdraw, untimed;
 * ``crops.png``: the same crop of original + line overdraw and simplified A + normal map + wire
   texture.
 
@@ -77,9 +84,12 @@ TABLE3 = ("renderer", "mesh", "size", "path", "rules", "triangles", "line_edges"
           "wall_ms", "speed_vs_overdraw", "rgba_texels_per_element", "hausdorff_mm", "d_mm",
           "wire_precision_1px", "wire_recall_1px", "wire_iou_1px", "ssim")
 # build_model keywords of the rows that show each change on its own: the paper's construction
-# (before both), and the certified distance bound with the paper's texture rule (before the
-# texture change); "new" is build_model's defaults
-RULES = {"paper": PAPER_RULES, "certified d, paper texture": PAPER_TEXTURE_RULE, "new": {}}
+# (before both), the certified distance bound with the paper's texture rule (before the
+# texture changes), and the width rule with fe2003's distance texture (before the element-id
+# encoding); "new" is build_model's defaults
+DISTANCE_TEXTURE = {"wire_encoding": "distance"}
+RULES = {"paper": PAPER_RULES, "certified d, paper texture": PAPER_TEXTURE_RULE,
+         "distance texture": DISTANCE_TEXTURE, "new": {}}
 NEW = "new"
 
 
@@ -116,6 +126,7 @@ def preprocessing_row(case: Case, model, rules: str = NEW) -> dict:
            "simplified_triangles": len(model.simplified.triangles),
            "atlas": f"{model.atlas_size[0]}x{model.atlas_size[1]}",
            "rgba_texels_per_element": model.rgba_texels_per_element,
+           "wire_encoding": model.wire_encoding,
            "narrow_elements": model.narrow_elements, "fit_share": model.fit_share,
            "split_subpatches": model.split_subpatches,
            "kept_subpatches": model.kept_subpatches,
@@ -229,8 +240,8 @@ def table_rows(case: Case, models: dict, variants: dict, drawer: Drawer, gl_rend
     return rows, images
 
 
-SWEEP_KEYS = ("fit_share", "certify", "texels_per_edge", "scale_by", "scale_quantile",
-              "atlas_turns", "border", "normal_reduction", "min_width")
+SWEEP_KEYS = ("fit_share", "certify", "wire_encoding", "texels_per_edge", "scale_by",
+              "scale_quantile", "atlas_turns", "border", "normal_reduction", "min_width")
 
 
 def sweep_configs(quick: bool) -> list[tuple[str, FEPatchParams, dict]]:
@@ -247,20 +258,23 @@ def sweep_configs(quick: bool) -> list[tuple[str, FEPatchParams, dict]]:
                ("A, paper rules", a, PAPER_RULES),
                ("A, paper texture rule", a, PAPER_TEXTURE_RULE),
                ("A, d/2 fit, not certified", a, {"fit_share": 0.5, "certify": False}),
-               ("A, width 3 q0.1", a, {"scale_quantile": 0.1}),
-               ("A, width 2.5 q0.02", a, {"texels_per_edge": 2.5, "min_width": 2.5}),
-               ("A, width 2 q0.1, no narrow lines", a, {"texels_per_edge": 2.0,
+               ("A, width 1.5 q0.1", a, {"scale_quantile": 0.1}),
+               ("A, width 1.25 q0.02", a, {"texels_per_edge": 1.25, "min_width": 1.25}),
+               ("A, width 1 q0.1, no narrow lines", a, {"texels_per_edge": 1.0,
                                                        "scale_quantile": 0.1,
                                                        "min_width": None}),
-               ("A, width 3 q0", a, {"scale_quantile": 0.0}),
-               ("A, extent 3", a, {"scale_by": "extent"}),
+               ("A, width 1.5 q0", a, {"scale_quantile": 0.0}),
+               ("A, extent 1.5", a, {"scale_by": "extent"}),
                ("A, no turns", a, {"atlas_turns": 1}),
                ("A, normal map 1/1", a, {"normal_reduction": 1}),
-               ("A, normal map 1/4", a, {"normal_reduction": 4})]
+               ("A, normal map 1/4", a, {"normal_reduction": 4}),
+               ("A, distance texture, width 3", a, DISTANCE_TEXTURE),
+               ("A, distance texture, width 2.5", a, {**DISTANCE_TEXTURE, "texels_per_edge": 2.5,
+                                                      "min_width": 2.5})]
     if not quick:
         configs += [("Ax2", scaled(a, 2.0), {}), ("A/4", scaled(a, 0.25), {}),
-                    ("A, width 3 q0.3", a, {"scale_quantile": 0.3}),
-                    ("A, width 2 q0.3, no narrow lines", a, {"texels_per_edge": 2.0,
+                    ("A, width 1.5 q0.3", a, {"scale_quantile": 0.3}),
+                    ("A, width 1 q0.3, no narrow lines", a, {"texels_per_edge": 1.0,
                                                             "scale_quantile": 0.3,
                                                             "min_width": None})]
     return configs
@@ -326,6 +340,53 @@ def save_sweep_figure(path: Path, rows: list[dict], title: str) -> None:
     plt.close(fig)
 
 
+CLOSEUP_SIZE = (400, 400)
+CLOSEUP_ELEMENTS = 6.0  # elements across the close-up view's radius
+
+
+def closeup_camera(mesh: FEMesh) -> Camera:
+    """A magnified view at ``VIEW``'s angles: centred on the node nearest to the top centre of the
+    mesh's bounding box, ``CLOSEUP_ELEMENTS`` median element edges in radius; its near and far
+    planes open so that the surface is not cut to the view sphere."""
+    import dataclasses
+
+    lo, hi = mesh.bounds()
+    nodes = mesh.nodes
+    e = np.asarray(mesh.elements)
+    edge = np.linalg.norm(nodes[e] - nodes[np.roll(e, -1, axis=1)], axis=2)
+    radius = CLOSEUP_ELEMENTS * float(np.median(edge[edge > 0]))
+    top = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2]])
+    centre = nodes[np.argmin(np.linalg.norm(nodes - top, axis=1))]
+    cam = Camera.fit(centre, radius, **VIEW)
+    return dataclasses.replace(cam, near=0.01 * radius, far=cam.far + 100.0 * radius)
+
+
+def closeup_rows(case: Case, models: dict, variants: dict, ctx, say) -> tuple[list, dict]:
+    """Wire fidelity magnified (:func:`closeup_camera`): each wire path of set A against line
+    overdraw, untimed, and the images by label."""
+    camera = closeup_camera(case.mesh)
+    crease = PARAMETER_SETS["A"].alpha_g1_deg
+    overdraw = measure(ctx, case.mesh, "gouraud", Style(crease_deg=crease, wireframe=True,
+                                                        wire_color=WIRE),
+                       camera=camera, size=CLOSEUP_SIZE, timed=False).image
+    images = {OVERDRAW: overdraw}
+    rows = []
+    drawn = [(NEW, models["A"])] + [(rules, m) for (name, rules), m in variants.items()
+                                     if name == "A"]
+    for rules, model in drawn:
+        label = variant_label("A", rules, "+ normal map + wire texture")
+        image = measure(ctx, model.simplified, "fe_normal_wire", Style(wire_color=WIRE),
+                        camera=camera, size=CLOSEUP_SIZE, timed=False).image
+        images[label] = image
+        rows.append(dict(mesh=case.label, view=f"close-up, {CLOSEUP_SIZE[0]}x{CLOSEUP_SIZE[1]}",
+                         path=label, rules=rules,
+                         wire_encoding=model.wire_encoding,
+                         **wire_agreement(image, overdraw, WIRE),
+                         ssim=compare_images(overdraw, image).ssim))
+        say(f"  {case.label} close-up {label}: wire IoU {rows[-1]['wire_iou_1px']:.3f}")
+    return rows, images
+
+
 def crop(image: np.ndarray, box) -> np.ndarray:
     y0, y1, x0, x1 = box
     return image[y0:y1, x0:x1]
@@ -340,7 +401,7 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
     ctx = create_context()
     gl_renderer = renderer(ctx)
     write_table(params_rows(), out_dir, "params", title="fe2003 Table 1: parameter sets")
-    pre, rows, sweep = [], [], []
+    pre, rows, sweep, closeups = [], [], [], []
     first = True
     for case in cases(quick, say):
         say(f"{case.label}: {case.mesh.n_elements} elements")
@@ -361,6 +422,13 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
         drawer = Drawer(ctx, case.mesh, size, repeat)
         mesh_rows, images = table_rows(case, models, variants, drawer, gl_renderer, say)
         rows += mesh_rows
+        near_rows, near_images = closeup_rows(case, models, variants, ctx, say)
+        closeups += near_rows
+        if first:
+            save_image_grid(out_dir / "closeup.png", list(near_images.values()),
+                            [f"{case.label}: {OVERDRAW}"]
+                            + [label.replace(" + normal map + wire texture", "")
+                               for label in list(near_images)[1:]], columns=3)
         if first:
             h, w = size[1], size[0]
             box = (h // 3, h // 3 + h // 3, w // 3, w // 3 + w // 3)
@@ -375,6 +443,8 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
         say(f"sweep on {sweep_case.label}")
         sweep = sweep_rows(sweep_case, Drawer(ctx, sweep_case.mesh, size, repeat), quick, say)
     write_table(pre, out_dir, "preprocessing", title="fe2003 Table 2: preprocessing seconds")
+    write_table(closeups, out_dir, "closeup",
+                title="Wire fidelity magnified: set A's wire frames against line overdraw")
     write_table(rows, out_dir, "table3", columns=TABLE3,
                 title="fe2003 Table 3: time per frame against error (all columns: table.md)")
     if sweep:

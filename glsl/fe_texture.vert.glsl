@@ -6,6 +6,10 @@
 in vec3 position;
 in vec2 texcoord;  // uv / (W, H)
 out vec2 st;
+#if WIRE_CORNERS
+in int base;  // the row of the subpatch's first element in the corner table
+flat out int element_base;
+#endif
 #if NORMAL_MAP
 in float axis;  // dropped normal component 0, 1 or 2, constant over a subpatch
 out vec3 eye_position;
@@ -18,6 +22,9 @@ out float light;
 void main() {
     vec3 p = place(position);
     st = texcoord;
+#if WIRE_CORNERS
+    element_base = base;
+#endif
 #if NORMAL_MAP
     eye_position = p;
     normal_axis = int(axis + 0.5);

@@ -17,9 +17,10 @@ def result(tmp_path_factory):
 
 def test_every_table_and_figure_is_written(result):
     _, out_dir = result
-    for name in ("table", "table3", "params", "preprocessing"):
+    for name in ("table", "table3", "params", "preprocessing", "closeup"):
         assert (out_dir / f"{name}.csv").is_file() and (out_dir / f"{name}.md").is_file()
     assert (out_dir / "crops.png").stat().st_size > 1000
+    assert (out_dir / "closeup.png").stat().st_size > 1000
     params = read_table(out_dir / "params.csv")
     assert [(r["set"], r["alpha_g1_deg"], r["d_mm"], r["l_outer_mm"], r["l_inner_mm"])
             for r in params] == [("A", 12, 1, 0.5, 8), ("B", 18, 3, 2.5, 15)]
@@ -70,15 +71,20 @@ def test_before_and_after_rows_show_the_bound_and_the_texture_memory(result):
         new = by["simplified A + normal map + wire texture"]
         paper = by["simplified A [paper] + normal map + wire texture"]
         bound_only = by["simplified A [certified d, paper texture] + normal map + wire texture"]
+        distance = by["simplified A [distance texture] + normal map + wire texture"]
         assert (new["rules"], paper["rules"]) == ("new", "paper")
         # the certified distance: within d with the new construction, whatever the paper's did
         for r in (new, bound_only):
             assert r["within_d"] and r["hausdorff_mm"] <= r["d_mm"]
-        # the texture rule alone changes the memory, not the surface
-        assert bound_only["triangles"] == new["triangles"]
-        assert new["rgba_texels_per_element"] < bound_only["rgba_texels_per_element"]
+        # the texture rule and the encoding change the memory, not the surface
+        assert bound_only["triangles"] == distance["triangles"] == new["triangles"]
+        assert new["rgba_texels_per_element"] < distance["rgba_texels_per_element"] \
+            < bound_only["rgba_texels_per_element"]
     pre = read_table(out_dir / "preprocessing.csv")
-    assert {r["rules"] for r in pre} == {"new", "paper", "certified d, paper texture"}
+    assert {r["rules"] for r in pre} == {"new", "paper", "certified d, paper texture",
+                                         "distance texture"}
+    assert {r["wire_encoding"] for r in pre if r["rules"] == "new"} == {"corners"}
+    assert {r["wire_encoding"] for r in pre if r["rules"] != "new"} == {"distance"}
     for r in pre:
         if r["rules"] != "paper":
             assert r["certified_bound_mm"] <= PARAMETER_SETS[r["set"]].d
@@ -86,3 +92,18 @@ def test_before_and_after_rows_show_the_bound_and_the_texture_memory(result):
     configs = {r["config"]: r for r in sweep}
     assert configs["A, paper rules"]["fit_share"] == 1 and not configs["A, paper rules"]["certify"]
     assert configs["A"]["within_d"] and configs["A"]["hausdorff_mm"] <= configs["A"]["d_mm"]
+
+
+def test_closeup_compares_every_wire_frame_of_set_a_magnified(result):
+    _, out_dir = result
+    rows = read_table(out_dir / "closeup.csv")
+    meshes = {r["mesh"] for r in rows}
+    assert "stamped panels" in meshes
+    for mesh in meshes:
+        by = {r["rules"]: r for r in rows if r["mesh"] == mesh}
+        assert set(by) == {"new", "paper", "certified d, paper texture", "distance texture"}
+        for r in by.values():
+            assert 0 < r["wire_recall_1px"] <= 1 and 0 < r["wire_precision_1px"] <= 1
+            assert r["wire_pixels"] > 0 and r["overdraw_wire_pixels"] > 0
+        # element corners draw the lines where they are, magnified too
+        assert by["new"]["wire_iou_1px"] >= 0.95

@@ -22,7 +22,7 @@ from workbench.algo.fepatch.pipeline import (
     simplified_triangles,
     unpinched,
 )
-from workbench.algo.fepatch.wiretex import on_outline
+from workbench.algo.fepatch.wireid import on_outline
 from workbench.algo.hausdorff import hausdorff
 from workbench.scene.derived import triangulate
 from workbench.scene.generators import stamped_panel
@@ -425,7 +425,7 @@ def test_wire_texture_outlines_every_interior_edge(bent):
         for a, b in zip(quad, quad[1:] + quad[:1]):
             sides.setdefault(tuple(sorted((a, b))), set()).add(int(m.subpatch[k]))
     t = np.linspace(0.2, 0.8, 7)[:, None]
-    probes, inside = [], []
+    probes, inside, base = [], [], []
     for k, quad in enumerate(e.tolist()):
         for a, b in zip(quad, quad[1:] + quad[:1]):
             if a == b or tuple(sorted((a, b))) in lines:
@@ -433,9 +433,10 @@ def test_wire_texture_outlines_every_interior_edge(bent):
             ua, ub = o.uv[vertex[(k, a)]], o.uv[vertex[(k, b)]]
             probes.append(ua + t * (ub - ua))
             inside += [len(sides[tuple(sorted((a, b)))]) == 1] * len(t)
+            base += [o.element_base[vertex[(k, a)]]] * len(t)
     probes, inside = np.concatenate(probes), np.array(inside)
     assert len(probes) > 7 * len(e) and 0 < inside.sum() < len(inside)
-    hit = on_outline(o.wire_map, probes, 0.5, o.wire_range)
+    hit = on_outline(o, probes, 0.5, np.array(base))
     assert hit.mean() >= 0.99, f"{hit.mean():.4f} of {len(probes)} probes on an outline"
     # inside a subpatch both elements of an edge share the chart: every probe is outlined
     # (the few misses are on subpatch borders, where the neighbour lies in another chart)
@@ -443,7 +444,8 @@ def test_wire_texture_outlines_every_interior_edge(bent):
     # and element interiors are not outlined everywhere: the centres are mostly clear
     centre = np.array([o.uv[[vertex[(k, n)] for n in quad]].mean(axis=0)
                        for k, quad in enumerate(e.tolist())])
-    assert on_outline(o.wire_map, centre, 0.5, o.wire_range).mean() < 0.05
+    centre_base = [o.element_base[vertex[(k, quad[0])]] for k, quad in enumerate(e.tolist())]
+    assert on_outline(o, centre, 0.5, np.array(centre_base)).mean() < 0.05
 
 
 # --------------------------------------------------------------------------- 7. fallback

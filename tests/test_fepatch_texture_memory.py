@@ -13,7 +13,9 @@ from hypothesis import strategies as st
 from workbench.algo.fepatch.atlas import build_atlas
 from workbench.algo.fepatch.pipeline import PAPER_TEXTURE_RULE, build_model
 from workbench.algo.fepatch.surface import TexturedSurface
-from workbench.algo.fepatch.wiretex import MIN_WIDTH, element_widths, on_outline
+from workbench.algo.fepatch import wireid, wiretex
+from workbench.algo.fepatch.wireid import on_outline
+from workbench.algo.fepatch.wiretex import element_widths
 from workbench.scene.derived import triangulate
 
 
@@ -36,14 +38,26 @@ def graded_plate(seed: int, nx: int, ny: int, grade: float, skew: float, bump: f
     return e.astype(np.int64), np.c_[x, y, z]
 
 
-def corner_uv(e, coords, surface) -> np.ndarray:
-    """(M, 4, 2) atlas positions of every element's corners on the original surface."""
+def corner_vertices(e, coords, surface) -> np.ndarray:
+    """(M, 4) vertex of every element corner on the original surface."""
     tri = triangulate(e, coords)
     vertex = {}
     for t, k in enumerate(tri.element_of.tolist()):
         for corner, v in zip(tri.corners[t].tolist(), surface.triangles[t].tolist()):
             vertex[(k, int(corner))] = v
-    return np.array([[surface.uv[vertex[(k, c)]] for c in range(4)] for k in range(len(e))])
+    return np.array([[vertex[(k, c)] for c in range(4)] for k in range(len(e))])
+
+
+def corner_uv(e, coords, surface) -> np.ndarray:
+    """(M, 4, 2) atlas positions of every element's corners on the original surface."""
+    return surface.uv[corner_vertices(e, coords, surface)]
+
+
+def element_base(e, coords, surface) -> np.ndarray | int:
+    """(M,) the corner-table row of each element's subpatch (0 for the distance texture)."""
+    if surface.element_base is None:
+        return 0
+    return surface.element_base[corner_vertices(e, coords, surface)[:, 0]]
 
 
 def segment_distance(points, a, b):
@@ -97,17 +111,24 @@ def test_element_widths_of_known_shapes():
 
 
 # ------------------------------------------------------------------------- the scale rule
+ENCODINGS = {"corners": (wireid.MIN_WIDTH, 1.2, 2.2), "distance": (wiretex.MIN_WIDTH, 2.0, 3.0)}
+
+
 @settings(max_examples=25, deadline=None)
 @given(seed=st.integers(0, 10**6), grade=st.floats(1.0, 1.25), skew=st.floats(-0.6, 0.6),
-       bump=st.floats(0.0, 3.0), texels=st.floats(2.0, 3.0), quantile=st.floats(0.0, 0.4))
+       bump=st.floats(0.0, 3.0), share=st.floats(0.0, 1.0), quantile=st.floats(0.0, 0.4),
+       encoding=st.sampled_from(sorted(ENCODINGS)))
 def test_every_outline_is_decodable_within_a_texel_or_drawn_as_lines(seed, grade, skew, bump,
-                                                                     texels, quantile):
+                                                                     share, quantile, encoding):
+    min_width, low, high = ENCODINGS[encoding]
     e, c = graded_plate(seed, 8, 6, grade, skew, bump)
-    m = build_model(e, c, "12,0.5,0.3,2", texels_per_edge=texels, scale_quantile=quantile)
+    m = build_model(e, c, "12,0.5,0.3,2", wire_encoding=encoding,
+                    texels_per_edge=low + share * (high - low), scale_quantile=quantile)
     o = m.original
     corners = corner_uv(e, c, o)
+    base = element_base(e, c, o)
     width = element_widths(corners)
-    narrow = width < MIN_WIDTH
+    narrow = width < min_width
     assert m.narrow_elements == int(narrow.sum())
     # node of every vertex: the corners the element triangulation names
     tri = triangulate(e, c)
@@ -121,7 +142,7 @@ def test_every_outline_is_decodable_within_a_texel_or_drawn_as_lines(seed, grade
             if a != b:
                 users.setdefault(tuple(sorted((a, b))), []).append((k, j, a))
     t = np.linspace(0.2, 0.8, 7)[:, None]
-    probes = []
+    probes, probe_base = [], []
     for key, sides in users.items():
         if any(narrow[k] for k, _, _ in sides):
             # too narrow for the texture at this scale: its edges are drawn as lines
@@ -132,6 +153,7 @@ def test_every_outline_is_decodable_within_a_texel_or_drawn_as_lines(seed, grade
             ua, ub = corners[k, j], corners[k, (j + 1) % 4]
             along = t if a == key[0] else 1.0 - t  # the same points of the edge on every side
             probes.append(ua + along * (ub - ua))
+            probe_base += [np.broadcast_to(base, len(e))[k]] * len(t)
     # recall: along the middle of every edge the texture must show, the outline of one of the
     # edge's elements passes (in its own chart): at every probe inside a subpatch; on subpatch
     # borders, where the two elements lie in different charts and each outlines itself alone,
@@ -139,7 +161,7 @@ def test_every_outline_is_decodable_within_a_texel_or_drawn_as_lines(seed, grade
     edge_ids = np.repeat(np.array([i for i, (key, sides) in enumerate(users.items())
                                    if key not in lines for _ in sides], np.int64), len(t))
     position = np.tile(np.arange(len(t)), len(probes))
-    hit = on_outline(o.wire_map, np.concatenate(probes), 0.5, o.wire_range) if probes else \
+    hit = on_outline(o, np.concatenate(probes), 0.5, np.array(probe_base)) if probes else \
         np.zeros(0, bool)
     shown = np.zeros((len(users), len(t)), bool)
     np.logical_or.at(shown, (edge_ids, position), hit)
@@ -148,15 +170,34 @@ def test_every_outline_is_decodable_within_a_texel_or_drawn_as_lines(seed, grade
                        for sides in users.values()])
     assert shown[needed & inside].all()
     assert shown[needed].mean() >= 0.99 if needed.any() else True
-    # precision: every texel centre the texture outlines lies within a texel of an element edge
-    h, w = o.wire_map.shape[:2]
-    jj, ii = np.meshgrid(np.arange(w), np.arange(h))
-    centres = np.c_[jj.ravel() + 0.5, ii.ravel() + 0.5]
-    hit = centres[on_outline(o.wire_map, centres, 0.5, o.wire_range)]
     a = corners.reshape(-1, 2)
     b = np.roll(corners, -1, axis=1).reshape(-1, 2)
     keep = np.linalg.norm(b - a, axis=1) > 1e-9
-    assert len(hit) and segment_distance(hit, a[keep], b[keep]).max() <= 1.0
+    if encoding == "distance":
+        # precision: every texel centre the texture outlines lies within a texel of an edge
+        h, w = o.wire_map.shape[:2]
+        jj, ii = np.meshgrid(np.arange(w), np.arange(h))
+        centres = np.c_[jj.ravel() + 0.5, ii.ravel() + 0.5]
+        hit = centres[on_outline(o, centres, 0.5)]
+        assert len(hit) and segment_distance(hit, a[keep], b[keep]).max() <= 1.0
+        return
+    # element ids and corners: along the middle of every edge the decoded distance is within a
+    # quarter texel of zero, and anywhere in an element it is never below the true distance to
+    # the nearest edge (no line that is not there), up to the corners' quantisation
+    if not probes:
+        return
+    probes = np.concatenate(probes)
+    decoded = wireid.outline_distance(o.element_map, o.corner_table, o.corner_frac, probes,
+                                      np.array(probe_base), o.no_element)
+    assert decoded.max() <= 0.25, f"{decoded.max():.3f} texels off an edge"
+    rng = np.random.default_rng(seed)
+    k = rng.integers(0, len(e), 400)
+    w3 = rng.dirichlet(np.ones(3), 400)
+    points = (w3[:, :, None] * corners[k][:, [0, 1, 2]]).sum(axis=1)
+    got = wireid.outline_distance(o.element_map, o.corner_table, o.corner_frac, points,
+                                  np.broadcast_to(base, len(e))[k], o.no_element)
+    true = segment_distance(points, a[keep], b[keep])
+    assert (got >= true - 1.0 / o.corner_frac).all()
 
 
 def test_quantile_rule_spends_no_more_texels_than_the_smallest_element_rule():
@@ -207,11 +248,11 @@ def test_new_rule_needs_fewer_texels_per_element_than_the_paper_rule():
 @pytest.mark.parametrize("reduction", [1, 2, 3])
 def test_normal_map_is_coarser_by_an_integer_and_shares_the_coordinates(reduction):
     e, c = graded_plate(1, 8, 6, 1.1, 0.1, 2.0)
-    m = build_model(e, c, "A", normal_reduction=reduction)
+    m = build_model(e, c, "A", normal_reduction=reduction, texels_per_edge=3.0)
     s = m.simplified
-    wh, ww = s.wire_map.shape[:2]
+    ww, wh = s.size
     nh, nw = s.normal_map.shape[:2]
-    assert (ww, wh) == s.size == tuple(m.atlas_size)
+    assert s.element_map.shape == (wh, ww) and (ww, wh) == tuple(m.atlas_size)
     assert (nw * reduction, nh * reduction) == (ww, wh)
     # the map is read at uv / (W, H): at each vertex it gives the vertex normal
     st = s.uv / np.array([ww, wh])

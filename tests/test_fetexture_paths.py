@@ -16,6 +16,7 @@ import pytest
 import workbench.paths.fetexture  # noqa: F401  (registers the paths)
 from workbench.algo.fepatch.normalmap import decode_normals, encode_normals
 from workbench.algo.fepatch.surface import TexturedSurface
+from workbench.algo.fepatch.wireid import corner_table, element_map
 from workbench.experiment.measure import measure
 from workbench.gl import Camera
 from workbench.paths import PATHS, Style, make_path
@@ -92,16 +93,30 @@ def triangles_of(quads):
     return np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
 
 
+def element_wire(quads) -> dict:
+    """The grid's element-id wire frame (one subpatch, elements in quad order)."""
+    size = 2 * MARGIN + N * TEXELS
+    corners = grid_uv()[quads]
+    owner = element_map(corners, (size, size), border=1)
+    table, frac = corner_table(corners, (size, size))
+    return {"element_map": np.where(owner < 0, 65535, owner).astype(np.uint16),
+            "corner_table": table, "corner_frac": frac,
+            "element_base": np.zeros((N + 1) ** 2, np.int32)}
+
+
 def surface(centre=FAR, normal=(0.0, 0.0, 1.0), axis=2, wire=True, line_edges=None, z=None):
-    """The grid as a TexturedSurface with a constant normal map and vertex normals."""
+    """The grid as a TexturedSurface with a constant normal map and vertex normals; ``wire``
+    True or "distance" (the distance texture), "corners" (element ids and corners) or False."""
     nodes, quads = grid_nodes(centre, z)
     size = 2 * MARGIN + N * TEXELS
     texel = encode_normals(np.asarray(normal, np.float64)[None], axis)[0]
+    frame = element_wire(quads) if wire == "corners" else \
+        {"wire_map": wire_map()} if wire else {}
     return TexturedSurface(
         positions=nodes, triangles=triangles_of(quads), uv=grid_uv(),
         normal_axis=np.full(len(nodes), axis), normals=np.tile(normal, (len(nodes), 1)),
-        normal_map=np.tile(texel, (size, size, 1)).astype(np.uint8),
-        wire_map=wire_map() if wire else None, line_edges=line_edges)
+        normal_map=np.tile(texel, (size, size, 1)).astype(np.uint8), line_edges=line_edges,
+        **frame)
 
 
 def camera(centre=FAR, **kw):
@@ -190,9 +205,10 @@ def test_registry_and_refusals(ctx):
     path.release()
 
 
+@pytest.mark.parametrize("encoding", ["distance", "corners"])
 @pytest.mark.parametrize("name", ["fe_wire_texture", "fe_normal_wire"])
-def test_wire_texture_outlines_the_cells(ctx, name):
-    image, _ = draw(ctx, name, surface(), camera(), base_color=(0.5, 0.5, 0.5))
+def test_wire_texture_outlines_the_cells(ctx, name, encoding):
+    image, _ = draw(ctx, name, surface(wire=encoding), camera(), base_color=(0.5, 0.5, 0.5))
     wire = is_wire(image)
     d = edge_distance_px()[wire]
     # one-pixel lines: about one wire pixel per pixel of inner edge length (the two lines
@@ -247,17 +263,21 @@ def test_normal_map_is_per_pixel(ctx):
     assert np.abs(got - expected).max() <= 2.0
 
 
-@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
-def test_wire_texture_matches_gouraud(ctx, projection):
+@pytest.mark.parametrize("projection, encoding", [("orthographic", "distance"),
+                                                  ("perspective", "distance"),
+                                                  ("perspective", "corners")])
+def test_wire_texture_matches_gouraud(ctx, projection, encoding):
     centre = FAR + [0.0, 0.0, 0.3]
     nodes, quads = grid_nodes(centre, z=lambda X, Y: 0.3 * np.sin(2.5 * X) * np.cos(1.5 * Y))
     mesh = FEMesh(nodes, quads)
     split = mesh.gouraud(30.0)
     vertex = np.asarray(split.vertex_node, np.int64)
-    base = surface()
+    frame = element_wire(quads) if encoding == "corners" else {"wire_map": wire_map()}
+    if encoding == "corners":
+        frame["element_base"] = frame["element_base"][vertex]
     surf = TexturedSurface(positions=nodes[vertex], triangles=split.triangles,
                            uv=grid_uv()[vertex], normal_axis=np.full(len(vertex), 2),
-                           normals=split.normals(mesh.nodes), wire_map=base.wire_map)
+                           normals=split.normals(mesh.nodes), **frame)
     cam = camera(centre, azimuth=30.0, elevation=25.0, projection=projection)
     ours, _ = draw(ctx, "fe_wire_texture", surf, cam)
     reference = measure(ctx, mesh, "gouraud", Style(), camera=cam, size=(SIZE, SIZE),

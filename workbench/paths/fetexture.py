@@ -38,11 +38,21 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from ..algo.fepatch.surface import TexturedSurface
+from ..algo.fepatch.surface import CORNER_ROW, TexturedSurface, corner_rows
 from ..gl import load_program
 from .base import GLPath
 
 __all__ = ["FETexturePath", "FEWireTexturePath", "FENormalMapPath", "FENormalWirePath"]
+
+
+def corner_texture(table: np.ndarray) -> np.ndarray:
+    """The (rows, CORNER_ROW, 4) uint32 texture of a (M, 4, 2) uint16 corner table: element i
+    at row i // CORNER_ROW, column i % CORNER_ROW, corner k in channel k as u + 65536·v; the
+    last row is padded with zeros."""
+    rows = corner_rows(len(table))
+    out = np.zeros((rows * CORNER_ROW, 4), np.uint32)
+    out[:len(table)] = table[..., 0].astype(np.uint32) | (table[..., 1].astype(np.uint32) << 16)
+    return out.reshape(rows, CORNER_ROW, 4)
 
 
 class FETexturePath(GLPath):
@@ -92,9 +102,9 @@ class FETexturePath(GLPath):
                              f"no normal_map")
         if not self.normal_map and surface.normals is None:
             raise ValueError(f"path {self.name!r} lights per vertex: the surface has no normals")
-        if self.wire_texture and surface.wire_map is None:
+        if self.wire_texture and surface.wire_map is None and surface.element_map is None:
             raise ValueError(f"path {self.name!r} outlines with the wire texture: the surface "
-                             f"has no wire_map")
+                             f"has no wire_map or element_map")
         if self.normal_map and len(surface.normal_axis) and \
                 (surface.normal_axis.min() < 0 or surface.normal_axis.max() > 2):
             raise ValueError("normal_axis must be 0, 1 or 2")
@@ -107,10 +117,16 @@ class FETexturePath(GLPath):
         self._surface = surface
 
     def _texture(self, ctx, data: np.ndarray, unit: int, name: str) -> int:
+        """Upload ``data`` (H, W, C) as a texture on ``unit``: bytes filtered linearly, unsigned
+        integers (uint16, uint32) as an integer texture read texel by texel."""
         height, width, channels = data.shape
+        integer = data.dtype != np.uint8
+        dtype = {np.dtype(np.uint8): "f1", np.dtype(np.uint16): "u2",
+                 np.dtype(np.uint32): "u4"}[data.dtype]
         tex = self._keep(ctx.texture((width, height), channels, np.ascontiguousarray(data).tobytes(),
-                                     dtype="f1", alignment=1))
-        tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+                                     dtype=dtype, alignment=1))
+        nearest = (moderngl.NEAREST, moderngl.NEAREST)
+        tex.filter = nearest if integer else (moderngl.LINEAR, moderngl.LINEAR)
         tex.repeat_x = tex.repeat_y = False
         self._program[name].value = unit
         self._textures.append((tex, unit))
@@ -118,8 +134,11 @@ class FETexturePath(GLPath):
 
     def _build(self, ctx: moderngl.Context, scene, camera) -> None:
         surface, style = self._surface, self.style
+        corners = self.wire_texture and surface.element_map is not None
         defines = {"NUM_CLIP": len(style.clip_planes), "NORMAL_MAP": int(self.normal_map),
-                   "WIRE_TEXTURE": int(self.wire_texture)}
+                   "WIRE_TEXTURE": int(self.wire_texture and not corners),
+                   "WIRE_CORNERS": int(corners), "CORNER_ROW": CORNER_ROW,
+                   "CORNER_SHIFT": CORNER_ROW.bit_length() - 1}
         self._program = self._keep(load_program(ctx, "fe_texture.vert.glsl",
                                                 "fe_texture.frag.glsl", defines=defines))
         self._program["base_color"].value = style.base_color
@@ -141,12 +160,23 @@ class FETexturePath(GLPath):
             extra = surface.normals.astype(np.float32)
             content.append((self._keep(ctx.buffer(extra.tobytes())), "3f", "normal"))
         uploaded += extra.nbytes
+        if corners:
+            base = np.ascontiguousarray(surface.element_base, np.int32)
+            content.append((self._keep(ctx.buffer(base.tobytes())), "1i", "base"))
+            uploaded += base.nbytes
         self._vao = self._keep(ctx.vertex_array(self._program, content, self._index,
                                                 index_element_size=4))
 
         if self.normal_map:
             uploaded += self._texture(ctx, surface.normal_map, 0, "normal_map")
-        if self.wire_texture:
+        if corners:
+            uploaded += self._texture(ctx, surface.element_map[..., None], 1, "element_map")
+            uploaded += self._texture(ctx, corner_texture(surface.corner_table), 2,
+                                      "corner_table")
+            self._program["no_element"].value = surface.no_element
+            self._program["corner_step"].value = 1.0 / surface.corner_frac
+            self._program["wire_color"].value = style.wire_color
+        elif self.wire_texture:
             uploaded += self._texture(ctx, surface.wire_map, 1, "wire_map")
             self._program["wire_range"].value = float(surface.wire_range)
             self._program["wire_color"].value = style.wire_color

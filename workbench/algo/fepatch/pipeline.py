@@ -18,9 +18,9 @@ Stages (timed separately, as in the paper's Table 2):
    original elements (see :func:`certified_triangles`).
 3. **textures** -- the atlas of the subpatch planes, the two-component normal map of the
    original crease-split vertex normals (dilated at subpatch borders, coarser than the wire
-   texture by an integer factor) and the wire-frame distance texture of every original
-   element; elements the atlas scale leaves too narrow for the texture get their edges drawn
-   as lines.
+   frame by an integer factor) and the wire frame of every original element, as element ids
+   and corners (the default) or as fe2003's signed-distance texture; elements the atlas scale
+   leaves too narrow for the encoding get their edges drawn as lines.
 
 Everything is float64 and GL-free; the result is two :class:`TexturedSurface`: ``original``
 (every element, triangulated) and ``simplified``.
@@ -41,7 +41,6 @@ from .lines import line_tolerance, simplify_polyline
 from .normalmap import dropped_axis
 from .polygon import polygon_area, triangulate_polygon
 from .surface import TexturedSurface
-from .wiretex import MIN_WIDTH
 
 __all__ = [
     "PAPER_DISTANCE_RULE",
@@ -58,6 +57,7 @@ __all__ = [
 ]
 
 STAGES = ("features, subpatches, lines", "retriangulation", "textures")
+WIRE_ENCODINGS = ("corners", "distance")
 
 
 @dataclass(frozen=True)
@@ -92,9 +92,9 @@ PARAMETER_SETS = {"A": FEPatchParams(12.0, 1.0, 0.5, 8.0, "A"),
 # may lie up to 2d from the original) and the texture scale (the smallest element extent
 # spans 3 texels per axis, a full-resolution normal map, a 3-texel border)
 PAPER_DISTANCE_RULE = {"fit_share": 1.0, "certify": False}
-PAPER_TEXTURE_RULE = {"texels_per_edge": 3.0, "border": 3, "scale_quantile": 0.0,
-                      "scale_by": "extent", "atlas_turns": 1, "normal_reduction": 1,
-                      "min_width": None}
+PAPER_TEXTURE_RULE = {"wire_encoding": "distance", "texels_per_edge": 3.0, "border": 3,
+                      "scale_quantile": 0.0, "scale_by": "extent", "atlas_turns": 1,
+                      "normal_reduction": 1, "min_width": None}
 PAPER_RULES = {**PAPER_DISTANCE_RULE, **PAPER_TEXTURE_RULE}
 
 
@@ -127,7 +127,8 @@ class FEModel:
     certified), so the one-sided Hausdorff distance is at most it; ``split_subpatches`` and
     ``kept_subpatches``: subpatches regrown or kept as original elements for the bound;
     ``narrow_elements``: elements whose edges are drawn as lines because the atlas scale
-    leaves them narrower than the wire texture can outline.
+    leaves them narrower than the wire texture can outline; ``wire_encoding`` "corners" or
+    "distance" (see :func:`build_model`).
     """
 
     params: FEPatchParams
@@ -150,6 +151,7 @@ class FEModel:
     split_subpatches: int = 0
     kept_subpatches: int = 0
     narrow_elements: int = 0
+    wire_encoding: str = "corners"
 
     @property
     def rgba_texels_per_element(self) -> float:
@@ -636,19 +638,23 @@ def _corner_normals(e: np.ndarray, coords: np.ndarray, crease_deg: float,
     return n
 
 
-def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, border: int = 2,
+def build_model(elements, coords, params="A", *, wire_encoding: str = "corners",
+                texels_per_edge: float | None = None, border: int | None = None,
                 wire_range: float = 2.0, atlas_scale: str = "subpatch", fit_share: float = 1.0,
-                certify: bool = True, scale_quantile: float = 0.02, normal_reduction: int = 2,
-                min_width: float | None = MIN_WIDTH, scale_by: str = "width",
-                atlas_turns: int = 8) -> FEModel:
+                certify: bool = True, scale_quantile: float = 0.02,
+                normal_reduction: int = 2, min_width: float | None | str = "encoding",
+                scale_by: str = "width", atlas_turns: int = 8) -> FEModel:
     """Run every stage on ``elements`` (M, 4) and ``coords`` (N, 3) float64 (model units).
 
-    ``params``: see :func:`parse_params`. ``texels_per_edge``: texels across the smallest element
-    along each plane axis, or across the ``scale_quantile`` one (the paper's Nyquist rule asks
-    for 2; the wire texture's outlines stay whole, magnified too, from about 3 texels of
-    width, see :mod:`workbench.algo.fepatch.wiretex`); ``border``: texels around each subpatch in the
-    atlas (the wire texture's ring and the normal map's dilation); ``atlas_scale``:
-    "subpatch" (one scale per subpatch and axis, as the paper) or "global".
+    ``params``: see :func:`parse_params`. ``wire_encoding``: "corners", the element-id wire
+    frame of :mod:`workbench.algo.fepatch.wireid` (outlines computed from element corners, whole
+    from about 1.5 texels of element width), or "distance", fe2003's signed-distance texture of
+    :mod:`workbench.algo.fepatch.wiretex` (whole from about 3 texels). ``texels_per_edge``:
+    texels across the smallest element along each plane axis, or across the ``scale_quantile``
+    one (the paper's Nyquist rule asks for 2; default: the encoding's ``MIN_WIDTH``);
+    ``border``: texels around each subpatch in the atlas (the wire frame's ring and the normal
+    map's dilation; default 1 for "corners", 2 for "distance"); ``atlas_scale``: "subpatch"
+    (one scale per subpatch and axis, as the paper) or "global".
 
     Distance bound: ``fit_share`` and ``certify``, the subpatch fit tolerance over ``d`` and
     the check-and-repair of the bound, see :func:`certified_triangles` (the paper's
@@ -658,16 +664,27 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
     (``scale_by`` "extent") or widths ("width"), not the smallest, span ``texels_per_edge``
     (see :func:`build_atlas`); every element narrower than ``min_width`` texels at that scale
     (:func:`element_widths`) has its edges drawn as lines, so that its outline shows although
-    the texture cannot hold it (None: no such lines). ``atlas_turns``: in-plane turns of each
-    subpatch's axes tried for the smallest rectangle (see :func:`build_atlas`).
-    ``normal_reduction`` (a positive integer) makes the normal map that many times coarser per
-    axis than the wire texture; both share the texture coordinates (the atlas size is a
-    multiple of it). The paper's rule is
-    :data:`PAPER_TEXTURE_RULE`. Refuses empty meshes and non-finite coordinates.
+    the texture cannot hold it ("encoding": the encoding's ``MIN_WIDTH``; None: no such lines).
+    ``atlas_turns``: in-plane turns of each subpatch's axes tried for the smallest rectangle
+    (see :func:`build_atlas`). ``normal_reduction`` (a positive integer) makes the normal map
+    that many times coarser per axis than the wire frame; both share the texture coordinates
+    (the atlas size is a multiple of it; default 2). The
+    paper's rule is :data:`PAPER_TEXTURE_RULE`. Refuses empty meshes, non-finite coordinates
+    and an unknown encoding.
     """
+    from . import wireid, wiretex
     from .bake import normal_map
-    from .wiretex import checkerboard, element_widths, wire_texture
 
+    if wire_encoding not in WIRE_ENCODINGS:
+        raise ValueError(f"wire_encoding must be one of {', '.join(WIRE_ENCODINGS)}, got "
+                         f"{wire_encoding!r}")
+    corners_encoding = wire_encoding == "corners"
+    encoding_width = wireid.MIN_WIDTH if corners_encoding else wiretex.MIN_WIDTH
+    texels_per_edge = encoding_width if texels_per_edge is None else texels_per_edge
+    min_width = encoding_width if isinstance(min_width, str) and min_width == "encoding" \
+        else min_width
+    if border is None:
+        border = 1 if corners_encoding else 2
     p = parse_params(params)
     e = as_elements(elements).astype(np.int64)
     c = as_coords(coords, e)
@@ -720,10 +737,15 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
     nmap = normal_map(corners_uv / reduction, corner_n, axis_of_label[sub],
                       (size[0] // reduction, size[1] // reduction),
                       dilate=max(1, -(-border // reduction)))
-    colour, line_nodes = checkerboard(e)
-    wmap = wire_texture(corners_uv, colour, size, wire_range=wire_range)
+    if corners_encoding:
+        wire = _element_wire(corners_uv, sub, size, border, label_of)
+        line_nodes = np.zeros((0, 2), np.int64)
+    else:
+        colour, line_nodes = wiretex.checkerboard(e)
+        wire = {"wire_map": wiretex.wire_texture(corners_uv, colour, size, wire_range=wire_range),
+                "wire_range": wire_range}
     narrow = np.zeros(len(e), bool) if min_width is None else \
-        element_widths(corners_uv) < min_width
+        wiretex.element_widths(corners_uv) < min_width
     seconds[STAGES[2]] = time.perf_counter() - t0
 
     # the line pass: edges the texture cannot show (same-colour neighbours, elements too narrow
@@ -735,7 +757,7 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
     original = TexturedSurface(
         positions=c[node_of], triangles=_element_triangles(corner_vertex, orig_tri),
         uv=uv, normal_axis=normal_axis, normals=vertex_normals, normal_map=nmap,
-        wire_map=wmap, wire_range=wire_range, line_edges=line_edges)
+        line_edges=line_edges, **wire)
     # simplified: the same vertices, only those the new triangles (and the line pass) use
     s_tri = np.concatenate([vertex(np.full(t.shape, s), t) for s, t in sorted(tris.items())])
     used = np.zeros(len(node_of), bool)
@@ -745,7 +767,7 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
     simplified = TexturedSurface(
         positions=c[node_of[used]], triangles=remap[s_tri], uv=uv[used],
         normal_axis=normal_axis[used], normals=vertex_normals[used], normal_map=nmap,
-        wire_map=wmap, wire_range=wire_range, line_edges=remap[line_edges])
+        line_edges=remap[line_edges], **_used_vertices(wire, used))
     on_lines = np.unique(np.concatenate([n for n, _, _ in network.lines])) if network.lines \
         else np.zeros(0, np.int64)
     return FEModel(
@@ -756,7 +778,39 @@ def build_model(elements, coords, params="A", *, texels_per_edge: float = 3.0, b
         fallback=fallback, atlas_size=size, seconds=seconds, fit_share=float(fit_share),
         distance_bound=cert.bound, certify_seconds=cert.certify_seconds,
         split_subpatches=cert.split, kept_subpatches=cert.kept,
-        narrow_elements=int(narrow.sum()))
+        narrow_elements=int(narrow.sum()), wire_encoding=wire_encoding)
+
+
+def _element_wire(corners_uv: np.ndarray, sub: np.ndarray, size, border: int,
+                  label_of: np.ndarray) -> dict:
+    """The element-id wire frame's TexturedSurface fields (see
+    :mod:`workbench.algo.fepatch.wireid`): elements ordered by subpatch in the corner table,
+    the element map holding each texel's element index within its subpatch (uint16 while every
+    subpatch has fewer than 65 535 elements, else uint32), and per vertex (subpatch
+    ``label_of``) the row of its subpatch's first element."""
+    from . import wireid
+
+    order = np.argsort(sub, kind="stable")
+    count = np.bincount(sub, minlength=int(label_of.max(initial=-1)) + 1)
+    first = np.r_[0, np.cumsum(count)[:-1]]
+    rank = np.empty(len(sub), np.int64)
+    rank[order] = np.arange(len(sub))
+    local = rank - first[sub]
+    dtype = np.uint16 if count.max() < np.iinfo(np.uint16).max else np.uint32
+    owner = wireid.element_map(corners_uv, size, border=border)
+    emap = np.full(owner.shape, np.iinfo(dtype).max, dtype)
+    hit = owner != wireid.NO_ELEMENT
+    emap[hit] = local[owner[hit]]
+    table, frac = wireid.corner_table(corners_uv[order], size)
+    return {"element_map": emap, "corner_table": table, "corner_frac": frac,
+            "element_base": first[label_of].astype(np.int32)}
+
+
+def _used_vertices(wire: dict, used: np.ndarray) -> dict:
+    """``wire``'s TexturedSurface fields for the vertices ``used`` (a per-vertex field is cut)."""
+    if "element_base" not in wire:
+        return wire
+    return {**wire, "element_base": wire["element_base"][used]}
 
 
 def _element_edges(e: np.ndarray) -> np.ndarray:
