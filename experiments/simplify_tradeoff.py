@@ -28,7 +28,8 @@ trade-off. At tolerances from 0.05 % to 2 % of each part's bounding-sphere diame
 triangles and certified one-sided distance E (exact metric, original → simplified, whole mesh),
 and for each peer, whole mesh and per part, the fewest triangles it needs for a certified
 distance ≤ E, found by bisection on its target count (per part, each part's share of the count
-is ours). Also our decimator without feature lines, at its own distance.
+is ours). Also our decimator without feature lines, at its own distance, with the count
+meshoptimizer (whole mesh) needs at that distance (``meshoptimizer_at_this_error``).
 
 Figures (``<mesh>_tradeoff.png``): one-sided Hausdorff against triangles and against time, one
 line per method and scope, log axes.
@@ -358,12 +359,16 @@ def equal_error_rows(model: Model, tolerances, say) -> list[dict]:
                                   parts=model.parts, feature_deg=180.0)
         h_free = max(hausdorff(model.vertices, model.triangles, model.vertices, free.triangles,
                                tol=BRACKET_REL * diag).upper, SEARCH_FLOOR_REL * diag)
+        shares = {p: n / max(len(ours.triangles), 1) for p, n in part_targets(model, ours).items()}
+        # and meshoptimizer searched to that distance, its like for like
+        at_free = fewest_triangles_within(
+            model, peer_runner(model, "meshoptimizer simplify", "whole mesh", shares), h_free)
         rows.append(dict(mesh=model.label, tol_pct=pct, method=OURS_NO_FEATURES, scope=scope,
                          borders=border_rule, vertices=kept, error=h_free,
                          error_pct_diag=100 * h_free / diag, triangles=len(free.triangles),
                          over_ours=len(free.triangles) / max(len(ours.triangles), 1),
-                         seconds=free.seconds, calls=1))
-        shares = {p: n / max(len(ours.triangles), 1) for p, n in part_targets(model, ours).items()}
+                         seconds=free.seconds, calls=1,
+                         meshoptimizer_at_this_error=at_free["triangles"]))
         peers = ([(m, "whole mesh") for m in SIMPLIFIERS]
                  + [(m, "per part") for m in PART_SIMPLIFIERS])
         for method, scope in peers:
