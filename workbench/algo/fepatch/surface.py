@@ -32,9 +32,10 @@ Texture conventions (shared with the shaders):
   rows hold each element's corners in texels times ``corner_frac``. A fragment is on an
   outline where its distance to the nearest edge of the elements of the four texels around it
   is within half a pixel. A surface has one wire frame or the other, not both.
-* ``line_edges`` are element edges the texture cannot show -- two neighbours of the same colour,
-  and the outer boundary, which the texture would draw on its inner half only: they are drawn
-  as lines in the same frame.
+* ``line_edges`` are element edges the wire frame cannot show -- two neighbours of the same
+  colour in the distance texture, elements too narrow for the atlas scale, and the outer
+  boundary, which either encoding would draw on its inner half only: they are drawn as lines
+  in the same frame.
 """
 
 from __future__ import annotations

@@ -9,9 +9,9 @@ Two textures hold it:
   texels outside a subpatch (so that lookups just outside a subpatch's border still find its
   elements), and :data:`NO_ELEMENT` beyond;
 * the **corner table**: each element's four corners in atlas texels, 16-bit fixed point with
-  ``frac`` steps per texel (the largest power of two that keeps the atlas within 16 bits), two
-  RGBA16 texels per element, elements ordered by subpatch so that a vertex's subpatch gives the
-  base of its elements.
+  ``frac`` steps per texel (the largest power of two up to 256 that keeps the atlas within 16
+  bits), 16 bytes per element (one RGBA32UI texel when uploaded), elements ordered by subpatch
+  so that a vertex's subpatch gives the row of its first element.
 
 A fragment at atlas position t reads the four texels around it (the bilinear footprint), takes
 the distinct elements they name, and measures the distance from t to the edges of each (line
