@@ -244,6 +244,40 @@ def test_feature_edges_are_kept():
     assert not sides(r_soft).all()
 
 
+def test_creases_shorter_than_the_tolerance_allows_are_not_feature_lines():
+    # a plate of noise: many edges bend by more than 30 degrees, but every crease line is short
+    # against ten tolerances, so none is kept and the plate goes down to a few triangles
+    for seed in range(3):
+        rng = np.random.default_rng(seed)
+        v, t = grid(12, size=2.0)
+        inner = ((v[:, :2] > 0.01) & (v[:, :2] < 1.99)).all(axis=1)
+        v[inner, 2] = rng.uniform(-0.04, 0.04, inner.sum())
+        r = hausdorff_decimate(v, t, 0.1, relative=False)
+        every = hausdorff_decimate(v, t, 0.1, relative=False, feature_min_length=None)
+        check_result(v, t, r, 0.1)
+        check_result(v, t, every, 0.1)
+        assert 2 * len(r.triangles) <= len(every.triangles)
+    # a long crease is kept whole: the fold of 35 degrees, two units long, at a tolerance
+    # whose ten times are shorter
+    angle = np.radians(35.0)
+    v, t = grid(8, size=2.0)
+    fold = v[:, 0] > 1.0
+    run = v[fold, 0] - 1.0
+    v[fold, 0] = 1.0 + run * np.cos(angle)
+    v[fold, 2] = run * np.sin(angle)
+    r = hausdorff_decimate(v, t, 0.01)
+    assert 10 * r.tol_for(0) < 2.0
+    check_result(v, t, r, r.tol_for(0))
+    e = np.sort(np.concatenate([r.triangles[:, [0, 1]], r.triangles[:, [1, 2]],
+                                r.triangles[:, [2, 0]]]), axis=1)
+    e = np.unique(e, axis=0)
+    on_ridge = np.isclose(v[e, 0], 1.0).all(axis=1) & np.isclose(v[e, 2], 0.0).all(axis=1)
+    assert np.linalg.norm(v[e[on_ridge, 0]] - v[e[on_ridge, 1]], axis=1).sum() == \
+        pytest.approx(2.0)
+    with pytest.raises(ValueError, match="feature_min_length"):
+        hausdorff_decimate(v, t, 0.01, feature_min_length=-1.0)
+
+
 def test_relative_tolerance_ignores_translation():
     v, t = grid(12, wave(0.2, 2.5, 2.0))
     r = hausdorff_decimate(v, t, 0.01)

@@ -926,7 +926,7 @@ def _final_bounds(V, F, orig, orig_tol, sup, sup_n, orig_depth):
 
 # --------------------------------------------------------------------------- preparation
 def _check_inputs(vertices, triangles, tol, parts, feature_deg, max_normal_deg, max_depth,
-                  passes):
+                  passes, feature_min_length=None):
     v = np.asarray(vertices)
     if v.ndim != 2 or v.shape[1] != 3 or v.dtype.kind not in "fiu":
         raise ValueError(f"vertices must be a numeric (N, 3) array, got {v.dtype} {v.shape}")
@@ -961,6 +961,10 @@ def _check_inputs(vertices, triangles, tol, parts, feature_deg, max_normal_deg, 
         raise ValueError(f"max_depth must be an integer within [0, 12], got {max_depth}")
     if int(passes) != passes or passes < 1:
         raise ValueError(f"passes must be a positive integer, got {passes}")
+    if feature_min_length is not None and not (np.isfinite(feature_min_length)
+                                               and feature_min_length >= 0):
+        raise ValueError(f"feature_min_length must be None or a finite number >= 0, got "
+                         f"{feature_min_length!r}")
     return v, t, tol, p
 
 
@@ -994,6 +998,21 @@ def _edges_of(F: np.ndarray, n_vert: int):
     face = np.repeat(np.arange(len(F)), 3)
     key = np.minimum(a, b) * n_vert + np.maximum(a, b)
     return a, b, face, key, a < b
+
+
+def _long_chains(a: np.ndarray, b: np.ndarray, V: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """(E,) bool: whether each edge (a, b) lies on a connected set of these edges (joined at
+    shared vertices) whose summed length is at least its ``reach``."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    nodes, inverse = np.unique(np.r_[a, b], return_inverse=True)
+    ia, ib = inverse[:len(a)], inverse[len(a):]
+    graph = coo_matrix((np.ones(len(a)), (ia, ib)), shape=(len(nodes), len(nodes)))
+    _, label = connected_components(graph, directed=False)
+    length = np.linalg.norm(V[a] - V[b], axis=1)
+    total = np.bincount(label[ia], weights=length)
+    return total[label[ia]] >= reach
 
 
 def certification_depths(corners: np.ndarray, tol: np.ndarray, max_depth=None) -> np.ndarray:
@@ -1032,7 +1051,8 @@ def _sliding_shared(key, common, union_boundary, cdeg, parts_at) -> np.ndarray:
 def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: bool = True,
                        parts=None, feature_deg: float = 30.0, keep_boundary: bool = True,
                        max_normal_deg: float = 60.0, max_depth: int | None = None,
-                       passes: int = 2, slide_shared: bool = True) -> Decimation:
+                       passes: int = 2, slide_shared: bool = True,
+                       feature_min_length: float | None = 10.0) -> Decimation:
     """Decimate a triangle mesh by half-edge collapses within a certified one-sided Hausdorff
     distance from the original surface (crash2000, section 3.2).
 
@@ -1050,8 +1070,10 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     or more parts meet, vertices used by more than one part never move. Either way every part
     stays drawable on its own and shares the vertices along its borders with its neighbours.
     Feature edges (the angle between the orientation-corrected normals of their two faces above
-    ``feature_deg`` degrees), the common boundaries of parts and, with ``keep_boundary``,
-    boundary edges are kept as polylines: a vertex on two of them only slides along them, a
+    ``feature_deg`` degrees, on a connected set of such edges at least ``feature_min_length``
+    times its part's tolerance long in all: a shorter crease is detail the tolerance lets go,
+    like the noise of a scanned surface; None keeps every crease), the common boundaries of
+    parts and, with ``keep_boundary``, boundary edges are kept as polylines: a vertex on two of them only slides along them, a
     vertex on one or on three or more, or where its polyline turns by more than
     ``feature_deg``, never moves. ``max_normal_deg`` bounds how far a changed
     face may turn per collapse and from the face it descends from; ``max_depth`` is the
@@ -1072,11 +1094,12 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     place, triangles with a repeated vertex index are dropped (they have no area; their
     ``bounds`` are NaN). Refused with ValueError: arrays of
     the wrong shape or type, indices out of range, non-finite coordinates, no triangles, a
-    non-positive tol, angles out of range, max_depth outside [0, 12], passes < 1.
+    non-positive tol, angles out of range, max_depth outside [0, 12], passes < 1, a negative
+    feature_min_length.
     """
     start = time.perf_counter()
     v_in, t_in, tol, p_in = _check_inputs(vertices, triangles, tol, parts, feature_deg,
-                                          max_normal_deg, max_depth, passes)
+                                          max_normal_deg, max_depth, passes, feature_min_length)
     n_vert = len(v_in)
     k_in = len(t_in)
     notes: list[str] = []
@@ -1150,6 +1173,10 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
         cos = np.einsum("ij,ij->i", n1, n2)
         cos = np.where(forward[g1] != forward[g2], cos, -cos)
         crease = cos < np.cos(np.radians(float(feature_deg))) - 1e-12
+        if feature_min_length is not None and crease.any():
+            edges = g1[crease]
+            reach = float(feature_min_length) * tol_of_label[fpart_index[face[edges]]]
+            crease[np.flatnonzero(crease)[~_long_chains(a[edges], b[edges], V, reach)]] = False
         constrained[g1[crease]] = True
         constrained[g2[crease]] = True
     # the common boundary of two parts (edges with one face of each) is always a polyline
