@@ -429,7 +429,6 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
                             [f"{case.label}: {OVERDRAW}"]
                             + [label.replace(" + normal map + wire texture", "")
                                for label in list(near_images)[1:]], columns=3)
-        if first:
             h, w = size[1], size[0]
             box = (h // 3, h // 3 + h // 3, w // 3, w // 3 + w // 3)
             save_image_grid(out_dir / "crops.png",

@@ -1073,9 +1073,9 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     ``feature_deg`` degrees, on a connected set of such edges at least ``feature_min_length``
     times its part's tolerance long in all: a shorter crease is detail the tolerance lets go,
     like the noise of a scanned surface; None keeps every crease), the common boundaries of
-    parts and, with ``keep_boundary``, boundary edges are kept as polylines: a vertex on two of them only slides along them, a
-    vertex on one or on three or more, or where its polyline turns by more than
-    ``feature_deg``, never moves. ``max_normal_deg`` bounds how far a changed
+    parts and, with ``keep_boundary``, boundary edges are kept as polylines: a vertex on two
+    of them only slides along them, a vertex on one or on three or more, or where its polyline
+    turns by more than ``feature_deg``, never moves. ``max_normal_deg`` bounds how far a changed
     face may turn per collapse and from the face it descends from; ``max_depth`` is the
     subdivision depth of the certification (deeper certifies closer to tol, slower): None
     (default) picks it per input triangle from its longest edge and its tolerance
