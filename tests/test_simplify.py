@@ -217,15 +217,23 @@ def test_smaller_tolerance_never_gives_fewer_triangles():
     assert counts[0] < counts[-1] < len(t)
 
 
-def test_feature_edges_are_kept():
-    # a plate folded by 35 degrees along x = 1, with a tolerance loose enough that faces across
-    # the fold pass: the feature rule alone keeps every face on one side
-    angle = np.radians(35.0)
+def folded_plate(angle_deg: float = 35.0):
+    """(vertices, triangles): the 8×8 grid over [0, 2]² folded up by ``angle_deg`` along x = 1
+    (the ridge, two units long, on z = 0)."""
+    angle = np.radians(angle_deg)
     v, t = grid(8, size=2.0)
     fold = v[:, 0] > 1.0
     run = v[fold, 0] - 1.0
     v[fold, 0] = 1.0 + run * np.cos(angle)
     v[fold, 2] = run * np.sin(angle)
+    return v, t
+
+
+def test_feature_edges_are_kept():
+    # a plate folded by 35 degrees along x = 1, with a tolerance loose enough that faces across
+    # the fold pass: the feature rule alone keeps every face on one side
+    angle = np.radians(35.0)
+    v, t = folded_plate(35.0)
 
     def sides(r):
         corners = v[r.triangles]
@@ -259,12 +267,7 @@ def test_creases_shorter_than_the_tolerance_allows_are_not_feature_lines():
         assert 2 * len(r.triangles) <= len(every.triangles)
     # a long crease is kept whole: the fold of 35 degrees, two units long, at a tolerance
     # whose ten times are shorter
-    angle = np.radians(35.0)
-    v, t = grid(8, size=2.0)
-    fold = v[:, 0] > 1.0
-    run = v[fold, 0] - 1.0
-    v[fold, 0] = 1.0 + run * np.cos(angle)
-    v[fold, 2] = run * np.sin(angle)
+    v, t = folded_plate(35.0)
     r = hausdorff_decimate(v, t, 0.01)
     assert 10 * r.tol_for(0) < 2.0
     check_result(v, t, r, r.tol_for(0))

@@ -1039,13 +1039,16 @@ def _sliding_shared(key, common, union_boundary, cdeg, parts_at) -> np.ndarray:
     edges (one face of each part), and on no edge with a single face over all parts. Every
     other vertex used by several parts is a corner of the part structure."""
     n_vert = len(cdeg)
-    common_keys = np.unique(key[common])
-    common_deg = (np.bincount(common_keys // n_vert, minlength=n_vert)
-                  + np.bincount(common_keys % n_vert, minlength=n_vert))
-    open_keys = np.unique(key[union_boundary])
-    open_deg = (np.bincount(open_keys // n_vert, minlength=n_vert)
-                + np.bincount(open_keys % n_vert, minlength=n_vert))
+    common_deg = _key_degree(np.unique(key[common]), n_vert)
+    open_deg = _key_degree(np.unique(key[union_boundary]), n_vert)
     return (parts_at == 2) & (cdeg == 2) & (common_deg == 2) & (open_deg == 0)
+
+
+def _key_degree(keys: np.ndarray, n_vert: int) -> np.ndarray:
+    """(N,) int32 how many of the undirected edges ``keys`` (``min * n_vert + max``, each once)
+    each vertex is on."""
+    return (np.bincount(keys // n_vert, minlength=n_vert)
+            + np.bincount(keys % n_vert, minlength=n_vert)).astype(np.int32)
 
 
 def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: bool = True,
@@ -1183,10 +1186,8 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     common = (uc[ui] == 2) & (per_part == 1)
     constrained |= common
     ckeys = np.unique(key[constrained])
-    cdeg = np.zeros(n_vert, np.int32)
+    cdeg = _key_degree(ckeys, n_vert)
     lo_v, hi_v = ckeys // n_vert, ckeys % n_vert
-    np.add.at(cdeg, lo_v, 1)
-    np.add.at(cdeg, hi_v, 1)
     # a vertex where its two feature/boundary edges turn by more than feature_deg is a corner
     ends = np.concatenate([lo_v, hi_v])
     others = np.concatenate([hi_v, lo_v])

@@ -73,7 +73,7 @@ def _min_extents(c2: np.ndarray, elements_local: np.ndarray, quantile: float = 0
     for k in range(2):
         positive = ext[:, k][ext[:, k] > 0]
         if positive.size:
-            out[k] = positive.min() if quantile == 0 else np.quantile(positive, quantile)
+            out[k] = np.quantile(positive, quantile)  # quantile 0: the smallest
     return out
 
 
@@ -100,7 +100,7 @@ def _width_factor(t2: np.ndarray, elements_local: np.ndarray, texels: float,
     width = width[width > 0]
     if not width.size:
         return 1.0
-    return float(texels / (width.min() if quantile == 0 else np.quantile(width, quantile)))
+    return float(texels / np.quantile(width, quantile))
 
 
 def build_atlas(coords, elements, labels, *, texels_per_edge: float = 2.0, border: int = 2,
