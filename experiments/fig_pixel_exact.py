@@ -59,7 +59,7 @@ from workbench.experiment.timing import time_call
 from workbench.gl import Camera, create_context, renderer
 from workbench.paths.colormap import colormap_lut
 from workbench.paths.spacetime import OVERDRAWS, SpacetimeStyle, spacetime_path, top_camera
-from workbench.scene.spacetime import (DOMAIN, PULSE, T_SLICE, Solution, SpacetimeScene, bar_scene,
+from workbench.algo.spacetime.scene import (DOMAIN, PULSE, T_SLICE, Solution, SpacetimeScene, bar_scene,
                                        plate_solution, slice_scene, window)
 
 U_MAX = 100.0  # kJ/m³, top of the log colour scale

@@ -38,7 +38,7 @@ from workbench.paths import Style, make_path
 from workbench.paths.colormap import scale_for
 from workbench.scene import generators
 from workbench.scene.builtin import builtin_scene
-from workbench.scene.derive import MESH_ITEMS, derivation_cost
+from workbench.scene.needs import MESH_ITEMS, derivation_cost
 
 BANDS = 10
 

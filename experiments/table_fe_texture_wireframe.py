@@ -61,6 +61,7 @@ from workbench.algo.fepatch.pipeline import (
     FEPatchParams,
     build_model,
 )
+from workbench.algo.fepatch.mesh_model import fepatch_model
 from workbench.algo.hausdorff import hausdorff
 from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.compare import compare_images, wire_agreement
@@ -407,7 +408,7 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
         say(f"{case.label}: {case.mesh.n_elements} elements")
         models, variants = {}, {}
         for name in PARAMETER_SETS:
-            models[name] = case.mesh.fepatch_model(name)  # derived once, cached by the mesh
+            models[name] = fepatch_model(case.mesh, name)  # derived once, cached by the mesh
             pre.append(preprocessing_row(case, models[name]))
             say(f"  set {name}: preprocessing {pre[-1]['total s']:.1f} s, "
                 f"{pre[-1]['simplified_triangles']} of {pre[-1]['original_triangles']} triangles")

@@ -51,9 +51,10 @@ from workbench.experiment.measure import default_camera, measure
 from workbench.experiment.registry import experiment, main
 from workbench.experiment.tables import atomic_open, write_table
 from workbench.gl import create_context, renderer
-from workbench.paths import Style
+from workbench.paths import SoftwareRasterizer, Style
 from workbench.paths.software import SoftwarePath
 from workbench.scene.generators import semicylinders
+from workbench.scene.needs import derive
 
 # es2008 Tables 2 (1 M triangles) and 3 (16.6 M): step → (vec-off s, vec-on s, ratio) each
 PAPER_STEPS = {
@@ -157,7 +158,7 @@ def bench_rows(ctx, bench: Bench, repeats: int, say) -> tuple[list[dict], dict]:
         if not bench.main and label == "software bands, GL rule":
             def probes(p, steps=probes):  # the 16.8 M scene's memory, on one row
                 return {**steps(p), **peak_memory(p)}
-        m = measure(None, mesh, path, camera=camera, size=size, repeats=repeats, probe=probes)
+        m = measure(SoftwareRasterizer(raster), mesh, path, camera=camera, size=size, repeats=repeats, probe=probes)
         images[label] = m.image
         same = images["EGL bands" if name == "pixel_color" else "EGL flat"]
         diff = compare_images(same, m.image)
@@ -192,8 +193,6 @@ def small_case_steps(say) -> dict:
     camera = default_camera(mesh, size, view=(0.0, 0.0), up="y")
     path = SoftwarePath("pixel_color", Style(**BANDS),
                         RasterOptions(generator="table", subpixel_bits=0, early_depth=False))
-    from workbench.scene.derive import derive
-
     derive(mesh, path.needs, path.style)
     path.prepare(None, mesh, camera)
     path.make_target(size)

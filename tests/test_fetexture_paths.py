@@ -7,13 +7,13 @@ texels; the wire map is computed here by brute force from the analytic signed di
 cell, following the convention of :mod:`workbench.algo.fepatch.surface`.
 """
 
-import sys
 import types
 
 import numpy as np
 import pytest
 
 import workbench.paths.fetexture  # noqa: F401  (registers the paths)
+from workbench.algo.fepatch import pipeline
 from workbench.algo.fepatch.normalmap import decode_normals, encode_normals
 from workbench.algo.fepatch.surface import TexturedSurface
 from workbench.algo.fepatch.wireid import corner_table, element_map
@@ -341,9 +341,7 @@ def test_model_built_once_per_mesh_and_parameters(ctx, monkeypatch):
         calls.append(params)
         return types.SimpleNamespace(original=original, simplified=simplified)
 
-    fake = types.ModuleType("workbench.algo.fepatch.pipeline")
-    fake.build_model = build_model
-    monkeypatch.setitem(sys.modules, "workbench.algo.fepatch.pipeline", fake)
+    monkeypatch.setattr(pipeline, "build_model", build_model)
     nodes, quads = grid_nodes()
     mesh, cam = FEMesh(nodes, quads), camera()
     for name, expected in (("fe_wire_texture", original), ("fe_normal_map", simplified),

@@ -4,6 +4,7 @@ farther than the threshold hidden by the alpha test."""
 import numpy as np
 import pytest
 
+from workbench.algo.part_distance import flange_distances
 from workbench.experiment.compare import coverage
 from workbench.experiment.measure import default_camera, measure
 from workbench.paths import make_path
@@ -39,7 +40,7 @@ def plates():
 
 
 def test_distances_of_the_plates(plates):
-    d = plates.part_distances(50.0)
+    d = flange_distances(plates, 50.0)
     base = np.flatnonzero(plates.nodes[:, 2] == 0.0)
     near = base[plates.nodes[base, 0] <= 40.0]
     assert np.allclose(d.distance[near], 1.0, rtol=0, atol=1e-12)
@@ -51,7 +52,7 @@ def test_flange_hides_exactly_the_elements_beyond_the_threshold(ctx, plates):
     camera = default_camera(plates, SIZE, view=(0.0, 90.0))
     flange = measure(ctx, plates, "flange", FlangeStyle(threshold=2.0), camera=camera,
                      size=SIZE, timed=False).image
-    distance = plates.part_distances(50.0).distance
+    distance = flange_distances(plates, 50.0).distance
     within = distance[plates.elements] <= 2.0
     all_near, any_near = within.all(axis=1), within.any(axis=1)
 

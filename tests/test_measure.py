@@ -10,16 +10,17 @@ import pytest
 
 from workbench.algo.spacetime.exact import colour_error, element_boundary, exact_image
 from workbench.algo.spacetime.fields import STEEL
+from workbench.algo.fepatch.mesh_model import fepatch_model
 from workbench.algo.spacetime.raster import PixelGrid
+from workbench.algo.spacetime.scene import spacetime_scene
 from workbench.experiment.measure import default_camera, measure
 from workbench.gl import renderer
 from workbench.paths import PATHS, Style, make_path, path_class, path_options
-from workbench.paths.base import GLPath
+from workbench.paths import GLPath
 from workbench.paths.colormap import colormap_lut
 from workbench.paths.spacetime import SpacetimeStyle
 from workbench.scene import generators
-from workbench.scene.derive import MESH_ITEMS, derivation_cost, derive, derived_items
-from workbench.scene.spacetime import spacetime_scene
+from workbench.scene.needs import MESH_ITEMS, derivation_cost, derive, derived_items
 
 ROOT = Path(__file__).resolve().parents[1]
 SIZE = (96, 72)
@@ -40,7 +41,7 @@ def test_every_path_is_registered_with_one_protocol():
     for name in PATHS:
         cls = path_class(name)
         assert issubclass(cls, GLPath)
-        assert cls.scene_kind in ("mesh", "spacetime")
+        assert cls.scene_kinds <= {"mesh", "spacetime", "surface"}
         for method in ("prepare", "set_camera", "set_step", "draw", "release"):
             assert callable(getattr(cls, method))
     assert "shading" not in path_options("spacetime_pixel")
@@ -92,7 +93,7 @@ def test_fe2003_paths_through_measure_draw_outlines_from_the_scene_model(ctx):
     # the wire texture draws the outlines; without it only the surface's few line edges are red
     assert red["fe_normal_wire"] > 50 and red["fe_normal_wire"] > 2 * red["fe_normal_map"]
     # a TexturedSurface built by the caller is a scene too
-    surface = mesh.fepatch_model("A").simplified
+    surface = fepatch_model(mesh, "A").simplified
     direct = measure(ctx, surface, "fe_normal_wire", Style(wire_color=(1.0, 0.0, 0.0)),
                      camera=camera, size=SIZE, timed=False)
     assert np.array_equal(direct.image, images["fe_normal_wire"])

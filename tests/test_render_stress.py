@@ -33,7 +33,7 @@ def test_far_offset_check_fails_on_a_moved_image(ctx, monkeypatch):
 
 
 def test_soak_check_fails_on_a_path_that_keeps_gl_objects(ctx, monkeypatch):
-    from workbench.paths.base import GLPath
+    from workbench.paths import GLPath
 
     real_release = GLPath.release
 

@@ -9,11 +9,12 @@ from workbench.algo.softraster import RasterOptions
 from workbench.cli import main
 from workbench.experiment.measure import default_camera, measure
 from workbench.gl import renderer
-from workbench.paths.base import Style
+from workbench.paths import SoftwareRasterizer, Style
 from workbench.paths.software import SoftwarePath
 from workbench.scene.generators import crash_sequence, semicylinders, stamped_panels
 
 SIZE = (320, 240)
+SOFTWARE = SoftwareRasterizer()
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +50,7 @@ CASES = [
 def test_software_image_matches_the_gl_image(ctx, panels, name, options, view):
     camera = default_camera(panels, SIZE, view=view)
     gl = measure(ctx, panels, name, Style(**options), camera=camera, size=SIZE, timed=False)
-    soft = measure(None, panels, SoftwarePath(name, Style(**options)), camera=camera, size=SIZE,
+    soft = measure(SOFTWARE, panels, SoftwarePath(name, Style(**options)), camera=camera, size=SIZE,
                    timed=False)
     assert gl.row["covered_px"] > 0.05 * SIZE[0] * SIZE[1]
     share = differing_share(soft.image, gl.image)
@@ -64,7 +65,7 @@ def test_software_image_matches_the_gl_image(ctx, panels, name, options, view):
 def test_software_coverage_of_the_es2008_scene_is_llvmpipes(ctx, sheets):
     camera = default_camera(sheets, SIZE, view=(0.0, 0.0), up="y")
     gl = measure(ctx, sheets, "position", camera=camera, size=SIZE, timed=False)
-    soft = measure(None, sheets, SoftwarePath("position"), camera=camera, size=SIZE, timed=False)
+    soft = measure(SOFTWARE, sheets, SoftwarePath("position"), camera=camera, size=SIZE, timed=False)
     if "llvmpipe" not in renderer(ctx):
         pytest.skip("pixel-exact coverage is llvmpipe's rule")
     assert np.array_equal(soft.image, gl.image)
@@ -74,14 +75,14 @@ def test_table_rule_deviates_only_along_edges(ctx, sheets):
     # 0 sub-pixel bits moves vertices by up to half a pixel: the coverage changes, a little
     camera = default_camera(sheets, SIZE, view=(0.0, 0.0), up="y")
     gl = measure(ctx, sheets, "position", camera=camera, size=SIZE, timed=False)
-    soft = measure(None, sheets, SoftwarePath("position", options=RasterOptions(
+    soft = measure(SOFTWARE, sheets, SoftwarePath("position", options=RasterOptions(
         generator="table", subpixel_bits=0)), camera=camera, size=SIZE, timed=False)
     share = differing_share(soft.image, gl.image)
     assert 0.0 < share < 0.02
 
 
 def test_measure_times_the_software_path(sheets):
-    result = measure(None, sheets, SoftwarePath("pixel_color", Style(field="distance", bands=8)),
+    result = measure(SOFTWARE, sheets, SoftwarePath("pixel_color", Style(field="distance", bands=8)),
                      size=SIZE, repeats=5, warmup=1)
     row = result.row
     assert row["renderer"].startswith("software rasterizer (half-space, 8 sub-pixel bits")
@@ -99,9 +100,9 @@ def test_refusals(sheets):
         SoftwarePath("flat", Style(strips="quad"))
     camera = default_camera(sheets, SIZE, projection="perspective")
     with pytest.raises(ValueError, match="orthographic"):
-        measure(None, sheets, SoftwarePath("flat"), camera=camera, size=SIZE, timed=False)
+        measure(SOFTWARE, sheets, SoftwarePath("flat"), camera=camera, size=SIZE, timed=False)
     with pytest.raises(ValueError, match="MSAA"):
-        measure(None, sheets, SoftwarePath("flat"), size=SIZE, samples=4, timed=False)
+        measure(SOFTWARE, sheets, SoftwarePath("flat"), size=SIZE, samples=4, timed=False)
 
 
 def test_cli_renders_with_the_software_rasterizer(tmp_path, capsys):

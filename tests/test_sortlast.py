@@ -146,7 +146,7 @@ def test_software_domains_composite_to_the_one_process_image(client, by, domains
     workers and composited there: the one-process frame, colour, depth and triangle."""
     from workbench.experiment.measure import default_camera
     from workbench.experiment.sortlast import SoftwareDomains
-    from workbench.paths.base import Style
+    from workbench.paths import Style
     from workbench.scene.domains import split_domains
     from workbench.scene.generators import semicylinders
 

@@ -84,12 +84,14 @@ def test_triangle_strips_equal_their_own_triangles_listed(ctx, name):
     # corners in the strips' order, the same triangles draw the same image pixel for pixel
     from workbench.algo.strips import tri_strips, unstripify
     from workbench.paths import PATHS
+    from workbench.paths.drawdata import Layout
 
     class StripOrderList(PATHS[name]):
-        def layout(self, mesh, triangles, n_vertices):
-            listed = super().layout(mesh, triangles, n_vertices)
-            self.mode = moderngl.TRIANGLES
-            return unstripify(tri_strips(listed, n_vertices).indices)
+        def layout(self, mesh, topology):
+            listed = super().layout(mesh, topology).index
+            n_vertices = len(topology.vertex_node)
+            triangles = unstripify(tri_strips(listed, n_vertices).indices)
+            return Layout(triangles, "triangles", len(triangles), 0, triangles.size)
 
     mesh, cam = scene_with_defects(), oblique()
     kw = {"field": SHADED[name], "bands": 7 if name == "vertex_color" else 0,

@@ -98,14 +98,13 @@ def _render_options(args, kind: str) -> dict:
 
 def cmd_render(args) -> int:
     from .experiment.figures import save_field_figure, save_png
-    from .experiment.measure import default_camera, measure
+    from .experiment.measure import measure
     from .gl import create_context
-    from .paths import make_path, path_class
+    from .paths import default_path, make_path, path_class
     from .scene.builtin import load_scene
-    from .scene.mesh import FEMesh
 
     scene = load_scene(args.mesh, all_faces=args.all_faces)
-    is_mesh = isinstance(scene, FEMesh)
+    is_mesh = scene.kind == "mesh"
     if is_mesh:
         fields = [*scene.node_fields, *scene.element_fields]
         if args.field is not None and args.field not in fields:
@@ -113,38 +112,31 @@ def cmd_render(args) -> int:
             raise KeyError(f"{scene.name} has no field {args.field!r}; fields: {', '.join(known)}")
         if not 0 <= args.step < scene.n_steps:
             raise ValueError(f"{scene.name} has {scene.n_steps} steps; --step {args.step} is outside")
-    path_name = args.path
-    if path_name is None:
-        if not is_mesh:
-            path_name = "spacetime_pixel"
-        elif args.field is None:
-            path_name = "gouraud"
-        else:
-            path_name = "element_color" if args.field in scene.element_fields else "pixel_color"
-    kind = path_class(path_name).scene_kind
-    if kind != ("mesh" if is_mesh else "spacetime"):
-        raise ValueError(f"path {path_name!r} draws {kind} scenes; {args.mesh!r} is "
-                         f"{'an FE mesh' if is_mesh else 'a spacetime scene'}")
-    path = make_path(path_name, **_render_options(args, kind))
-    ctx = None
+    path_name = args.path or default_path(scene, args.field)
+    kinds = path_class(path_name).scene_kinds
+    if scene.kind not in kinds:
+        raise ValueError(f"path {path_name!r} draws {' or '.join(sorted(kinds))} scenes; "
+                         f"{args.mesh!r} is {'an FE mesh' if is_mesh else 'a spacetime scene'}")
+    path = make_path(path_name, **_render_options(args, "mesh" if "mesh" in kinds else "spacetime"))
     if args.rasterizer == "software":
         from .algo.softraster import RasterOptions
-        from .paths.software import SoftwarePath
+        from .paths import SoftwareRasterizer
 
         bits = args.subpixel_bits
         if bits is None:
             bits = 0 if args.generator == "table" else 8
-        options = RasterOptions(generator=args.generator, table_size=args.table_size,
-                                subpixel_bits=bits, threads=args.threads)
-        path = SoftwarePath(path_name, path.style, options)
+        backend = SoftwareRasterizer(RasterOptions(
+            generator=args.generator, table_size=args.table_size, subpixel_bits=bits,
+            threads=args.threads))
+        path = backend.path(path)
     else:
-        ctx = create_context()
+        backend = create_context()
     size = args.size
-    camera = default_camera(scene, size, view=args.view, projection=args.projection, up=args.up,
-                            style=path.style)
+    camera = path.default_camera(scene, size, view=args.view, projection=args.projection,
+                                 up=args.up, style=path.style)
     if args.domains is not None:
         return _render_sortlast(args, scene, path, camera, size)
-    result = measure(ctx, scene, path, camera=camera, size=size, samples=args.samples,
+    result = measure(backend, scene, path, camera=camera, size=size, samples=args.samples,
                      timed=False)
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -309,10 +301,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("info", help="renderer, OpenGL version, library versions, shared data")
     p.set_defaults(func=cmd_info)
 
-    from .paths import PATHS, path_class
+    from .paths.registry import paths_for
 
-    mesh_paths = sorted(n for n in PATHS if path_class(n).scene_kind == "mesh")
-    spacetime_paths = sorted(n for n in PATHS if path_class(n).scene_kind == "spacetime")
+    mesh_paths = paths_for("mesh")
+    spacetime_paths = paths_for("spacetime")
     p = sub.add_parser(
         "render", help="render one scene to a PNG",
         formatter_class=argparse.RawDescriptionHelpFormatter,

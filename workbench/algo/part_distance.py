@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..scene.needs import derived_item
 from .distance import points_triangles_distance
 from .hierarchy import (
     KINDS,
@@ -54,7 +55,7 @@ from .hierarchy import (
 )
 
 __all__ = ["Connectivity", "PartDistances", "brute_force_part_distances", "connectivity",
-           "node_parts", "part_distances"]
+           "node_parts", "part_distances", "flange_distances"]
 
 
 @dataclass
@@ -208,6 +209,15 @@ def part_distances(mesh, cutoff: float, *, kind: str = "aabb", leaf_size: int = 
     return PartDistances(r.distance, r.part, r.element, h.n_bvs, h.n_top_bvs, r.bv_tests,
                          r.element_tests, r.plane_skips, r.leaf_elements, int(active.sum()),
                          h.build_s, query_s, kind, int(leaf_size), cutoff)
+
+
+@derived_item("part_distances", key=lambda cutoff, step=0: (float(cutoff), int(step)),
+              from_style=lambda style: (getattr(style, "cutoff", 50.0), getattr(style, "step", 0)))
+def flange_distances(mesh, cutoff: float, step: int = 0) -> PartDistances:
+    """The derived item ``part_distances`` (what the flange path needs): :func:`part_distances`
+    of step ``step`` within ``cutoff`` (model units) through AABB trees of one element per
+    leaf, kept in the mesh's cache per (cutoff, step)."""
+    return part_distances(mesh, cutoff, step=step)
 
 
 def connectivity(mesh, distance: float, *, kind: str = "aabb", leaf_size: int = 1,

@@ -64,8 +64,8 @@ class SoftwareDomains:
         if path is None:
             from ..algo.softraster import RasterOptions
             from ..paths.software import SoftwarePath
-            from ..scene.derive import derive
-            from .sweep_points import fresh_scene
+            from ..scene.builtin import fresh_scene
+            from ..scene.needs import derive
 
             mesh = fresh_scene(self.scene, self.quick)
             path = SoftwarePath(self.path, self.style, self.options or RasterOptions())

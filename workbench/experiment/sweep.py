@@ -160,13 +160,13 @@ def parse_size(text) -> tuple[int, int]:
 
 
 def _check_scene(spec) -> str:
-    from ..scene.builtin import BUILTIN, parse_scene_spec
+    from ..scene.builtin import parse_scene_spec, scene_names
 
     if not isinstance(spec, str):
         raise ValueError(f"scene must be a name or a file, got {spec!r}")
     if Path(spec).exists() or parse_scene_spec(spec) is not None:
         return spec
-    raise ValueError(f"scene {spec!r} is neither a built-in scene ({', '.join(BUILTIN)}, "
+    raise ValueError(f"scene {spec!r} is neither a built-in scene ({', '.join(scene_names())}, "
                      f"with ':N' for the sized ones) nor an existing file")
 
 
@@ -406,8 +406,9 @@ def point_sources(point: Point, glsl_dir=None) -> dict[str, str]:
     modules = {Path(inspect.getsourcefile(path_class(name))).resolve() for name in paths}
     base = PACKAGE / "paths" / "base.py"
     shaders = _shader_files(sorted(modules | {base}), glsl)
-    modules |= {base, PACKAGE / "paths" / "colormap.py", PACKAGE / "experiment" / "measure.py",
-                PACKAGE / "experiment" / "sweep_points.py"}
+    modules |= {base, *(PACKAGE / "paths" / name for name in (
+                    "colormap.py", "mesh.py", "drawdata.py", "style.py", "backends.py")),
+                PACKAGE / "experiment" / "measure.py", PACKAGE / "experiment" / "sweep_points.py"}
     if point.reference:
         modules.add(PACKAGE / "experiment" / "compare.py")
     if point.simplifier:
@@ -427,10 +428,10 @@ def _scene_modules(spec: str) -> set[Path]:
     """The modules that make scene ``spec`` and what the paths derive from it: the spacetime
     builders, the generators or the readers, with the derived-data modules."""
     scene = PACKAGE / "scene"
-    modules = {scene / "mesh.py", scene / "derived.py", scene / "derive.py"}
+    modules = {scene / "mesh.py", scene / "derived.py", scene / "needs.py"}
     name = spec.split(":")[0]
     if name == "spacetime" and not Path(spec).is_file():
-        return modules | {scene / "spacetime.py", *(PACKAGE / "algo" / "spacetime").glob("*.py")}
+        return modules | set((PACKAGE / "algo" / "spacetime").glob("*.py"))
     if name in ("semicylinders", "panels") and not Path(spec).is_file():
         return modules | {scene / "generators.py"}
     return modules | {scene / n for n in ("io.py", "parse.py", "keyword.py", "d3plot.py",

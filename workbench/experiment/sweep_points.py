@@ -111,37 +111,14 @@ def failure_row(point: Point, exc: BaseException, **extra) -> dict:
 
 
 # ------------------------------------------------------------------------- worker side
-def fresh_scene(spec: str, quick: bool):
-    """A scene nobody has drawn yet: derived data is computed (and counted) by this point.
-
-    Loading is cached per worker; an FE mesh is handed out as a new instance sharing the
-    loaded arrays, without their derived caches. A spacetime scene derives nothing and no path
-    changes it, so the loaded one is handed out as it is."""
-    import dataclasses
-
-    from ..scene.mesh import FEMesh
-
-    scene = _loaded_scene(spec, quick)
-    if isinstance(scene, FEMesh):
-        return dataclasses.replace(scene, node_fields=dict(scene.node_fields),
-                                   element_fields=dict(scene.element_fields))
-    return scene
-
-
-@lru_cache(maxsize=4)
-def _loaded_scene(spec: str, quick: bool):
-    from ..scene.builtin import load_scene
-
-    return load_scene(spec, quick)
-
-
 @lru_cache(maxsize=16)
 def _our_decimation(spec: str, quick: bool, tolerance: float):
     """:func:`~workbench.algo.simplify.hausdorff_decimate` of the scene at ``tolerance`` %,
     per part (cached per worker: the reference simplifiers aim at its triangle count)."""
     from ..algo.simplify import hausdorff_decimate
+    from ..scene.builtin import loaded_scene
 
-    mesh = _loaded_scene(spec, quick)
+    mesh = loaded_scene(spec, quick)
     tri = mesh.triangulation
     return hausdorff_decimate(mesh.nodes, tri.triangles, tolerance / 100.0, relative=True,
                               parts=mesh.parts[tri.element_of])
@@ -198,16 +175,6 @@ def simplified_scene(mesh, point: Point):
     return simplified, columns
 
 
-def scene_kind(scene) -> str:
-    """"mesh" for an FE mesh, "spacetime" for a spacetime scene (what ``RenderPath.scene_kind``
-    names), else the scene's type name."""
-    from ..scene.mesh import FEMesh
-
-    if isinstance(scene, FEMesh):
-        return "mesh"
-    return "spacetime" if hasattr(scene, "corners") else type(scene).__name__
-
-
 def _reference_image(ctx, point: Point, scene, camera, measured):
     """The reference path's image of the unsimplified, unsplit scene with the point's options:
     the point's own image when it draws the reference path on that very scene."""
@@ -229,22 +196,20 @@ def measured_columns(point: Point, ctx) -> dict:
     lock), the simplification columns, and ``diff_*`` (:meth:`ImageDiff.as_row`: max and mean
     absolute difference in 1/255, share of pixels differing, PSNR in dB, SSIM) against the
     reference image."""
-    from ..paths import make_path
+    from ..paths import SoftwareRasterizer, make_path
+    from ..scene.builtin import fresh_scene
     from .cluster import draw_lock
     from .compare import compare_images
-    from .measure import default_camera, measure
+    from .measure import measure
 
     original = fresh_scene(point.scene, point.quick)
     path = make_path(point.path, **point.options)
-    if point.rasterizer == "software":
-        from ..paths.software import SoftwarePath
-
-        path = SoftwarePath(point.path, path.style)
-    kind = scene_kind(original)
-    if kind != path.scene_kind:
-        raise ValueError(f"path {point.path!r} draws {path.scene_kind} scenes; "
-                         f"{point.scene!r} is a {kind} scene")
-    camera = default_camera(original, point.size, view=point.view, style=path.style)
+    backend = SoftwareRasterizer() if point.rasterizer == "software" else ctx
+    kind = original.kind
+    if kind not in path.scene_kinds:
+        raise ValueError(f"path {point.path!r} draws {' or '.join(sorted(path.scene_kinds))} "
+                         f"scenes; {point.scene!r} is a {kind} scene")
+    camera = path.default_camera(original, point.size, view=point.view, style=path.style)
     scene, columns = original, {}
     if point.simplifier is not None:
         scene, columns = simplified_scene(original, point)
@@ -259,9 +224,9 @@ def measured_columns(point: Point, ctx) -> dict:
         waited = time.perf_counter()
         with draw_lock():
             columns["lock_wait_ms"] = (time.perf_counter() - waited) * 1e3
-            measured = measure(ctx, scene, path, repeats=point.repeats, **kwargs)
+            measured = measure(backend, scene, path, repeats=point.repeats, **kwargs)
     else:
-        measured = measure(ctx, scene, path, timed=False, **kwargs)
+        measured = measure(backend, scene, path, timed=False, **kwargs)
     row = {("scene_name" if k == "scene" else k): v for k, v in measured.row.items()
            if k != "path"}
     row.update(columns)

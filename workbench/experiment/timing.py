@@ -1,9 +1,10 @@
 """Timing of draws and CPU work: warm-up, at least five repetitions, median and spread.
 
-GPU time comes from a GL_TIME_ELAPSED query around the draw; wall time spans the draw and
-``ctx.finish()``; read-back (``Framebuffer.read``) is timed on its own. Clearing the target is
-excluded from all three. Times are in milliseconds and hold only for the renderer they were
-measured on (``workbench.gl.renderer(ctx)``), so experiments report ratios from one run.
+GPU time comes from a GL_TIME_ELAPSED query around the draw (where the renderer has timer
+queries); wall time spans the draw and the backend's ``finish`` (``ctx.finish()`` on GL);
+read-back (``Framebuffer.read``) is timed on its own. Clearing the target is excluded from all
+three. Times are in milliseconds and hold only for the renderer they were measured on (the
+backend's ``renderer``), so experiments report ratios from one run.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from dataclasses import dataclass, field
 from statistics import median
 from typing import Any, Callable
 
-from workbench.gl import GpuTimer
+from ..paths.backends import as_backend
 
 MIN_REPEATS = 5
 
@@ -75,69 +76,49 @@ class Timing:
         return {prefix + name: getattr(self, name) for name in names}
 
 
-def time_draw(ctx, fb, draw: Callable[[], Any], warmup: int = 2, repeat: int = 7,
+def time_draw(backend, fb, draw: Callable[[], Any], warmup: int = 2, repeat: int = 7,
               readback_repeat: int | None = None, background=(1.0, 1.0, 1.0, 1.0)) -> Timing:
-    """Time ``draw()`` into framebuffer ``fb`` on ``ctx``: GPU, wall and read-back milliseconds.
+    """Time ``draw()`` into framebuffer ``fb`` on ``backend`` (a GL context, or a backend of
+    :mod:`workbench.paths.backends`): GPU, wall and read-back milliseconds.
 
-    Each repetition clears ``fb`` to ``background`` RGBA (and waits for the clear) outside the clock, then measures wall
-    time around ``draw()`` inside a GPU timer query plus ``ctx.finish()``. ``draw`` must draw into
-    the bound framebuffer and must not open a time query of its own (queries of one kind do not
-    nest). Read-back is then timed separately: ``fb.read()`` of the finished last draw, repeated
-    ``readback_repeat`` times (default ``repeat``) after one untimed read. Afterwards ``fb`` holds
-    the last drawn image. Refuses ``repeat`` < 5 and a negative ``warmup``.
+    Each repetition clears ``fb`` to ``background`` RGBA (and waits for the clear) outside the
+    clock, then measures wall time around ``draw()`` plus the backend's ``finish``, inside a
+    GPU timer query where the renderer has one (``gpu_ms`` None otherwise, as on the software
+    rasterizer). ``draw`` must draw into the bound framebuffer and must not open a time query of
+    its own (queries of one kind do not nest). Read-back is then timed separately: ``fb.read()``
+    of the finished last draw, repeated ``readback_repeat`` times (default ``repeat``) after
+    one untimed read. Afterwards ``fb`` holds the last drawn image. Refuses ``repeat`` < 5 and
+    a negative ``warmup``.
     """
+    backend = as_backend(backend)
     check_counts(warmup, repeat)
     readback_repeat = repeat if readback_repeat is None else readback_repeat
     check_counts(0, readback_repeat)
-    timer = GpuTimer(ctx)  # moderngl 5.13 queries have no release(); the object is collected
+    timer = backend.gpu_timer()
     wall: list[float] = []
     gpu: list[float] = []
     for i in range(warmup + repeat):
         fb.clear(background)
-        ctx.finish()
+        backend.finish()
         start = time.perf_counter()
-        with timer:
+        if timer is None:
             draw()
-        ctx.finish()
+        else:
+            with timer:
+                draw()
+        backend.finish()
         elapsed = (time.perf_counter() - start) * 1e3
         if i >= warmup:
             wall.append(elapsed)
-            gpu.append(timer.elapsed_ms)
+            if timer is not None:
+                gpu.append(timer.elapsed_ms)
     fb.read()
     readback = []
     for _ in range(readback_repeat):
         start = time.perf_counter()
         fb.read()
         readback.append((time.perf_counter() - start) * 1e3)
-    return Timing.from_samples(wall, gpu, readback)
-
-
-def time_cpu_draw(target, draw: Callable[[], Any], warmup: int = 2, repeat: int = 7,
-                  readback_repeat: int | None = None,
-                  background=(1.0, 1.0, 1.0, 1.0)) -> Timing:
-    """Time ``draw()`` of a CPU renderer into ``target`` (``clear``/``read`` as a framebuffer):
-    wall and read-back milliseconds, as :func:`time_draw` without a GPU (``gpu_ms`` None).
-
-    Each repetition clears ``target`` outside the clock; read-back is ``target.read()``, timed
-    apart. Refuses ``repeat`` < 5 and a negative ``warmup``.
-    """
-    check_counts(warmup, repeat)
-    readback_repeat = repeat if readback_repeat is None else readback_repeat
-    check_counts(0, readback_repeat)
-    wall: list[float] = []
-    for i in range(warmup + repeat):
-        target.clear(background)
-        start = time.perf_counter()
-        draw()
-        elapsed = (time.perf_counter() - start) * 1e3
-        if i >= warmup:
-            wall.append(elapsed)
-    readback = []
-    for _ in range(readback_repeat):
-        start = time.perf_counter()
-        target.read()
-        readback.append((time.perf_counter() - start) * 1e3)
-    return Timing.from_samples(wall, None, readback)
+    return Timing.from_samples(wall, gpu if timer is not None else None, readback)
 
 
 def time_call(fn: Callable[[], Any], warmup: int = 1, repeat: int = 5) -> Timing:

@@ -22,6 +22,23 @@ PROJECTIONS = ("orthographic", "perspective")
 _UP_FRAMES = {"y": np.eye(3), "z": np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])}
 
 
+def check_resolvable(lo, hi) -> None:
+    """Refuse (ValueError) a bounding box ``lo``–``hi`` (float64, model units) that cannot be
+    drawn: not finite, of zero extent, or so far from the origin that float64 coordinates
+    cannot tell its points apart to 1/10 000 of its extent (they would draw as one point)."""
+    lo, hi = np.asarray(lo, np.float64), np.asarray(hi, np.float64)
+    if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
+        raise ValueError("the scene's coordinates are not finite")
+    extent = float(np.max(hi - lo))
+    magnitude = float(np.max(np.abs(np.concatenate([lo, hi]))))
+    if extent <= 0:
+        raise ValueError("the scene has zero extent: every point lies at one place")
+    if np.spacing(magnitude) > 1e-4 * extent:
+        raise ValueError(f"coordinates of magnitude {magnitude:.3g} are resolved to "
+                         f"{np.spacing(magnitude):.3g} in float64, too coarse for a scene "
+                         f"{extent:.3g} wide: translate it nearer the origin")
+
+
 def up_frame(up: str) -> np.ndarray:
     """(3, 3) float64: the world directions (columns) of the Y-up frame's x, y, z axes for the
     ``up`` axis "y" or "z" (the frame :meth:`Camera.fit` turns its angles in)."""

@@ -1,11 +1,15 @@
 """Render paths: comparable ways of drawing a scene, all behind one protocol
-(:class:`~workbench.paths.base.RenderPath`) and in one registry (``PATHS``)."""
+(:class:`~workbench.paths.base.RenderPath`), in one registry (``PATHS``), drawn on a GL context
+or by the software rasterizer (:mod:`workbench.paths.backends`)."""
 
-from . import fetexture, fields, flange, spacetime, surface, wire  # noqa: F401  (each registers)
-from . import exploded  # noqa: F401  (registers)
-from .base import (PATHS, GLPath, MeshPath, RenderPath, Style, check_options, make_path,
-                   path_class, path_options)
+from . import exploded, fetexture, fields, flange, spacetime, surface, wire  # noqa: F401  (each registers)
+from .backends import GLBackend, SoftwareRasterizer, as_backend
+from .base import GLPath, RenderPath
 from .colormap import ColorScale, colormap_lut, scale_for
+from .mesh import MeshPath
+from .registry import PATHS, check_options, default_path, make_path, path_class, path_options
+from .style import Style
 
-__all__ = ["PATHS", "ColorScale", "GLPath", "MeshPath", "RenderPath", "Style", "check_options",
-           "colormap_lut", "make_path", "path_class", "path_options", "scale_for"]
+__all__ = ["PATHS", "ColorScale", "GLBackend", "GLPath", "MeshPath", "RenderPath",
+           "SoftwareRasterizer", "Style", "as_backend", "check_options", "colormap_lut",
+           "default_path", "make_path", "path_class", "path_options", "scale_for"]

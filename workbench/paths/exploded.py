@@ -61,7 +61,9 @@ import moderngl
 import numpy as np
 
 from ..gl import Framebuffer, GpuTimer, SamplesPassed, load_program, write_masks
-from .base import MeshPath, Style
+from .drawdata import Layout, Topology
+from .mesh import MeshPath
+from .style import Style
 
 AXES = ("x", "y", "z")
 NO_PART = np.iinfo(np.int64).min  # what id_image() holds where no part was drawn
@@ -173,10 +175,13 @@ class ExplodedPath(MeshPath):
         self.last_occlusion: dict = {}
         self.count_in_draw = True
         self._frame_count: dict | None = None
+        self.state = None  # the animation state, from prepare on
 
     # ------------------------------------------------------------------ prepare
-    def _check_scene(self, mesh) -> None:
-        super()._check_scene(mesh)
+    def check_mesh(self, mesh):
+        """Refuse as :class:`MeshPath` does, and a focus the mesh cannot show (see the module
+        docstring)."""
+        scale = super().check_mesh(mesh)
         focus = self.style.focus
         ids = sorted(int(p) for p in np.unique(mesh.parts))
         if focus is None:
@@ -191,9 +196,11 @@ class ExplodedPath(MeshPath):
         if not (mesh.parts[element_of] == focus).any():
             raise ValueError(f"focus part {focus} of {mesh.name} is empty: it has no "
                              f"drawable triangle")
+        return scale
 
-    def layout(self, mesh, triangles, n_vertices):
-        index = super().layout(mesh, triangles, n_vertices)  # a triangle list (style checked)
+    def layout(self, mesh, topology: Topology) -> Layout:
+        """The triangle list sorted by part, the focus first; records each part's range."""
+        layout = super().layout(mesh, topology)  # a triangle list (style checked)
         part = mesh.parts[mesh.triangulation.element_of].astype(np.int64)
         focus = self.style.focus
         order = np.lexsort((part, part != focus))
@@ -204,7 +211,9 @@ class ExplodedPath(MeshPath):
         n_focus = int((part == focus).sum())
         self._focus_range = (0, n_focus)
         self._rest_range = (n_focus, len(part) - n_focus)
-        return index[order]
+        element = None if layout.triangle_element is None else layout.triangle_element[order]
+        return Layout(layout.index[order], layout.primitive, layout.triangles, layout.strips,
+                      layout.vertices_sent, triangle_element=element)
 
     def _build(self, ctx, mesh, camera) -> None:
         algo = _explode()
@@ -262,7 +271,7 @@ class ExplodedPath(MeshPath):
         self._upload_plane()
         self._unoccluded = {}  # p_unocc per image size, for this camera and step
         self._frame_count = None
-        if hasattr(self, "state"):  # a new view: a held explosion may shrink again
+        if self.state is not None:  # a new view: a held explosion may shrink again
             self.state = _explode().release(self.state)
         eye = self.origin + np.asarray(camera.eye, np.float64)  # world space, float64
         if camera.projection == "orthographic":  # parallel rays: an eye far back along them
@@ -281,7 +290,7 @@ class ExplodedPath(MeshPath):
             raise ValueError(f"alpha must be in (0, 1], got {alpha}")
         self.offset, self.alpha = offset, alpha
         self._frame_count = None
-        if hasattr(self, "state"):
+        if self.state is not None:
             self.state = _explode().release(
                 _explode().ExplodeState(offset=offset, frame=self.state.frame))
 

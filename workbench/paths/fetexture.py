@@ -22,7 +22,8 @@ surface's ``line_edges`` (element edges the texture cannot show) are drawn after
 
 The path receives its prepared input: ``prepare`` takes either a ``TexturedSurface`` built by
 the caller, or an FE mesh whose fe2003 model the scene has derived and cached
-(``mesh.fepatch_model(Style.fepatch)``, asked for through ``needs = {"fepatch"}``); the path
+(:func:`~workbench.algo.fepatch.mesh_model.fepatch_model` of ``Style.fepatch``, asked for
+through ``needs = {"fepatch"}``); the path
 draws that model's ``original`` or ``simplified`` surface. The surface is built for one
 configuration, so only step 0 is drawn: ``Style.step`` other than 0, a deformation plot
 (magnification ≠ 1 with a reference step other than 0), ``set_step`` with another step,
@@ -38,8 +39,9 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from ..algo.fepatch.surface import CORNER_ROW, TexturedSurface, corner_rows
-from ..gl import load_program
+from ..algo.fepatch.mesh_model import fepatch_model
+from ..algo.fepatch.surface import CORNER_ROW, corner_rows
+from ..gl import Camera, load_program
 from .base import GLPath
 
 __all__ = ["FETexturePath", "FEWireTexturePath", "FENormalMapPath", "FENormalWirePath"]
@@ -65,6 +67,7 @@ class FETexturePath(GLPath):
     """
 
     needs = frozenset({"fepatch"})
+    scene_kinds = frozenset({"mesh", "surface"})
     model_surface: str = "simplified"
     normal_map: bool = True
     wire_texture: bool = False
@@ -85,14 +88,23 @@ class FETexturePath(GLPath):
             raise ValueError(f"path {self.name!r} draws its surface's triangle list: "
                              f"use strips='none'")
 
+    @classmethod
+    def default_camera(cls, scene, size: tuple[int, int], *, view=(30.0, 25.0),
+                       projection: str = "orthographic", up: str = "z", style=None) -> Camera:
+        """:meth:`Camera.fit_box` over the surface, or over every step of the mesh whose model
+        is drawn."""
+        lo, hi = scene.bounds(all_steps=True) if scene.kind == "mesh" else scene.bounds()
+        return cls.fit_camera(lo, hi, size, view=view, projection=projection, up=up)
+
     def _surface_for(self, scene):
         """The TexturedSurface ``scene`` is, or the one of the mesh's cached fe2003 model."""
-        if isinstance(scene, TexturedSurface):
+        kind = getattr(scene, "kind", None)
+        if kind == "surface":
             return scene
-        if not hasattr(scene, "fepatch_model"):
+        if kind != "mesh":
             raise ValueError(f"path {self.name!r} draws an FE mesh or a TexturedSurface, "
                              f"got {type(scene).__name__}")
-        return getattr(scene.fepatch_model(self.style.fepatch), self.model_surface)
+        return getattr(fepatch_model(scene, self.style.fepatch), self.model_surface)
 
     def _check_surface(self, surface) -> None:
         if len(surface.triangles) == 0:

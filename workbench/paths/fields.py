@@ -26,7 +26,8 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import maximum_bipartite_matching
 
-from .base import MeshPath
+from .drawdata import Topology
+from .mesh import MeshPath
 
 
 class VertexColorPath(MeshPath):
@@ -58,23 +59,12 @@ class ElementColorPath(MeshPath):
     vertex_shader, fragment_shader = "element_color.vert.glsl", "element_color.frag.glsl"
     field_per = "element"
 
-    def topology(self, mesh):
-        vertex_node, triangles, self._provoking = provoking_vertices(
+    def topology(self, mesh) -> Topology:
+        """The mesh nodes plus the duplicates :func:`provoking_vertices` needs, each element's
+        triangles rotated so that its own vertex comes last."""
+        vertex_node, triangles, provoking = provoking_vertices(
             mesh.triangles, mesh.triangulation.element_of, mesh.n_nodes, mesh.n_elements)
-        self._provoking_vertex = None
-        return vertex_node, triangles
-
-    def vertex_values(self, t: np.ndarray) -> np.ndarray:
-        if self._provoking_vertex is None:
-            has = self._provoking >= 0
-            vertex = self._provoking[has]
-            if self._remap is not None:
-                vertex = self._remap[vertex]
-            self._provoking_vertex = (has, vertex)
-        has, vertex = self._provoking_vertex
-        out = np.zeros(self.vertices, np.float64)
-        out[vertex] = t[has]
-        return out
+        return Topology(vertex_node, triangles, element_vertex=provoking)
 
 
 def provoking_vertices(triangles, element_of, n_nodes: int, n_elements: int):

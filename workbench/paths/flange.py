@@ -1,7 +1,8 @@
 """The flange path (crash2000 §5, Fig. 9): every node's distance to another part as a colour,
 and the geometry farther than a threshold hidden by an RGBα 1-D texture and the alpha test.
 
-The distance is :meth:`FEMesh.part_distances` (exact, float64, to the nearest element of any
+The distance is the derived item ``part_distances``
+(:func:`workbench.algo.part_distance.flange_distances`: exact, float64, to the nearest element of any
 part the node does not belong to, up to the distance of interest ``cutoff``), installed on the
 mesh as the node field ``"part_distance"`` and drawn per pixel like ``pixel_color`` (Gouraud
 light, the scalar interpolated and looked up per fragment):
@@ -25,8 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .base import Style
+from ..algo.part_distance import flange_distances
 from .fields import PixelColorPath
+from .style import Style
 
 FIELD = "part_distance"
 SHOWS = ("flanges", "distance")
@@ -80,13 +82,17 @@ class FlangePath(PixelColorPath):
     needs = frozenset({"gouraud", "part_distances"})
     style_class = FlangeStyle
 
-    def _check_scene(self, mesh) -> None:
-        if not hasattr(mesh, "part_distances"):
+    def check_mesh(self, mesh):
+        """Install the node field ``part_distance`` on ``mesh`` from its cached distances (far
+        nodes hidden with the flanges, drawn in ``base_color`` on the map), then check as
+        ``pixel_color`` does."""
+        if getattr(mesh, "kind", None) != "mesh":
             raise ValueError(f"path {self.name!r} draws an FE mesh, got {type(mesh).__name__}")
         style = self.style
-        distance = np.array(mesh.part_distances(style.cutoff, style.step).distance, np.float64)
+        distance = np.array(flange_distances(mesh, style.cutoff, style.step).distance,
+                            np.float64)
         far = ~np.isfinite(distance)
         # beyond the distance of interest: hidden with the flanges, the base colour on the map
         distance[far] = 2.0 * style.threshold if style.show == "flanges" else np.nan
         mesh.node_fields[FIELD] = distance
-        super()._check_scene(mesh)
+        return super().check_mesh(mesh)

@@ -1,12 +1,13 @@
 """Any mesh render path drawn by the es2008 software rasterizer instead of GL.
 
 :class:`SoftwarePath` takes the name of a mesh path (``position``, ``flat``, ``gouraud``,
-``vertex_color``, ``pixel_color``, ``element_color``) and its :class:`~.base.Style`, and draws
-the same image on the CPU with :func:`workbench.algo.softraster.render`: the same triangles
-(the GL path's own topology and quad diagonals), the same deformation plot, normals, colour
-texture, transfer-function alpha test and clip planes, the same pixel rule as llvmpipe. It
-follows the path protocol (prepare, set_camera, set_step, draw, release) so that
-:func:`workbench.experiment.measure` times it like any path; it draws into its own
+``vertex_color``, ``pixel_color``, ``element_color``) and its :class:`~.style.Style`, and draws
+the same image on the CPU with :func:`workbench.algo.softraster.render`: it rasterizes the
+path's own :class:`~.drawdata.MeshDrawData` (the same triangles and quad diagonals, the same
+deformation plot, normals, colour texture, transfer-function alpha test and clip planes), with
+the same pixel rule as llvmpipe. It follows the path protocol (prepare, set_camera, set_step,
+draw, release) so that :func:`workbench.experiment.measure` times it like any path through the
+:class:`~workbench.paths.backends.SoftwareRasterizer` backend; it draws into a
 :class:`SoftwareTarget` instead of a GL framebuffer, and needs no GL context.
 
 Refused with ValueError: a path that is not a mesh path, a wire frame (a GL line pass),
@@ -19,8 +20,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..algo.softraster import Frame, RasterOptions, Shading, render
-from .base import MeshPath, RenderPath, path_class
+from .base import RenderPath
 from .colormap import NO_VALUE
+from .registry import path_class
 
 SHADING_OF = {"position": "constant", "flat": "flat", "gouraud": "gouraud",
               "vertex_color": "vertex_color", "pixel_color": "pixel_color",
@@ -59,7 +61,7 @@ class SoftwarePath(RenderPath):
     """The image of mesh path ``name`` with ``style``, rasterized on the CPU with ``options``."""
 
     rasterizer = "software"
-    needs = frozenset({"triangles"})  # replaced by the wrapped path's
+    needs = frozenset({"triangles"})  # replaced by the drawn path's
 
     def __init__(self, name: str = "pixel_color", style=None,
                  options: RasterOptions = RasterOptions()) -> None:
@@ -77,11 +79,16 @@ class SoftwarePath(RenderPath):
         super().__init__(style)
         self.needs = cls.needs
         self.options = options
-        self._gl: MeshPath = cls(self.style)
+        self._drawn = cls(self.style)  # builds the draw data; never prepared on GL
         self.target: SoftwareTarget | None = None
         self.stats = None
-        self.mesh = None
+        self.mesh = self.data = self.scale = None
         self._workspace: dict = {}
+
+    @classmethod
+    def default_camera(cls, scene, size, **kwargs):
+        """The camera of the mesh paths."""
+        return path_class("position").default_camera(scene, size, **kwargs)
 
     @property
     def renderer(self) -> str:
@@ -93,7 +100,7 @@ class SoftwarePath(RenderPath):
                 f"{threads} threads)")
 
     def make_target(self, size: tuple[int, int], samples: int = 0) -> SoftwareTarget:
-        """The framebuffer this path draws into (and ``measure`` reads), ``size`` (W, H)."""
+        """A framebuffer of ``size`` (W, H) that this path draws into from now on."""
         if samples:
             raise ValueError("the software rasterizer draws without MSAA: samples must be 0")
         self.target = SoftwareTarget(size)
@@ -101,23 +108,20 @@ class SoftwarePath(RenderPath):
 
     # ------------------------------------------------------------------ prepare
     def prepare(self, ctx, mesh, camera) -> None:
+        """Build the drawn path's draw data for ``mesh`` (``ctx`` is not used: no GL)."""
         style = self.style
         if camera.projection != "orthographic":
             raise ValueError("the software rasterizer draws orthographic views only")
-        gl = self._gl
-        gl._check_scene(mesh)
-        self.scale = gl.scale
-        vertex_node, triangles = gl.topology(mesh)
-        n_vertices = mesh.n_nodes if vertex_node is None else len(vertex_node)
-        self._triangles = np.ascontiguousarray(gl.layout(mesh, triangles, n_vertices), np.int64)
-        self._vertex_node = None if vertex_node is None else np.asarray(vertex_node, np.int64)
-        self.triangles, self.vertices = len(self._triangles), n_vertices
+        data = self._drawn.draw_data(mesh)
+        self.data, self.scale = data, data.scale
+        self._triangles = np.ascontiguousarray(data.triangle_list(), np.int64)
+        self.triangles, self.vertices = len(self._triangles), data.n_vertices
         self.vertices_sent = self._triangles.size
         self.mesh, self.origin = mesh, np.array(camera.origin, np.float64)
-        kind = SHADING_OF[self.name]
-        scale = self.scale
+        scale = data.scale
         self._shading = Shading(
-            kind=kind, base_color=style.base_color, missing_color=style.base_color,
+            kind=SHADING_OF[self.name], base_color=style.base_color,
+            missing_color=style.base_color,
             texels=None if scale is None else scale.texture_data(),
             linear=False if scale is None else scale.linear,
             coord=(1.0, 0.0) if scale is None else scale.coord_transform,
@@ -140,36 +144,27 @@ class SoftwarePath(RenderPath):
 
     def shown_coordinates(self, step: int) -> np.ndarray:
         """(N, 3) float64 node positions drawn for ``step`` (deformation plot applied)."""
-        return MeshPath.shown_coordinates(self, step)
+        return self.data.shown_coordinates(step)
 
     def set_step(self, step: int) -> int:
-        mesh = self.mesh
+        mesh, data = self.mesh, self.data
         if mesh is None:
             raise RuntimeError(f"software path {self.name!r} is not prepared")
         if int(step) != step or not 0 <= step < mesh.n_steps:
             raise ValueError(f"step {step} out of range: {mesh.name} has {mesh.n_steps} steps")
         step = int(step)
-        shown = self.shown_coordinates(step)
-        node = self._vertex_node
+        shown = data.shown_coordinates(step)
         # what GL uploads per step: float32 relative to the origin (subtracted in float64)
-        self._positions = ((shown if node is None else shown[node]) - self.origin).astype(
-            np.float32)
-        self._normals = self._values = self._triangle_values = None
-        if self._gl.split:
-            self._normals = self._gl._gouraud.normals(shown).astype(np.float32)
-        field = self.style.field
-        if self._gl.field_per == "node":
-            t = self.scale.normalise(mesh.node_field(field, step))
-            self._values = t if node is None else t[node]
+        self._positions = data.positions(shown, self.origin)
+        self._normals = data.normals(shown)
+        self._values = self._triangle_values = None
+        if data.field_per is not None:
+            t = data.normalised(step)
             self.missing_values = int((~np.isfinite(t)).sum())
-        elif self._gl.field_per == "element":
-            t = self.scale.normalise(mesh.element_field(field, step))
-            self._triangle_values = t[mesh.triangulation.element_of]
-            self.missing_values = int((~np.isfinite(t)).sum())
-        for name in ("_values", "_triangle_values"):
-            values = getattr(self, name)
-            if values is not None:
-                setattr(self, name, np.where(np.isfinite(values), values, NO_VALUE))
+            if data.field_per == "node":
+                self._values = _with_no_value(data.vertex_values(t))
+            else:
+                self._triangle_values = _with_no_value(t[data.triangle_element])
         self.step = step
         return sum(a.nbytes for a in (self._positions, self._normals, self._values,
                                       self._triangle_values) if a is not None)
@@ -207,3 +202,9 @@ class SoftwarePath(RenderPath):
         self.mesh = None
         self.target = None
         self._workspace = {}
+
+
+def _with_no_value(values: np.ndarray) -> np.ndarray:
+    """``values`` (float64) with every non-finite entry replaced by :data:`NO_VALUE` (drawn in
+    the missing colour)."""
+    return np.where(np.isfinite(values), values, NO_VALUE)

@@ -47,11 +47,12 @@ from dataclasses import dataclass, replace
 import moderngl
 import numpy as np
 
+from ..algo.spacetime.raster import PixelGrid
+from ..algo.spacetime.scene import SpacetimeScene
 from ..algo.spacetime.shading import LIGHT
 from ..gl import load_program
 from ..gl.camera import Camera
 from ..gl.texbuffer import TextureBuffer
-from ..scene.spacetime import SpacetimeScene  # noqa: F401  (re-exported: the data drawn)
 from .base import GLPath
 from .colormap import colormap_lut
 
@@ -118,7 +119,7 @@ def top_camera(grid, z_range: tuple[float, float] = (-1.0, 1.0), origin=None) ->
 class SpacetimePath(GLPath):
     """The shared implementation of the two registered spacetime paths (``spacetime_vertex``,
     ``spacetime_pixel``; :func:`spacetime_path` picks one by ``style.shading``), prepared for one scene: a
-    :class:`~workbench.scene.spacetime.SpacetimeScene` (a slice, or the bar's spacetime), built
+    :class:`~workbench.algo.spacetime.scene.SpacetimeScene` (a slice, or the bar's spacetime), built
     by the caller. The scene is one configuration, so ``set_step`` accepts only step 0.
 
     After :meth:`prepare`: ``polygons``, ``triangles``, ``lines`` (shared edges overdrawn) and
@@ -127,7 +128,7 @@ class SpacetimePath(GLPath):
 
     needs = frozenset()
     style_class = SpacetimeStyle
-    scene_kind = "spacetime"
+    scene_kinds = frozenset({"spacetime"})
 
     def __init__(self, style: SpacetimeStyle | None = None) -> None:
         super().__init__(style)
@@ -143,6 +144,17 @@ class SpacetimePath(GLPath):
     def _behind(self) -> bool:
         """Whether the overdraw goes to the far half of the depth range, behind the fill."""
         return self.style.edge_overdraw in ("behind", "skirts")
+
+    @classmethod
+    def default_camera(cls, scene, size: tuple[int, int], *, view=(30.0, 25.0),
+                       projection: str = "orthographic", up: str = "z", style=None) -> Camera:
+        """The top view of the scene's drawing plane ((x, y) or (x, t), heights up z) whose
+        pixel centres are those of :meth:`PixelGrid.fit`, so that the exact image matches; its
+        depth range encloses the heights drawn with ``style.height_scale``. ``view``,
+        ``projection`` and ``up`` do not apply."""
+        grid = PixelGrid.fit(*scene.bounds(), size[0], size[1])
+        top = float(getattr(style, "height_scale", 1.0)) * scene.max_speed()
+        return top_camera(grid, (-1.0, top + 1.0))
 
     def _check_scene(self, scene) -> None:
         if not isinstance(scene, SpacetimeScene):

@@ -13,7 +13,7 @@
 
 from __future__ import annotations
 
-from .base import MeshPath
+from .mesh import MeshPath
 
 
 class PositionPath(MeshPath):

@@ -22,11 +22,13 @@ The coordinate is per strip, so the strips' vertices are uploaded once per strip
 
 from __future__ import annotations
 
-import moderngl
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..algo.strips import RESTART, join_strips, quad_strips, unstripify
-from .base import MeshPath
+from .drawdata import Layout, Topology
+from .mesh import MeshPath
 
 # boundary bits of the flat per-triangle mask: which iso-lines of the wire coordinate are
 # element edges no other element shares
@@ -51,6 +53,15 @@ def single_use_edges(elements, pairs) -> np.ndarray:
     return count == 1
 
 
+@dataclass(eq=False)
+class StripTopology(Topology):
+    """A :class:`Topology` whose vertices are the strips' own: ``draw_index`` the strip index
+    array (with restart markers) over them and ``n_strips`` the strips drawn."""
+
+    draw_index: np.ndarray | None = None
+    n_strips: int = 0
+
+
 class QuadWirePath(MeshPath):
     """Gouraud shading with the element outlines drawn in the same pass from quad strips."""
 
@@ -59,7 +70,10 @@ class QuadWirePath(MeshPath):
     vertex_shader, fragment_shader = "quad_wire.vert.glsl", "quad_wire.frag.glsl"
     split = True
 
-    def topology(self, mesh):
+    def topology(self, mesh) -> StripTopology:
+        """The crease-split vertices once per strip they belong to, with the wire coordinate
+        and the boundary bits as static attributes; ValueError for a second wire frame or for
+        anything but quad strips."""
         style = self.style
         if style.wireframe:
             raise ValueError("quad_wire draws its wire frame in the fill pass: wireframe=True "
@@ -67,8 +81,8 @@ class QuadWirePath(MeshPath):
         if style.strips == "triangle" or style.quad_diagonal == "shorter":
             raise ValueError("quad_wire always draws quad strips: use strips='none' or 'quad' "
                              "and quad_diagonal 'auto' or 'strip'")
-        self._gouraud = mesh.gouraud(style.crease_deg)
-        quads = quad_strips(self._gouraud.elements, style.strip_cutoff)
+        split = mesh.gouraud(style.crease_deg)
+        quads = quad_strips(split.elements, style.strip_cutoff)
         source, lengths = quads.draw_sequences()
         source = source.astype(np.int64)
         # position of each draw vertex within its strip
@@ -82,12 +96,12 @@ class QuadWirePath(MeshPath):
         if n_tris:
             wire[-3 * n_tris:] = np.tile(np.array([[0, 0, 1], [0, 1, 0], [1, 0, 0]], np.float32),
                                          (n_tris, 1))
-        self._wire_coord = wire
-        self._boundary = self._boundary_masks(mesh, quads, len(source))
-        self._draw_index = join_strips(np.arange(len(source), dtype=np.uint32), lengths, RESTART)
-        self._n_draw_strips = len(lengths)
-        self._split_rows = source
-        return np.asarray(self._gouraud.vertex_node, np.int64)[source], unstripify(self._draw_index)
+        boundary = self._boundary_masks(mesh, quads, len(source))
+        draw_index = join_strips(np.arange(len(source), dtype=np.uint32), lengths, RESTART)
+        return StripTopology(np.asarray(split.vertex_node, np.int64)[source],
+                             unstripify(draw_index), split=split, split_rows=source,
+                             attributes=[(wire, "3f", "wire"), (boundary, "1f", "boundary")],
+                             draw_index=draw_index, n_strips=len(lengths))
 
     @staticmethod
     def _boundary_masks(mesh, quads, n_draw: int) -> np.ndarray:
@@ -125,15 +139,10 @@ class QuadWirePath(MeshPath):
             mask[first + 3 * np.arange(len(tri)) + 2] = bits
         return mask
 
-    def layout(self, mesh, triangles, n_vertices):
-        self.mode = moderngl.TRIANGLE_STRIP
-        self.triangles = len(triangles)
-        self.strips = self._n_draw_strips
-        self.vertices_sent = n_vertices
-        return self._draw_index
-
-    def static_attributes(self):
-        return [(self._wire_coord, "3f", "wire"), (self._boundary, "1f", "boundary")]
+    def layout(self, mesh, topology: StripTopology) -> Layout:
+        """The strips over the strip vertices, each sent once."""
+        return Layout(topology.draw_index, "triangle_strip", len(topology.triangles),
+                      topology.n_strips, len(topology.vertex_node))
 
     def _build(self, ctx, mesh, camera) -> None:
         super()._build(ctx, mesh, camera)

@@ -5,14 +5,16 @@ triangle repeating its third node (``e[3] == e[2]``), one part id per element, o
 (T, N, 3) coordinates of every time step sharing one topology, and fields per node
 ((N,) or (T, N)) or per element ((M,) or (T, M)).
 
-Derived data (triangulation, unique edges, normals, crease-split "Gouraud edges") is computed
-on first request and cached on the instance; see :mod:`workbench.scene.derived`.
+Derived data (triangulation, unique edges, crease-split "Gouraud edges", and what algorithms
+register) is computed on first request and kept in the mesh's one cache, ``derived``; see
+:mod:`workbench.scene.needs` (the registry) and :mod:`workbench.scene.derived` (the geometry).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import ClassVar
 
 import numpy as np
 
@@ -42,6 +44,10 @@ class FEMesh:
     element_ids: np.ndarray | None = None
     name: str = "mesh"
     units: str = "mm"
+    # what render paths made the mesh derive, by cache key (see workbench.scene.needs)
+    derived: dict = field(default_factory=dict, init=False, repr=False)
+
+    kind: ClassVar[str] = "mesh"
 
     def __post_init__(self) -> None:
         self.nodes = np.ascontiguousarray(self.nodes, dtype=np.float64)
@@ -201,24 +207,26 @@ class FEMesh:
         )
 
     # ----------------------------------------------------------------- derived (cached)
-    @cached_property
+    @property
     def triangulation(self):
-        """:class:`~workbench.scene.derived.Triangulation`: quads split along the shorter diagonal."""
-        from .derived import triangulate
+        """:class:`~workbench.scene.derived.Triangulation`: quads split along the shorter
+        diagonal (derived once, see :mod:`workbench.scene.needs`)."""
+        from .needs import triangulation
 
-        return triangulate(self.elements, self.nodes)
+        return triangulation(self)
 
     @property
     def triangles(self) -> np.ndarray:
         """(K, 3) int32 triangles into ``nodes`` (quads split along the shorter diagonal)."""
         return self.triangulation.triangles
 
-    @cached_property
+    @property
     def edges(self) -> np.ndarray:
-        """(E, 2) int32 unique element edges (quad edges only, no diagonals), sorted per row."""
-        from .derived import unique_edges
+        """(E, 2) int32 unique element edges (quad edges only, no diagonals), sorted per row
+        (derived once)."""
+        from .needs import edges
 
-        return unique_edges(self.elements)
+        return edges(self)
 
     def face_normals(self, step: int | None = None) -> np.ndarray:
         """(M, 3) float64 unit normals per element (zero for degenerate elements)."""
@@ -233,43 +241,12 @@ class FEMesh:
         return node_normals(self.elements, self.coordinates(step))
 
     def gouraud(self, crease_deg: float = 30.0):
-        """:class:`~workbench.scene.derived.GouraudSplit` for this crease angle (cached per angle).
+        """:class:`~workbench.scene.derived.GouraudSplit` for this crease angle (derived once
+        per angle). Creases are detected on the first and last time steps together
+        (crash2000, Fig. 2)."""
+        from .needs import gouraud
 
-        Creases are detected on the first and last time steps together (crash2000, Fig. 2).
-        """
-        cache = self.__dict__.setdefault("_gouraud_cache", {})
-        if crease_deg not in cache:
-            from .derived import gouraud_split
-
-            coords = [self.coordinates(0)]
-            if self.n_steps > 1:
-                coords.append(self.coordinates(self.n_steps - 1))
-            cache[crease_deg] = gouraud_split(self.elements, coords, crease_deg, self.triangulation)
-        return cache[crease_deg]
-
-    def fepatch_model(self, fepatch: str = "A"):
-        """The fe2003 model of step 0 (``.original`` and ``.simplified`` textured surfaces) for
-        the parameter string ``fepatch`` ("A", "B" or "alpha_g1,d,l_outer,l_inner"; see
-        :func:`workbench.algo.fepatch.pipeline.build_model`), built once per string."""
-        cache = self.__dict__.setdefault("_fepatch_cache", {})
-        if fepatch not in cache:
-            from ..algo.fepatch.pipeline import build_model
-
-            cache[fepatch] = build_model(self.elements, self.coordinates(0), fepatch)
-        return cache[fepatch]
-
-    def part_distances(self, cutoff: float, step: int = 0):
-        """The crash2000 distances of step ``step``: for every node, the exact distance to the
-        nearest element of another part within ``cutoff`` (model units), as
-        :func:`workbench.algo.part_distance.part_distances` computes them with AABB trees of
-        one element per leaf; cached per (cutoff, step)."""
-        cache = self.__dict__.setdefault("_part_distance_cache", {})
-        key = (float(cutoff), int(step))
-        if key not in cache:
-            from ..algo.part_distance import part_distances
-
-            cache[key] = part_distances(self, float(cutoff), step=int(step))
-        return cache[key]
+        return gouraud(self, crease_deg)
 
     def __repr__(self) -> str:
         return (f"FEMesh({self.name!r}: {self.n_nodes} nodes, {self.n_elements} elements "

@@ -41,6 +41,7 @@ Texture conventions (shared with the shaders):
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -65,7 +66,7 @@ class TexturedSurface:
     ``wire_map`` (H, W, 4) uint8 or None; ``wire_range`` texels of byte 0/255; or the
     element-id wire frame: ``element_map`` (H, W) uint16/uint32, ``corner_table`` (M, 4, 2)
     uint16, ``corner_frac`` steps per texel and ``element_base`` (V,) int32; ``line_edges``
-    (E, 2) int32 vertex pairs drawn as lines.
+    (E, 2) int32 vertex pairs drawn as lines. ``name`` is how tables name the surface.
     """
 
     positions: np.ndarray
@@ -81,6 +82,9 @@ class TexturedSurface:
     corner_table: np.ndarray | None = None
     corner_frac: int = 1
     element_base: np.ndarray | None = None
+    name: str = "TexturedSurface"
+
+    kind: ClassVar[str] = "surface"
 
     def __post_init__(self) -> None:
         self.positions = np.asarray(self.positions, np.float64)
@@ -145,6 +149,10 @@ class TexturedSurface:
             raise ValueError(f"corner_frac must be a positive integer, got {self.corner_frac!r}")
         self.element_map, self.corner_table, self.element_base = emap, table, base
         self.corner_frac = int(self.corner_frac)
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi) float64 corners of the box of the positions, model units."""
+        return self.positions.min(axis=0), self.positions.max(axis=0)
 
     @property
     def no_element(self) -> int:

@@ -2,8 +2,9 @@
 
 A :class:`SpacetimeScene` is a set of polygons, each showing the cubic solution of one
 spacetime element: a constant-time slice of a tetrahedral spacetime mesh, or the (x, t)
-triangles of a 1-D bar. The built-in scenes (:func:`spacetime_scene`) are least-squares cubic
-fits of closed-form elastodynamic fields on tent-pitched meshes (st2005 §3):
+triangles of a 1-D bar. The built-in scenes (:func:`spacetime_scene`, registered as
+``spacetime:radial`` and ``spacetime:bar`` in :mod:`workbench.scene.builtin`) are least-squares
+cubic fits of closed-form elastodynamic fields on tent-pitched meshes (st2005 §3):
 
 * ``radial`` — a radial P pulse on a 100 mm steel plate meshed n×n cells, refined along the
   front, sliced at t = 5 µs (``cells`` per side, default 28, 12 quick: ~10⁴ and ~2·10³
@@ -15,13 +16,15 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
-from ..algo.spacetime.fields import BAR, STEEL, RadialPulse, ReflectingWave
-from ..algo.spacetime.mesh import front_refined, interval_mesh, rect_triangulation
-from ..algo.spacetime.poly import evaluate, fit_cubic, local_frames
-from ..algo.spacetime.slicing import Slice, polygon_areas, quadrisect, slice_at
+from ...scene.builtin import builtin
+from .fields import BAR, STEEL, RadialPulse, ReflectingWave
+from .mesh import front_refined, interval_mesh, rect_triangulation
+from .poly import evaluate, fit_cubic, local_frames
+from .slicing import Slice, polygon_areas, quadrisect, slice_at
 
 DOMAIN = 100.0  # mm, the square plate
 PULSE = dict(centre=(30.0, 35.0), a=2.0, t0=2.0)
@@ -53,6 +56,8 @@ class SpacetimeScene:
     t: float | None = None
     outer: np.ndarray | None = None
     name: str = "spacetime"
+
+    kind: ClassVar[str] = "spacetime"
 
     @property
     def is_bar(self) -> bool:
@@ -110,7 +115,7 @@ class SpacetimeScene:
                               name=f"{self.name} quadrisected {fraction:g}")
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """(lo, hi) of the polygons in the drawing plane, float64."""
+        """(lo, hi) of the polygons in the drawing plane (x, y) or (x, t), float64."""
         flat = self.corners.reshape(-1, 2)
         return flat.min(axis=0), flat.max(axis=0)
 
@@ -202,3 +207,14 @@ def spacetime_scene(name: str, cells: int | None = None, quick: bool = False) ->
         scene = slice_scene(sol, slice_at(sol.mesh, T_SLICE, outer=True))
     scene.name = f"spacetime:{name}:{n}"
     return scene
+
+
+@builtin("spacetime:radial", "st2005: a spacetime plate with a radially spreading pulse, N cells "
+                             "per side", sized=True)
+def radial_scene(size: int | None, quick: bool) -> SpacetimeScene:
+    return spacetime_scene("radial", cells=size, quick=quick)
+
+
+@builtin("spacetime:bar", "st2005: the (x, t) triangles of a 1-D bar", sized=True)
+def bar_builtin(size: int | None, quick: bool) -> SpacetimeScene:
+    return spacetime_scene("bar", cells=size, quick=quick)

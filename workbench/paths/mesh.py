@@ -1,0 +1,247 @@
+"""The shared implementation of the FE mesh paths: draw data built on the CPU, uploaded once.
+
+:class:`MeshPath` builds a :class:`~workbench.paths.drawdata.MeshDrawData` for a mesh
+(:meth:`MeshPath.draw_data`, GL-free: the software rasterizer draws the same object) and
+uploads it: one indexed triangle VAO, optionally a wire-frame VAO of lines. Per time step it
+uploads positions (and normals, and time-dependent field values), never topology.
+
+Subclasses choose shaders and two switches: ``split`` (vertices are the crease-split Gouraud
+vertices with per-vertex normals; otherwise the mesh's referenced nodes without normals) and
+``field_per`` (None, ``"node"`` or ``"element"``: the field's normalised values go up as a
+per-vertex float attribute ``value``). :meth:`MeshPath.topology` and :meth:`MeshPath.layout`
+may be overridden to number the vertices or lay out the index buffer differently.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import moderngl
+import numpy as np
+
+from ..algo.strips import RESTART, quad_strips, tri_strips
+from ..gl import Camera, load_program
+from .base import GLPath
+from .colormap import ColorScale, scale_for
+from .drawdata import Layout, MeshDrawData, Topology, compact, vertex_of_node
+from .style import Style
+
+PRIMITIVE_MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP}
+
+
+def field_kind(mesh, name: str) -> str:
+    """'node' or 'element' for a field of ``mesh``; KeyError listing the mesh's fields otherwise."""
+    if name in mesh.node_fields:
+        return "node"
+    if name in mesh.element_fields:
+        return "element"
+    raise KeyError(f"{mesh.name} has no field {name!r}; node fields: {sorted(mesh.node_fields)}, "
+                   f"element fields: {sorted(mesh.element_fields)}")
+
+
+class MeshPath(GLPath):
+    """An FE mesh drawn from its :class:`MeshDrawData` (see the module docstring)."""
+
+    vertex_shader: ClassVar[str]
+    fragment_shader: ClassVar[str]
+    split: ClassVar[bool] = False
+    field_per: ClassVar[str | None] = None
+
+    @classmethod
+    def default_camera(cls, scene, size: tuple[int, int], *, view=(30.0, 25.0),
+                       projection: str = "orthographic", up: str = "z", style=None) -> Camera:
+        """:meth:`Camera.fit_box` over the bounds of every step of the mesh at azimuth and
+        elevation ``view`` (degrees)."""
+        return cls.fit_camera(*scene.bounds(all_steps=True), size, view=view,
+                              projection=projection, up=up)
+
+    # ------------------------------------------------------------------ draw data (GL-free)
+    def check_mesh(self, mesh) -> ColorScale | None:
+        """Refuse a mesh or style this path cannot draw (ValueError, KeyError for an unknown
+        field); the colour scale of the field drawn (None without a field)."""
+        if getattr(mesh, "kind", None) != "mesh":
+            raise ValueError(f"path {self.name!r} draws an FE mesh, got {type(mesh).__name__}")
+        style = self.style
+        for label in ("step", "reference_step"):
+            if getattr(style, label) >= mesh.n_steps:
+                raise ValueError(f"{label} {getattr(style, label)} out of range: "
+                                 f"{mesh.name} has {mesh.n_steps} steps")
+        if self.field_per is None:
+            return None
+        self._check_field(mesh)
+        return scale_for(mesh, style.field, style.colormap, style.value_range, style.bands,
+                         style.hide_range)
+
+    def _check_field(self, mesh) -> None:
+        name = self.style.field
+        if name is None:
+            raise ValueError(f"path {self.name!r} draws a field: set Style.field to one of "
+                             f"node fields {sorted(mesh.node_fields)} or element fields "
+                             f"{sorted(mesh.element_fields)}")
+        kind = field_kind(mesh, name)
+        if kind != self.field_per:
+            other = "element_color" if kind == "element" else "pixel_color or vertex_color"
+            article = "an" if kind == "element" else "a"
+            raise ValueError(f"path {self.name!r} draws {self.field_per} fields, {name!r} is "
+                             f"{article} {kind} field: draw it with {other}")
+
+    def topology(self, mesh) -> Topology:
+        """The drawn vertices and triangles: the crease-split vertices (``split``) or the mesh
+        nodes, triangles in the triangulation's order."""
+        if self.split:
+            split = mesh.gouraud(self.style.crease_deg)
+            return Topology(np.asarray(split.vertex_node, np.int64), split.triangles, split=split)
+        return Topology(None, mesh.triangles)
+
+    def layout(self, mesh, topology: Topology) -> Layout:
+        """The index buffer for ``Style.strips`` and ``Style.quad_diagonal`` (see
+        :class:`Layout`); ValueError for strips of a path whose vertices are not shared."""
+        style, triangles = self.style, topology.triangles
+        if style.strips == "none" and style.diagonal == "shorter":
+            return Layout(triangles, "triangles", len(triangles), 0, triangles.size,
+                          triangle_element=mesh.triangulation.element_of)
+        if type(self).topology is not MeshPath.topology:
+            raise ValueError(f"path {self.name!r} gives every triangle its own provoking vertex; "
+                             f"strips and strip diagonals need shared vertices: draw it with "
+                             f"strips='none' and quad_diagonal='shorter'")
+        if style.diagonal == "strip":
+            elements = topology.split.elements if self.split else mesh.elements
+            quads = quad_strips(elements, style.strip_cutoff)
+            if style.strips == "quad":
+                index = quads.restart_indices(RESTART)
+                strips = quads.n_strips + len(quads.leftover) + len(quads.triangles)
+                return Layout(index, "triangle_strip", len(triangles), strips,
+                              len(index) - max(strips - 1, 0))
+            triangles = quads.triangle_list()
+        if style.strips == "triangle":
+            n_vertices = mesh.n_nodes if topology.vertex_node is None \
+                else len(topology.vertex_node)
+            tri = tri_strips(triangles, n_vertices, RESTART)
+            return Layout(tri.indices, "triangle_strip", len(triangles), tri.n_strips,
+                          tri.n_vertices)
+        return Layout(triangles, "triangles", len(triangles), 0, triangles.size)
+
+    def draw_data(self, mesh) -> MeshDrawData:
+        """What this path draws of ``mesh`` with its style, GL-free (refusals as
+        :meth:`check_mesh` and :meth:`layout`)."""
+        scale = self.check_mesh(mesh)
+        topology = self.topology(mesh)
+        layout = self.layout(mesh, topology)
+        vertex_node, n_vertices, index, split_rows, remap = compact(topology, layout,
+                                                                    mesh.n_nodes)
+        element_vertex = topology.element_vertex
+        attributes = [(np.ascontiguousarray(data, np.float32), fmt, name)
+                      for data, fmt, name in topology.attributes]
+        if remap is not None:
+            keep = np.flatnonzero(remap >= 0)
+            attributes = [(data[keep], fmt, name) for data, fmt, name in attributes]
+            if element_vertex is not None:
+                element_vertex = np.where(element_vertex >= 0,
+                                          remap[np.maximum(element_vertex, 0)], -1)
+        edges = None
+        if getattr(self.style, "wireframe", False):
+            edges = np.ascontiguousarray(vertex_of_node(vertex_node, mesh.n_nodes)[mesh.edges],
+                                         dtype=np.int32)
+        return MeshDrawData(
+            mesh=mesh, style=self.style, vertex_node=vertex_node, n_vertices=n_vertices,
+            index=index, primitive=layout.primitive, triangles=layout.triangles,
+            strips=layout.strips, vertices_sent=layout.vertices_sent, split=topology.split,
+            split_rows=split_rows, field_per=self.field_per, scale=scale,
+            element_vertex=element_vertex, attributes=attributes, edges=edges,
+            triangle_element=layout.triangle_element)
+
+    # ------------------------------------------------------------------ prepare (GL)
+    def _check_scene(self, mesh) -> None:
+        self.data = self.draw_data(mesh)
+        self.scale = self.data.scale
+
+    def _build(self, ctx: moderngl.Context, mesh, camera) -> None:
+        data, style = self.data, self.style
+        self.mesh = mesh
+        self.mode = PRIMITIVE_MODES[data.primitive]
+        self.triangles, self.strips = data.triangles, data.strips
+        self.vertices_sent, self.vertices = data.vertices_sent, data.n_vertices
+        defines = {"NUM_CLIP": len(style.clip_planes)}
+        if style.hide_range is not None and self.field_per is not None:
+            defines["HIDE"] = 1
+        self._program = self._keep(load_program(ctx, self.vertex_shader, self.fragment_shader,
+                                                defines=defines))
+        n = data.n_vertices
+        self._positions = self._keep(ctx.buffer(reserve=n * 12))
+        self._index = self._keep(ctx.buffer(data.index.tobytes()))
+        uploaded = data.index.nbytes
+        content = [(self._positions, "3f", "position")]
+        self._normals = self._values = None
+        if data.split is not None:
+            self._normals = self._keep(ctx.buffer(reserve=n * 12))
+            content.append((self._normals, "3f", "normal"))
+        if self.field_per is not None:
+            self._values = self._keep(ctx.buffer(reserve=n * 4))
+            content.append((self._values, "1f", "value"))
+        for array, fmt, name in data.attributes:
+            content.append((self._keep(ctx.buffer(array.tobytes())), fmt, name))
+            uploaded += array.nbytes
+        if data.scale is not None:
+            uploaded += self._colormap_texture(ctx, data.scale)
+        self._vao = self._keep(ctx.vertex_array(self._program, content, self._index,
+                                                index_element_size=4))
+        if "base_color" in self._uniforms(self._program):
+            self._program["base_color"].value = style.base_color
+        if data.edges is not None:
+            uploaded += self._line_pass(ctx, self._positions, data.edges)
+        if data.static_values:
+            uploaded += self._upload_values(style.step)
+        self._set_clip_planes()
+        self.set_camera(camera)
+        self.bytes_per_step = self.set_step(style.step)
+        self.bytes_uploaded = uploaded + self.bytes_per_step
+
+    def _colormap_texture(self, ctx, scale: ColorScale) -> int:
+        """The 1-D colour texture on unit 0 and the scale's uniforms; returns its bytes."""
+        texels = scale.texture_data()
+        texture = self._keep(ctx.texture((len(texels), 1), 4, texels.tobytes()))
+        self._textures = [(texture, 0)]
+        filt = moderngl.LINEAR if scale.linear else moderngl.NEAREST
+        texture.filter = (filt, filt)
+        texture.repeat_x = texture.repeat_y = False
+        self._program["colormap"].value = 0
+        self._program["missing_color"].value = self.style.base_color
+        self._program["colormap_st"].value = scale.coord_transform
+        return texels.nbytes
+
+    # ------------------------------------------------------------------ per frame / per step
+    def shown_coordinates(self, step: int) -> np.ndarray:
+        """(N, 3) float64 node positions drawn for ``step`` (deformation plot applied)."""
+        return self.data.shown_coordinates(step)
+
+    def set_step(self, step: int) -> int:
+        self._require_prepared()
+        if int(step) != step or not 0 <= step < self.mesh.n_steps:
+            raise ValueError(f"step {step} out of range: {self.mesh.name} has "
+                             f"{self.mesh.n_steps} steps")
+        step = int(step)
+        shown = self.data.shown_coordinates(step)
+        positions = self.data.positions(shown, self.origin)
+        self._positions.write(positions)
+        sent = positions.nbytes
+        normals = self.data.normals(shown)
+        if normals is not None:
+            self._normals.write(normals)
+            sent += normals.nbytes
+        if self.field_per is not None and not self.data.static_values:
+            sent += self._upload_values(step)
+        self.step = step
+        return sent
+
+    def _upload_values(self, step: int) -> int:
+        """Upload the normalised field values of ``step``; non-finite ones as ``NO_VALUE``."""
+        values, self.missing_values = self.data.values(step)
+        self._values.write(values)
+        return values.nbytes
+
+    def draw(self) -> None:
+        self.ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
+        self._render(self.mode)
+
+
+__all__ = ["MeshPath", "Style", "field_kind"]

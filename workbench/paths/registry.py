@@ -1,0 +1,71 @@
+"""The registry of render paths: every path class by name, and the path a scene is drawn with
+by default.
+
+A class derived from :class:`~workbench.paths.base.RenderPath` that sets ``name`` registers
+itself on definition; :func:`make_path` makes one by name with its style's options.
+"""
+
+from __future__ import annotations
+
+PATHS: dict[str, type] = {}
+
+# the path a scene of each kind is drawn with when none is named
+DEFAULT_PATHS = {"mesh": "gouraud", "spacetime": "spacetime_pixel", "surface": "fe_normal_map"}
+
+
+def register(cls: type) -> None:
+    """Put path class ``cls`` in the registry under ``cls.name``."""
+    PATHS[cls.name] = cls
+
+
+def path_class(name: str) -> type:
+    """The registered path class ``name``; ValueError listing the registry otherwise."""
+    try:
+        return PATHS[name]
+    except KeyError:
+        raise ValueError(f"unknown render path {name!r}; known paths: {sorted(PATHS)}") from None
+
+
+def make_path(name: str, style=None, **options):
+    """A new, unprepared path of registry ``name`` with ``style`` (an instance of the path's
+    ``style_class``) or, instead, ``options`` naming fields of that class; ValueError for an
+    unknown path, or for an option the path does not take (naming it and the known ones)."""
+    cls = path_class(name)
+    if options:
+        if style is not None:
+            raise ValueError("give either a style or options, not both")
+        style = cls.style_class(**check_options(name, options))
+    return cls(style)
+
+
+def path_options(name: str) -> frozenset[str]:
+    """The option names path ``name`` takes: the fields of its ``style_class`` but those the
+    path fixes itself (``fixed_options``, e.g. the shading of a spacetime path)."""
+    cls = path_class(name)
+    return frozenset(cls.style_class.__dataclass_fields__) - cls.fixed_options
+
+
+def check_options(name: str, options: dict) -> dict:
+    """``options`` unchanged when path ``name`` takes every key; ValueError naming the first
+    unknown key and the known ones otherwise."""
+    known = path_options(name)
+    for key in options:
+        if key not in known:
+            raise ValueError(f"path {name!r} takes no option {key!r}; "
+                             f"its options: {', '.join(sorted(known))}")
+    return options
+
+
+def paths_for(kind: str) -> list[str]:
+    """The names of the paths that draw scenes of ``kind`` ("mesh", "spacetime", "surface"),
+    sorted."""
+    return sorted(name for name, cls in PATHS.items() if kind in cls.scene_kinds)
+
+
+def default_path(scene, field: str | None = None) -> str:
+    """The path ``scene`` is drawn with when none is named: for an FE mesh ``gouraud``, or with
+    a ``field`` ``element_color`` (an element field) or ``pixel_color`` (a node field); the
+    per-pixel path for a spacetime scene; the normal-map path for a textured surface."""
+    if scene.kind == "mesh" and field is not None:
+        return "element_color" if field in scene.element_fields else "pixel_color"
+    return DEFAULT_PATHS[scene.kind]
