@@ -411,8 +411,8 @@ def point_sources(point: Point, glsl_dir=None) -> dict[str, str]:
     if point.reference:
         modules.add(PACKAGE / "experiment" / "compare.py")
     if point.simplifier:
-        modules |= {PACKAGE / "algo" / "simplify.py", PACKAGE / "algo" / "hausdorff.py",
-                    PACKAGE / "experiment" / "simplifiers.py"}
+        modules |= {PACKAGE / "algo" / "simplify.py", PACKAGE / "experiment" / "simplifiers.py",
+                    *(PACKAGE / "algo" / "hausdorff").glob("*.py")}
     if point.rasterizer == "software":
         modules |= {PACKAGE / "paths" / "software.py",
                     *(PACKAGE / "algo" / "softraster").glob("*.py")}
