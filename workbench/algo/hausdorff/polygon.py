@@ -5,8 +5,10 @@ convex pieces (the plane-split refinement of :mod:`workbench.algo.hausdorff`).
 faces of its vertices (:func:`_vertex_bound`), then by every face near it (:func:`_gather`,
 :func:`_face_bound`); a piece that neither settles is cut in two by a plane chosen where the
 nearest face changes (:func:`_face_cut`) or across its middle (:func:`_halving_cut`). The
-geometry of pieces and planes is in :mod:`.pieces`. Lengths are in model units; the kernels
-compare squared distances where they can.
+geometry of pieces and planes is in :mod:`.pieces`. The steps of the loop are small kernels
+that numba inlines into it (``inline="always"``): the hot loop compiles to one function, with no
+more calls or allocations per piece than written out in one body. Lengths are in model units;
+the kernels compare squared distances where they can.
 """
 
 from __future__ import annotations
@@ -190,7 +192,7 @@ def _polygon_bounds(tri, start_upper, target, max_splits, eps, best_point, corne
     return np.sqrt(max(lower_sq, 0.0)), np.sqrt(max(upper_sq, lower_sq))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _piece_stack(size):
     """Empty stack of ``size`` pieces for :func:`_polygon_bounds`: (poly (size, _MAX_POLY, 3)
     vertices, count_v vertex counts, depth_v cuts from the triangle, kind how a piece was cut
@@ -208,14 +210,14 @@ def _piece_stack(size):
     return poly, count_v, depth_v, kind, bound, parent_start, parent_n
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _final(level, max_splits, n):
     """Whether a piece of n vertices, ``level`` cuts from its triangle, may not be cut again:
     ``max_splits`` cuts made, or no room for the two vertices a cut can add."""
     return level >= max_splits or n + 2 > _MAX_POLY
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _settled(best_max, piece_lower, target_sq, eps, level, max_splits, n):
     """Whether a piece stops: its squared bound ``best_max`` is <= ``target_sq``, or its bound
     within ``eps`` of its largest vertex distance (squared ``piece_lower``), or it is final
@@ -224,7 +226,7 @@ def _settled(best_max, piece_lower, target_sq, eps, level, max_splits, n):
             or _final(level, max_splits, n))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _vertex_bound(piece, n, best_max, lower_sq, hint, best_point, corners, tree, stack, stack_d,
                   tmp, near, quick):
     """The nearest faces of a piece's n vertices (from the tree): exact distances, and a bound
@@ -265,7 +267,7 @@ def _vertex_bound(piece, n, best_max, lower_sq, hint, best_point, corners, tree,
     return best_max, piece_lower, lower_sq, hint
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _face_bound(piece, n, faces, corners, dist, tmp, best_max, piece_lower, lower_sq, full,
                 best_point):
     """A piece's n vertices against the faces near it: their squared distances into
@@ -304,7 +306,7 @@ def _face_bound(piece, n, faces, corners, dist, tmp, best_max, piece_lower, lowe
     return best_max, piece_lower, lower_sq, best_f, worst_v
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _face_cut(piece, n, faces, best_f, worst_v, dist, parent_cut, rho, corners, point, normal,
               side):
     """A plane across a piece (radius ``rho``) on whose sides one face tends to be nearest:
@@ -312,8 +314,8 @@ def _face_cut(piece, n, faces, best_f, worst_v, dist, parent_cut, rho, corners, 
     of the vertex ``worst_v`` that spoils it, else (unless the piece itself came from such a
     cut, ``parent_cut`` 2) the zero line of ``d(·, best) - d(·, g)``. Writes the plane to
     ``point``/``normal`` and the vertices' signed sides to ``side``; returns (how it was cut:
-    1 bisector, 2 secant, vertices above, vertices below, the vertex to halve the piece from
-    when neither plane separates). Among more than ``_MANY_FACES`` faces no plane is tried
+    0 not, 1 bisector, 2 secant; vertices above; vertices below; the vertex to halve the piece
+    from when neither plane separates). Among more than ``_MANY_FACES`` faces no plane is tried
     and the piece is to be halved across its diameter (cheaper than resolving the conflicts of
     many faces in one piece, whose cost grows with their square).
     """
@@ -339,7 +341,7 @@ def _face_cut(piece, n, faces, best_f, worst_v, dist, parent_cut, rho, corners, 
     return cut, n_pos, n_neg, worst_v
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _halving_cut(piece, n, v, rho, point, normal, side):
     """The plane halfway between vertex v of a piece (radius ``rho``) and its vertex farthest
     from v, across their segment: written to ``point``/``normal``, the vertices' signed sides
