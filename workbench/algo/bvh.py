@@ -16,6 +16,16 @@ each leaf's range of references, the triangle of each reference) and queried by 
 
 Distances are in the units of the vertices. Coordinates far from the origin keep their digits
 best when translated near it first (:func:`workbench.algo.hausdorff.hausdorff` does).
+
+Why a second hierarchy beside :class:`~workbench.algo.hierarchy.ElementHierarchy`: this tree
+serves the certified Hausdorff metric, whose inputs are bare triangle meshes (decimated ones
+with long slivers, no elements or parts), and holds what that hierarchy cannot: split
+references of long triangles, so that a sliver's box does not contain most queries; a hint per
+query (a neighbour's nearest triangle) that prunes from the first box; every triangle within a
+radius, the candidate lists of the certified bounds; and kernels (:func:`nearest_one`,
+:func:`within`) that those bounds call inside their own numba loops. It has no parts to
+exclude, no oriented boxes, no slab test and no test counters: those are crash2000 §4's, in the
+element hierarchy. Measured by benchmarks/bvh_compare.py: see docs/results.md.
 """
 
 from __future__ import annotations

@@ -413,7 +413,8 @@ def point_sources(point: Point, glsl_dir=None) -> dict[str, str]:
         modules.add(PACKAGE / "experiment" / "compare.py")
     if point.simplifier:
         modules |= {*(PACKAGE / "algo" / "simplify").glob("*.py"),
-                    PACKAGE / "algo" / "hausdorff.py", PACKAGE / "experiment" / "simplifiers.py"}
+                    *(PACKAGE / "algo" / "hausdorff").glob("*.py"),
+                    PACKAGE / "experiment" / "simplifiers.py"}
     if point.rasterizer == "software":
         modules |= {PACKAGE / "paths" / "software.py",
                     *(PACKAGE / "algo" / "softraster").glob("*.py")}
