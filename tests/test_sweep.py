@@ -136,7 +136,8 @@ def test_point_key_follows_the_shaders_a_path_loads(tmp_path):
     assert "glsl/vertex_color.vert.glsl" not in point_sources(gouraud)
     assert "workbench/paths/base.py" in point_sources(gouraud)
     # the code that makes the scene is part of the key: the generator, not the readers
-    assert "workbench/scene/generators.py" in point_sources(gouraud)
+    assert "workbench/scene/generators/cylinders.py" in point_sources(gouraud)
+    assert "workbench/scene/generators/__init__.py" in point_sources(gouraud)
     assert "workbench/scene/keyword.py" not in point_sources(gouraud)
 
     shader = glsl / "vertex_color.vert.glsl"

@@ -257,126 +257,228 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
         raise ValueError(f"frame is {frame.size}, size is {(width, height)}")
     color32 = frame.color.view(np.uint32).reshape(height, width)
     stats = RenderStats(triangles=len(tris))
-    kind = shading.kind
-    code = SHADINGS.index(kind)
-    bits = options.subpixel_bits
-    table = None
+    table = _fragment_table(options)
+    stats.table_bytes = table.nbytes
+    look = _Look.of(shading)
+    with _threads(options.threads if vectorized else 1) as threads, \
+            (_interpreted() if not vectorized else _null(_compiled())) as k:
+        stats.threads = threads
+        clock = _Clock(stats.seconds)
+        lit = _transform_and_light(k, pos, tris, view, proj, (width, height), options.subpixel_bits,
+                                   shading, look, normals, values, triangle_values, planes,
+                                   workspace)
+        clock.lap("transform and light")
+        sessions = _Sessions(k, tris, ids, lit, frame, color32, options, table, shading, look,
+                             threads, stats, clock)
+        for k0 in range(0, len(tris), options.session):
+            sessions.draw(k0, min(k0 + options.session, len(tris)))
+    return frame, stats
+
+
+class _Clock:
+    """Adds the seconds since the previous lap (or since it was made) to a step of
+    ``seconds``."""
+
+    def __init__(self, seconds: dict):
+        self.seconds = seconds
+        self.t0 = time.perf_counter()
+
+    def lap(self, step: str) -> None:
+        now = time.perf_counter()
+        self.seconds[step] += now - self.t0
+        self.t0 = now
+
+
+@dataclass(frozen=True)
+class _Table:
+    """The span table's arrays as the kernels take them (``lo``, ``hi`` flattened, ``size``
+    its S; one -1 each and the options' S without the table), ``present`` whether the
+    generator uses it and ``nbytes`` its memory (0 without)."""
+
+    present: bool
+    lo: np.ndarray
+    hi: np.ndarray
+    size: int
+    nbytes: int
+
+
+def _fragment_table(options: RasterOptions) -> _Table:
+    """The span table of ``options`` (:mod:`.spantable`), or the placeholder of the half-space
+    generator."""
     if options.generator == "table":
         from .spantable import span_table
 
         table = span_table(options.table_size)
-        stats.table_bytes = table.nbytes
-        lo_table, hi_table, size_s = table.lo.reshape(-1), table.hi.reshape(-1), table.size
-    else:
-        lo_table = hi_table = np.full(1, -1, np.int8)
-        size_s = options.table_size
-    texels = np.ascontiguousarray(shading.texels if shading.texels is not None
-                                  else np.zeros((1, 4)), np.uint8)
-    texf = texels.astype(np.float32) / np.float32(255.0)
-    base = np.asarray(shading.base_color, np.float32)
-    missing = np.asarray(shading.missing_color, np.float32)
-    seconds = stats.seconds
+        return _Table(True, table.lo.reshape(-1), table.hi.reshape(-1), table.size, table.nbytes)
+    none = np.full(1, -1, np.int8)
+    return _Table(False, none, none, options.table_size, 0)
 
-    def clock(step: str, start: float) -> float:
-        now = time.perf_counter()
-        seconds[step] += now - start
-        return now
 
-    with _threads(options.threads if vectorized else 1) as threads, \
-            (_interpreted() if not vectorized else _null(_compiled())) as k:
-        stats.threads = threads
-        t0 = time.perf_counter()
-        # ---- transform and light (all vertices once)
-        rel32 = pos if pos.dtype == np.float32 else pos.astype(np.float32)
-        mvp32 = (proj @ view).astype(np.float32)
-        n_v = len(pos)
-        lend = _lender(workspace)
-        fx, fy = lend("fx", n_v, np.int64), lend("fy", n_v, np.int64)
-        fz, ok = lend("fz", n_v, np.float32), lend("ok", n_v, bool)
-        k.transform(rel32, mvp32, width, height, bits, fx, fy, fz, ok)
-        n_attr = _ATTRS[kind]
-        attr = lend("attr", (n_v, n_attr), np.float32)
-        scale, offset = (np.float32(v) for v in shading.coord)
-        if kind in ("gouraud", "vertex_color", "pixel_color"):
-            s = np.zeros(n_v, np.float32)
-            if values is not None:
-                t = np.asarray(values, np.float64)
-                s = t.astype(np.float32) * scale + offset
-                s[~np.isfinite(t)] = np.float32(-1e30)
-            normals32 = np.asarray(normals)
-            if normals32.dtype != np.float32:
-                normals32 = normals32.astype(np.float32)
-            k.light_vertices(code, np.ascontiguousarray(view[:3, :3], np.float32), normals32,
-                             s, texels, texf, shading.linear, missing, attr)
-        tri_light = np.zeros(len(tris) if kind in ("flat", "element_color") else 1, np.float32)
-        if kind in ("flat", "element_color"):
-            k.light_triangles(rel32, tris, view.astype(np.float32), fx, fy, bits, tri_light)
-        tri_s = np.zeros(1, np.float32)
-        if kind == "element_color":
-            tv = np.asarray(triangle_values, np.float64)
-            tri_s = tv.astype(np.float32) * scale + offset
-            tri_s[~np.isfinite(tv)] = np.float32(-1e30)
-        clipd = np.zeros((n_v, len(planes)), np.float32)
-        if len(planes):
-            p32, w32 = planes[:, :3].astype(np.float32), planes[:, 3].astype(np.float32)
-            clipd = np.ascontiguousarray((rel32 @ p32.T) + w32, np.float32)
-        t0 = clock("transform and light", t0)
+@dataclass(frozen=True)
+class _Look:
+    """The shading as the kernels take it: ``code`` (index in :data:`SHADINGS`), ``texels``
+    (n, 4) uint8 and ``texf`` the same in [0, 1] float32 (one zero texel without a texture),
+    ``base`` and ``missing`` colours float32."""
 
+    code: int
+    texels: np.ndarray
+    texf: np.ndarray
+    base: np.ndarray
+    missing: np.ndarray
+
+    @classmethod
+    def of(cls, shading: Shading) -> _Look:
+        texels = np.ascontiguousarray(shading.texels if shading.texels is not None
+                                      else np.zeros((1, 4)), np.uint8)
+        return cls(code=SHADINGS.index(shading.kind), texels=texels,
+                   texf=texels.astype(np.float32) / np.float32(255.0),
+                   base=np.asarray(shading.base_color, np.float32),
+                   missing=np.asarray(shading.missing_color, np.float32))
+
+
+@dataclass(frozen=True)
+class _Lit:
+    """The transform-and-light step's output. Per vertex: window positions ``fx``, ``fy``
+    (fixed point) and depth ``fz``, ``ok`` (placed), ``attr`` (V, n_attr) the shading
+    attributes, ``clipd`` (V, P) the clip distances. Per triangle where the shading uses them
+    (else one entry): ``tri_light`` the flat light, ``tri_s`` the texture coordinate."""
+
+    fx: np.ndarray
+    fy: np.ndarray
+    fz: np.ndarray
+    ok: np.ndarray
+    attr: np.ndarray
+    n_attr: int
+    clipd: np.ndarray
+    tri_light: np.ndarray
+    tri_s: np.ndarray
+
+
+def _transform_and_light(k, pos, tris, view, proj, size, bits: int, shading: Shading,
+                         look: _Look, normals, values, triangle_values, planes,
+                         workspace) -> _Lit:
+    """The first step, all vertices once: float32 placement and snapping, per-vertex or flat
+    lighting and colour look-up, the clip distances (see :func:`render` for the arguments)."""
+    width, height = size
+    kind, code = shading.kind, look.code
+    rel32 = pos if pos.dtype == np.float32 else pos.astype(np.float32)
+    mvp32 = (proj @ view).astype(np.float32)
+    n_v = len(pos)
+    lend = _lender(workspace)
+    fx, fy = lend("fx", n_v, np.int64), lend("fy", n_v, np.int64)
+    fz, ok = lend("fz", n_v, np.float32), lend("ok", n_v, bool)
+    k.transform(rel32, mvp32, width, height, bits, fx, fy, fz, ok)
+    n_attr = _ATTRS[kind]
+    attr = lend("attr", (n_v, n_attr), np.float32)
+    scale, offset = (np.float32(v) for v in shading.coord)
+    if kind in ("gouraud", "vertex_color", "pixel_color"):
+        s = np.zeros(n_v, np.float32)
+        if values is not None:
+            t = np.asarray(values, np.float64)
+            s = t.astype(np.float32) * scale + offset
+            s[~np.isfinite(t)] = np.float32(-1e30)
+        normals32 = np.asarray(normals)
+        if normals32.dtype != np.float32:
+            normals32 = normals32.astype(np.float32)
+        k.light_vertices(code, np.ascontiguousarray(view[:3, :3], np.float32), normals32,
+                         s, look.texels, look.texf, shading.linear, look.missing, attr)
+    tri_light = np.zeros(len(tris) if kind in ("flat", "element_color") else 1, np.float32)
+    if kind in ("flat", "element_color"):
+        k.light_triangles(rel32, tris, view.astype(np.float32), fx, fy, bits, tri_light)
+    tri_s = np.zeros(1, np.float32)
+    if kind == "element_color":
+        tv = np.asarray(triangle_values, np.float64)
+        tri_s = tv.astype(np.float32) * scale + offset
+        tri_s[~np.isfinite(tv)] = np.float32(-1e30)
+    clipd = np.zeros((n_v, len(planes)), np.float32)
+    if len(planes):
+        p32, w32 = planes[:, :3].astype(np.float32), planes[:, 3].astype(np.float32)
+        clipd = np.ascontiguousarray((rel32 @ p32.T) + w32, np.float32)
+    return _Lit(fx=fx, fy=fy, fz=fz, ok=ok, attr=attr, n_attr=n_attr, clipd=clipd,
+                tri_light=tri_light, tri_s=tri_s)
+
+
+@dataclass
+class _Sessions:
+    """The steps after transform and light, run on one session of triangles at a time into
+    ``frame`` (``color32`` its colour as one uint32 per pixel), with the kernels ``k``; counts
+    and seconds go to ``stats`` and ``clock``."""
+
+    k: SimpleNamespace
+    tris: np.ndarray
+    ids: np.ndarray
+    lit: _Lit
+    frame: Frame
+    color32: np.ndarray
+    options: RasterOptions
+    table: _Table
+    shading: Shading
+    look: _Look
+    threads: int
+    stats: RenderStats
+    clock: _Clock
+
+    def draw(self, k0: int, k1: int) -> None:
+        """Draw triangles ``k0`` .. ``k1 - 1``."""
+        k, tris, lit, frame, options, table = (self.k, self.tris, self.lit, self.frame,
+                                               self.options, self.table)
+        stats, clock, look, shading = self.stats, self.clock, self.look, self.shading
+        width, height = frame.size
+        bits = options.subpixel_bits
+        n_attr = lit.n_attr
         shift = options.tile.bit_length() - 1
         tiles_x = -(-width // options.tile)
         n_tiles = tiles_x * (-(-height // options.tile))
-        for k0 in range(0, len(tris), options.session):
-            k1 = min(k0 + options.session, len(tris))
-            stats.sessions += 1
-            keep = np.empty(k1 - k0, bool)
-            k.clip_triangles(tris, k0, fx, fy, fz, ok, clipd, width, height, bits, keep)
-            kept = np.flatnonzero(keep) + k0
-            n = len(kept)
-            stats.kept += n
-            t0 = clock("clip triangle", t0)
-            if n == 0:
-                continue
-            zplane = np.empty((n, 1, 3))
-            k.depth_gradient(kept, tris, fx, fy, fz, bits, zplane)
-            t0 = clock("depth gradient", t0)
-            planes_m = np.empty((n, n_attr + len(planes), 3))
-            k.scalar_gradient(kept, tris, fx, fy, bits, attr, clipd, planes_m)
-            t0 = clock("scalar gradient", t0)
-            verts = np.empty((n, 6), np.int64)
-            box = np.empty((n, 4), np.int32)
-            k.range_and_tc(kept, tris, fx, fy, width, height, bits, verts, box)
-            t0 = clock("range and TC", t0)
-            fit = np.zeros(n, bool)
-            if table is not None:
-                k.collect_table_fit(verts, size_s, fit)
-                stats.table_fit += int(fit.sum())
-            t0 = clock("collect table-fit", t0)
-            start, members, frag_start = k.bin_triangles(box, shift, tiles_x, n_tiles, threads)
-            slots = int(frag_start[-1])
-            frag_tri = np.empty(slots, np.int32)
-            frag_i, frag_j = np.empty(slots, np.int32), np.empty(slots, np.int32)
-            frag_count = np.zeros(n_tiles, np.int64)
-            t0 = clock("bin", t0)
-            k.generate_fragments(start, members, frag_start, verts, box, fit, lo_table,
-                                 hi_table, size_s, options.tile, tiles_x, bits,
-                                 options.early_depth, zplane, frame.depth, frag_tri, frag_i,
-                                 frag_j, frag_count)
-            stats.fragments += int(frag_count.sum())
-            t0 = clock("generate fragment", t0)
-            frag_z = np.empty(slots, np.float32)
-            k.interpolate_z(frag_start, frag_count, frag_tri, frag_i, frag_j, zplane, planes_m,
-                            n_attr, frag_z)
-            t0 = clock("interpolate z", t0)
-            frag_rgba = np.empty(slots, np.uint32)
-            k.interpolate_color(code, frag_start, frag_count, frag_tri, frag_i, frag_j,
-                                planes_m, kept, tri_light, tri_s, base, missing, texels, texf,
-                                shading.linear, shading.alpha_test, frag_z, frag_rgba)
-            t0 = clock("interpolate color", t0)
-            k.write_fragments(frag_start, frag_count, frag_tri, frag_i, frag_j, frag_z,
-                              frag_rgba, kept, ids, frame.depth, color32, frame.triangle)
-            t0 = clock("write fragment", t0)
-            stats.fragment_bytes = max(stats.fragment_bytes, slots * 20)
-    return frame, stats
+        stats.sessions += 1
+        keep = np.empty(k1 - k0, bool)
+        k.clip_triangles(tris, k0, lit.fx, lit.fy, lit.fz, lit.ok, lit.clipd, width, height,
+                         bits, keep)
+        kept = np.flatnonzero(keep) + k0
+        n = len(kept)
+        stats.kept += n
+        clock.lap("clip triangle")
+        if n == 0:
+            return
+        zplane = np.empty((n, 1, 3))
+        k.depth_gradient(kept, tris, lit.fx, lit.fy, lit.fz, bits, zplane)
+        clock.lap("depth gradient")
+        planes_m = np.empty((n, n_attr + lit.clipd.shape[1], 3))
+        k.scalar_gradient(kept, tris, lit.fx, lit.fy, bits, lit.attr, lit.clipd, planes_m)
+        clock.lap("scalar gradient")
+        verts = np.empty((n, 6), np.int64)
+        box = np.empty((n, 4), np.int32)
+        k.range_and_tc(kept, tris, lit.fx, lit.fy, width, height, bits, verts, box)
+        clock.lap("range and TC")
+        fit = np.zeros(n, bool)
+        if table.present:
+            k.collect_table_fit(verts, table.size, fit)
+            stats.table_fit += int(fit.sum())
+        clock.lap("collect table-fit")
+        start, members, frag_start = k.bin_triangles(box, shift, tiles_x, n_tiles, self.threads)
+        slots = int(frag_start[-1])
+        frag_tri = np.empty(slots, np.int32)
+        frag_i, frag_j = np.empty(slots, np.int32), np.empty(slots, np.int32)
+        frag_count = np.zeros(n_tiles, np.int64)
+        clock.lap("bin")
+        k.generate_fragments(start, members, frag_start, verts, box, fit, table.lo, table.hi,
+                             table.size, options.tile, tiles_x, bits, options.early_depth,
+                             zplane, frame.depth, frag_tri, frag_i, frag_j, frag_count)
+        stats.fragments += int(frag_count.sum())
+        clock.lap("generate fragment")
+        frag_z = np.empty(slots, np.float32)
+        k.interpolate_z(frag_start, frag_count, frag_tri, frag_i, frag_j, zplane, planes_m,
+                        n_attr, frag_z)
+        clock.lap("interpolate z")
+        frag_rgba = np.empty(slots, np.uint32)
+        k.interpolate_color(look.code, frag_start, frag_count, frag_tri, frag_i, frag_j,
+                            planes_m, kept, lit.tri_light, lit.tri_s, look.base, look.missing,
+                            look.texels, look.texf, shading.linear, shading.alpha_test, frag_z,
+                            frag_rgba)
+        clock.lap("interpolate color")
+        k.write_fragments(frag_start, frag_count, frag_tri, frag_i, frag_j, frag_z, frag_rgba,
+                          kept, self.ids, frame.depth, self.color32, frame.triangle)
+        clock.lap("write fragment")
+        stats.fragment_bytes = max(stats.fragment_bytes, slots * 20)
 
 
 @contextmanager
