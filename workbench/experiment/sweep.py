@@ -433,8 +433,7 @@ def _scene_modules(spec: str) -> set[Path]:
         return modules | {scene / "spacetime.py", *(PACKAGE / "algo" / "spacetime").glob("*.py")}
     if name in ("semicylinders", "panels") and not Path(spec).is_file():
         return modules | {scene / "generators.py"}
-    return modules | {scene / n for n in ("io.py", "parse.py", "keyword.py", "d3plot.py",
-                                          "solids.py")}
+    return modules | {*(scene / "readers").glob("*.py"), scene / "solids.py"}
 
 
 def scene_digest(spec: str) -> str | None:

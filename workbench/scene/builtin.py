@@ -21,7 +21,7 @@ SIZED = ("semicylinders", "panels", "spacetime:radial", "spacetime:bar")  # take
 def builtin_scene(name: str, quick: bool = False, size: int | None = None):
     """The built-in scene ``name`` (see the module docstring), ``size`` its size parameter
     where it takes one; FileNotFoundError if its data is absent."""
-    from . import generators, io
+    from . import generators, readers
 
     if name.startswith("spacetime:"):
         from .spacetime import spacetime_scene
@@ -36,7 +36,7 @@ def builtin_scene(name: str, quick: bool = False, size: int | None = None):
                 f"built-in scene {name!r} needs the shared data folder (set WORKBENCH_DATA to the folder "
                 f"holding {CAR_DECK if name == 'car' else D3PLOT})"
             )
-        return io.load(path)
+        return readers.load(path)
     if name == "semicylinders":
         return generators.semicylinders(n=size or (64 if quick else 250))
     if name == "panels":
@@ -66,11 +66,11 @@ def parse_scene_spec(spec: str) -> tuple[str, int | None] | None:
 
 def load_scene(spec: str, quick: bool = False, all_faces: bool = False):
     """A built-in scene by name (see :func:`parse_scene_spec`), else a mesh file read by
-    :func:`workbench.scene.io.load` (``all_faces``: every face of its solids, not only their
+    :func:`workbench.scene.load` (``all_faces``: every face of its solids, not only their
     boundary); an existing file wins over a built-in name."""
     parsed = parse_scene_spec(spec)
     if parsed is not None and not Path(spec).exists():
         return builtin_scene(parsed[0], quick, parsed[1])
-    from .io import load
+    from .readers import load
 
     return load(spec, all_faces=all_faces)

@@ -30,8 +30,8 @@ count). Shells of rigid parts carry no stress, strain or thickness in a d3plot; 
 are NaN. Beams, solids and thick shells are not read. Part ids are the user part ids, names
 come from the part titles.
 
-Refused with :class:`~workbench.scene.parse.ParseError`: a file lasso-python cannot read, or one
-without shell elements.
+Refused with :class:`~workbench.scene.readers.errors.ParseError`: a file lasso-python cannot
+read, or one without shell or solid elements.
 """
 
 from __future__ import annotations
@@ -43,8 +43,8 @@ from warnings import warn as _warn
 
 import numpy as np
 
-from .mesh import FEMesh
-from .parse import ParseError, ParseWarning, build_mesh
+from ..mesh import FEMesh
+from .errors import ParseError, ParseWarning, build_mesh
 
 RIGID_MATERIAL_TYPE = 20
 STRESS_COMPONENTS = ("xx", "yy", "zz", "xy", "yz", "zx")  # d3plot (and lasso-python) order
@@ -149,7 +149,7 @@ def read_d3plot(path, units: str = "mm", all_faces: bool = False,
     element_ids = None if element_ids is None else np.asarray(element_ids, dtype=np.int64)
     face_of = np.zeros(0, np.int64)
     if len(solids):  # drawn by their boundary faces (every face with all_faces)
-        from .solids import boundary_surface
+        from ..solids import boundary_surface
 
         solid_part_index = np.asarray(need(ArrayType.element_solid_part_indexes), np.int64)
         try:
