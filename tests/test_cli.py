@@ -185,7 +185,7 @@ def test_simplify_writes_a_surface_within_the_tolerance(tmp_path, capsys):
     import trimesh
 
     from workbench.algo.hausdorff import hausdorff
-    from workbench.scene.io import load
+    from workbench.scene.readers import load
 
     original = load(deck)
     simplified = trimesh.load(out, process=False)

@@ -350,7 +350,7 @@ def test_car_deck():
     path = data.shared_file(data.CAR_DECK)
     if path is None:
         pytest.skip("shared car deck (lsopt_car6/car6_crash_v3.k) not available")
-    from workbench.scene.io import load
+    from workbench.scene.readers import load
     mesh = load(path)
     fe = feature_edges(mesh.elements, mesh.nodes)
     counts = fe.counts()

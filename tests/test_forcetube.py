@@ -316,7 +316,7 @@ def write_stress_d3plot(folder):
 
 
 def test_d3plot_stress_components_are_the_layer_mean_in_d3plot_order(tmp_path):
-    from workbench.scene.d3plot import read_d3plot
+    from workbench.scene.readers.d3plot import read_d3plot
 
     mesh = read_d3plot(write_stress_d3plot(tmp_path))
     values = {name: mesh.element_fields[name][:, 0] for name in STRESS_FIELDS}
@@ -333,7 +333,7 @@ def test_shared_d3plot_stresses_and_a_section():
     path = shared_file(D3PLOT)
     if path is None:
         pytest.skip(f"shared data {D3PLOT} not available (set WORKBENCH_DATA)")
-    from workbench.scene.io import load
+    from workbench.scene.readers import load
 
     mesh = load(path)
     for name in (*STRESS_FIELDS, "thickness"):

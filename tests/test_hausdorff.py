@@ -317,7 +317,7 @@ def car_pair():
     if path is None:
         pytest.skip("the shared car deck (lsopt_car6) is not available")
     pymeshlab = pytest.importorskip("pymeshlab")
-    from workbench.scene.io import load
+    from workbench.scene.readers import load
 
     car = load(path)
     used, inverse = np.unique(car.triangles, return_inverse=True)

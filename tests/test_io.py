@@ -8,9 +8,14 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from workbench.data import CAR_DECK, D3PLOT, shared_file
-from workbench.scene.d3plot import mid_surface, von_mises
-from workbench.scene.io import MESHIO_SUFFIXES, ParseError, detect_format, load
-from workbench.scene.parse import ParseWarning
+from workbench.scene.readers import (
+    MESHIO_SUFFIXES,
+    ParseError,
+    ParseWarning,
+    detect_format,
+    load,
+)
+from workbench.scene.readers.d3plot import mid_surface, von_mises
 
 
 # --------------------------------------------------------------------------- writing small decks
@@ -661,7 +666,7 @@ def test_underscores_in_numbers_are_refused(tmp_path, card, line):
 
 @given(st.integers(-2**40, 2**40), st.sampled_from(["{:d}", "{:.1f}", "{:.15E}", "{:.0f}.", "{:+.2f}"]))
 def test_integer_field_parser_takes_integral_values_in_any_notation(value, form):
-    from workbench.scene.keyword import _convert
+    from workbench.scene.readers.cards import _convert
 
     text = form.format(value).encode()
     assert _convert(text, "i") == value
@@ -670,7 +675,7 @@ def test_integer_field_parser_takes_integral_values_in_any_notation(value, form)
 @given(st.floats(allow_nan=True, allow_infinity=True).filter(
     lambda x: not (np.isfinite(x) and x == np.floor(x))))
 def test_integer_field_parser_refuses_fractional_and_non_finite(value):
-    from workbench.scene.keyword import _convert
+    from workbench.scene.readers.cards import _convert
 
     with pytest.raises(ValueError):
         _convert(repr(value).encode(), "i")

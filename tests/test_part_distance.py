@@ -201,7 +201,7 @@ def car():
     path = data.shared_file(data.CAR_DECK)
     if path is None:
         pytest.skip("the shared car deck (lsopt_car6) is not available")
-    from workbench.scene.io import load
+    from workbench.scene.readers import load
 
     mesh = load(path)
     return mesh, brute_force_part_distances(mesh, 1.5)

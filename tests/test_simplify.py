@@ -394,7 +394,7 @@ def test_car_parts_within_tolerance():
     path = workbench.data.shared_file(workbench.data.CAR_DECK)
     if path is None:
         pytest.skip("shared LS-DYNA car deck not available")
-    from workbench.scene.io import load
+    from workbench.scene.readers import load
 
     mesh = load(path)
     v, t = mesh.nodes, mesh.triangles

@@ -205,7 +205,7 @@ def car():
     path = workbench.data.shared_file(workbench.data.CAR_DECK)
     if path is None:
         pytest.skip("shared LS-DYNA car deck not available (set WORKBENCH_DATA)")
-    from workbench.scene.io import load
+    from workbench.scene.readers import load
 
     mesh = load(path)
     return mesh.nodes, mesh.triangles.astype(np.int64), mesh.parts[mesh.triangulation.element_of]

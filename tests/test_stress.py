@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from workbench.data import D3PLOT, shared_file
-from workbench.scene.keyword import read_keyword
-from workbench.scene.parse import ParseError
+from workbench.scene.readers import ParseError
+from workbench.scene.readers.keyword import read_keyword
 from workbench.stress import (
     BENIGN,
     BOM,
@@ -105,7 +105,7 @@ def test_a_read_past_the_time_limit_is_a_hang(tmp_path):
 
 
 def test_other_exception_types_are_reported(tmp_path, monkeypatch):
-    from workbench.scene import keyword
+    from workbench.scene.readers import keyword
 
     def broken(path):
         raise RuntimeError("boom")
@@ -169,8 +169,8 @@ def test_damaged_d3plots_are_read_or_refused_never_anything_else():
 @pytest.mark.skipif(shared_file(D3PLOT) is None, reason="shared d3plot absent (set WORKBENCH_DATA)")
 def test_regression_garbled_part_index_is_a_parse_error(tmp_path):
     """Damage 175 of seed 0 garbles a shell part index to -1.6e9: once an IndexError."""
-    from workbench.scene.d3plot import read_d3plot
-    from workbench.scene.parse import ParseError
+    from workbench.scene.readers import ParseError
+    from workbench.scene.readers.d3plot import read_d3plot
     from workbench.stress import damaged_d3plot
 
     kind, data = damaged_d3plot(shared_file(D3PLOT).read_bytes(), 175, 0)
@@ -185,7 +185,7 @@ def test_regression_lasso_message_that_does_not_format():
     """lasso-python once logged a '%d' message with a string argument: reporting it raised."""
     import logging
 
-    from workbench.scene.d3plot import _LassoWarnings
+    from workbench.scene.readers.d3plot import _LassoWarnings
 
     handler = _LassoWarnings()
     handler.emit(logging.LogRecord("lasso", logging.WARNING, "x", 1, "part %d is broken",

@@ -560,7 +560,7 @@ def test_car_deck():
     path = shared_file(CAR_DECK)
     if path is None:
         pytest.skip(f"shared data {CAR_DECK} not available")
-    from workbench.scene.io import load
+    from workbench.scene.readers import load
 
     elements = load(path).elements
     result = quad_strips(elements, cutoff=1)

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+import workbench.scene.readers as scene_readers
 from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.sweep import (glsl_folder, grid_points, load_config, point_key,
                                         point_sources, run_sweep, stable_row)
@@ -138,7 +139,12 @@ def test_point_key_follows_the_shaders_a_path_loads(tmp_path):
     # the code that makes the scene is part of the key: the generator, not the readers
     assert "workbench/scene/generators/cylinders.py" in point_sources(gouraud)
     assert "workbench/scene/generators/__init__.py" in point_sources(gouraud)
-    assert "workbench/scene/keyword.py" not in point_sources(gouraud)
+    readers = {f"workbench/scene/readers/{p.name}"
+               for p in Path(scene_readers.__file__).parent.glob("*.py")}
+    assert {"workbench/scene/readers/keyword.py", "workbench/scene/readers/cards.py"} <= readers
+    assert not readers & set(point_sources(gouraud))
+    deck = Point(index=0, scene=str(tmp_path / "plate.k"), path="gouraud", options={})
+    assert readers | {"workbench/scene/solids.py"} <= set(point_sources(deck))
 
     shader = glsl / "vertex_color.vert.glsl"
     shader.write_text(shader.read_text() + "\n// changed\n")

@@ -421,7 +421,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     from .gl.context import GLUnavailable
     from .scene.mesh import MeshError
-    from .scene.parse import ParseWarning
+    from .scene.readers import ParseWarning
 
     warnings.simplefilter("always", ParseWarning)  # every missing value, not the first only
     warnings.showwarning = _show_warning

@@ -4,11 +4,11 @@
 Keyword decks (the shared car deck when present, and small generated decks in fixed and
 comma format, with ``*ELEMENT_SHELL_THICKNESS``, ``*PART`` and ``*SECTION_SHELL``) are
 mutated at random, deterministically from the seed, and read back with
-:func:`workbench.scene.keyword.read_keyword` under a time limit.
+:func:`workbench.scene.readers.keyword.read_keyword` under a time limit.
 
 * A benign mutation (CRLF line ends, ``$`` comment lines, lower-case keywords, a UTF-8 byte
   order mark) must read the identical mesh: nodes, elements, parts, node and element ids.
-* Any other mutation must either be refused with :class:`~workbench.scene.parse.ParseError`
+* Any other mutation must either be refused with :class:`~workbench.scene.readers.ParseError`
   or read a consistent mesh: finite coordinates, node and element counts equal to the
   well-formed node and element cards that a strict, independent decoding of the mutated text
   finds, and node and element ids all among those cards' ids. A read that differs is a
@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .scene.parse import ParseError
+from .scene.readers import ParseError
 
 BENIGN = ("crlf", "comments", "lowercase", "bom")
 HARMFUL = ("delete", "duplicate", "swap", "garble", "huge", "nonfinite", "truncate_card",
@@ -403,7 +403,7 @@ def _read(path: Path, timeout: float, reader=None):
     """(mesh or None, outcome, message) of one read of ``path`` by ``reader`` (default the
     keyword reader) under a ``timeout`` (seconds; enforced with SIGALRM where this runs in the
     main thread of a POSIX process)."""
-    from .scene.keyword import read_keyword
+    from .scene.readers.keyword import read_keyword
 
     reader = reader or read_keyword
     timed = hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
@@ -526,7 +526,7 @@ def run_reader_stress(n: int, seed: int, decks=None, timeout: float = TIMEOUT_S)
 
     ``decks`` maps names to deck texts (bytes) or paths; by default :func:`default_decks`.
     """
-    from .scene.keyword import read_keyword
+    from .scene.readers.keyword import read_keyword
 
     decks = {name: Path(d).read_bytes() if isinstance(d, (str, Path)) else bytes(d)
              for name, d in (decks or default_decks()).items()}
@@ -606,7 +606,7 @@ def run_d3plot_stress(n: int, seed: int, source=None,
     shared d3plot; None when it is absent): each must be read or refused with ParseError,
     never another exception, never past ``timeout`` seconds."""
     from .data import D3PLOT, shared_file
-    from .scene.d3plot import read_d3plot
+    from .scene.readers.d3plot import read_d3plot
 
     source = shared_file(D3PLOT) if source is None else Path(source)
     if source is None:

@@ -435,8 +435,7 @@ def _scene_modules(spec: str) -> set[Path]:
         return modules | set((PACKAGE / "algo" / "spacetime").glob("*.py"))
     if name in ("semicylinders", "panels") and not Path(spec).is_file():
         return modules | {*(scene / "generators").glob("*.py")}
-    return modules | {scene / n for n in ("io.py", "parse.py", "keyword.py", "d3plot.py",
-                                          "solids.py")}
+    return modules | {*(scene / "readers").glob("*.py"), scene / "solids.py"}
 
 
 def scene_digest(spec: str) -> str | None:

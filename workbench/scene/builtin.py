@@ -114,7 +114,7 @@ def load_scene(spec: str, quick: bool = False, all_faces: bool = False):
         parsed = parse_scene_spec(spec)
         if parsed is not None:
             return builtin_scene(parsed[0], quick, parsed[1])
-    from .io import load
+    from .readers import load
 
     return load(spec, all_faces=all_faces)
 
@@ -144,7 +144,7 @@ def _shared_mesh(name: str, relative: Path):
     if path is None:
         raise FileNotFoundError(f"built-in scene {name!r} needs the shared data folder (set "
                                 f"WORKBENCH_DATA to the folder holding {relative})")
-    from .io import load
+    from .readers import load
 
     return load(path)
 

@@ -1,16 +1,17 @@
 """What every mesh reader shares: the :class:`ParseError` refusal, the :class:`ParseWarning`
 for what a reader reads as missing, and :func:`build_mesh`.
 
-The readers (:mod:`workbench.scene.keyword`, :mod:`workbench.scene.d3plot` and the meshio and
-trimesh readers in :mod:`workbench.scene.io`) import from here, and :mod:`workbench.scene.io`
-imports the readers, so that no reader depends on the module that dispatches to it.
+The readers (:mod:`~workbench.scene.readers.keyword` and its modules,
+:mod:`~workbench.scene.readers.d3plot` and :mod:`~workbench.scene.readers.meshio_trimesh`)
+import from here, and the package (:func:`workbench.scene.readers.load`) imports the readers,
+so that no reader depends on the module that dispatches to it.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from .mesh import FEMesh, MeshError
+from ..mesh import FEMesh, MeshError
 
 
 class ParseError(ValueError):
@@ -56,7 +57,8 @@ class ParseWarning(UserWarning):
 
 
 def build_mesh(path, **kwargs) -> FEMesh:
-    """``FEMesh(**kwargs)`` with a refusal of the model reported as :class:`ParseError` on ``path``."""
+    """``FEMesh(**kwargs)``, with a refusal of the model reported as :class:`ParseError` on
+    ``path``."""
     try:
         return FEMesh(**kwargs)
     except MeshError as exc:

@@ -30,21 +30,22 @@ count). Shells of rigid parts carry no stress, strain or thickness in a d3plot; 
 are NaN. Beams, solids and thick shells are not read. Part ids are the user part ids, names
 come from the part titles.
 
-Refused with :class:`~workbench.scene.parse.ParseError`: a file lasso-python cannot read, or one
-without shell elements.
+Refused with :class:`~workbench.scene.readers.errors.ParseError`: a file lasso-python cannot
+read, or one without shell or solid elements.
 """
 
 from __future__ import annotations
 
 import logging
 import re
+from dataclasses import dataclass
 from pathlib import Path
 from warnings import warn as _warn
 
 import numpy as np
 
-from .mesh import FEMesh
-from .parse import ParseError, ParseWarning, build_mesh
+from ..mesh import FEMesh
+from .errors import ParseError, ParseWarning, build_mesh
 
 RIGID_MATERIAL_TYPE = 20
 STRESS_COMPONENTS = ("xx", "yy", "zz", "xy", "yz", "zx")  # d3plot (and lasso-python) order
@@ -108,12 +109,50 @@ def read_d3plot(path, units: str = "mm", all_faces: bool = False,
     keeping its solid's id and part; the shell fields are NaN on them. ``stress_components``
     reads the six mid-surface stress components as element fields.
     """
-    from lasso.dyna import ArrayType, D3plot
+    from lasso.dyna import ArrayType
 
-    path = Path(path)
+    path = _first_member(Path(path))
+    arrays, warnings = _lasso_arrays(path)
+    elements = _elements(path, arrays, ArrayType, warnings, all_faces)
+    parts, part_names = _parts(path, arrays, ArrayType, warnings, elements.part_index)
+    steps = times = None
+    if ArrayType.node_displacement in arrays and len(arrays[ArrayType.node_displacement]):
+        steps = np.asarray(arrays[ArrayType.node_displacement], dtype=np.float64)
+        times = np.asarray(arrays.get(ArrayType.global_timesteps, np.arange(len(steps))),
+                           dtype=np.float64)
+    n_states = 0 if steps is None else len(steps)
+    fields = {}
+    if n_states:
+        fields = _shell_fields(arrays, ArrayType, elements, n_states, stress_components)
+        if elements.n_solids:
+            _solid_fields(fields, arrays, ArrayType, elements.face_of, elements.n_shells,
+                          n_states)
+
+    node_ids = arrays.get(ArrayType.node_ids)
+    mesh = build_mesh(
+        path, nodes=elements.nodes, elements=elements.connectivity, parts=parts,
+        steps=steps, times=times, element_fields=fields, part_names=part_names,
+        node_ids=None if node_ids is None else np.asarray(node_ids, dtype=np.int64),
+        element_ids=elements.element_ids, name=path.name, units=units)
+    for failure in warnings.failures:  # read, but with sections missing: say which
+        _warn(ParseWarning(path, f"lasso-python could not read {failure}: what it holds is "
+                                 f"missing"), stacklevel=2)
+    return mesh
+
+
+def _first_member(path: Path) -> Path:
+    """The first file of the d3plot family ``path`` belongs to: ``d3plot`` for ``d3plot01``
+    when it lies beside it, else ``path`` itself."""
     member = re.fullmatch(r"(d3plot.*?)(\d{2,})", path.name, flags=re.IGNORECASE)
     if member and (path.parent / member.group(1)).is_file():
-        path = path.parent / member.group(1)
+        return path.parent / member.group(1)
+    return path
+
+
+def _lasso_arrays(path: Path):
+    """(lasso-python's arrays of the d3plot family at ``path``, the warnings it logged while
+    reading); ParseError when it cannot read the file at all."""
+    from lasso.dyna import D3plot
 
     warnings = _LassoWarnings()
     logger = logging.getLogger("lasso")
@@ -127,14 +166,35 @@ def read_d3plot(path, units: str = "mm", all_faces: bool = False,
     finally:
         logger.removeHandler(warnings)
         logger.propagate = propagate
-    arrays = plot.arrays
+    return plot.arrays, warnings
 
-    def need(key):
-        if key not in arrays:
-            raise ParseError(path, f"no {key} in the d3plot" + warnings.summary())
-        return arrays[key]
 
-    nodes = np.asarray(need(ArrayType.node_coordinates), dtype=np.float64)
+def _need(path: Path, arrays, key, warnings: _LassoWarnings):
+    """``arrays[key]``; ParseError naming what is missing (and what lasso-python gave up on)."""
+    if key not in arrays:
+        raise ParseError(path, f"no {key} in the d3plot" + warnings.summary())
+    return arrays[key]
+
+
+@dataclass
+class _Elements:
+    """What is drawn of a d3plot: the shells, then the faces of its solids."""
+
+    nodes: np.ndarray  # (N, 3) initial coordinates
+    connectivity: np.ndarray  # (M, 4) node indices: shells, then solid faces
+    part_index: np.ndarray  # (M,) internal part index of each
+    element_ids: np.ndarray | None  # (M,) user ids (a face: its solid's), None when unknown
+    face_of: np.ndarray  # (M - n_shells,) the solid of each face
+    n_shells: int
+    n_solids: int
+
+
+def _elements(path: Path, arrays, ArrayType, warnings: _LassoWarnings,
+              all_faces: bool) -> _Elements:
+    """The shells and solid faces of the d3plot (every face of the solids with ``all_faces``);
+    ParseError for a file without either, or missing part indexes."""
+    nodes = np.asarray(_need(path, arrays, ArrayType.node_coordinates, warnings),
+                       dtype=np.float64)
     connectivity = np.asarray(arrays.get(ArrayType.element_shell_node_indexes, np.zeros((0, 4))),
                               dtype=np.int64)
     solids = np.asarray(arrays.get(ArrayType.element_solid_node_indexes, np.zeros((0, 8))),
@@ -143,15 +203,16 @@ def read_d3plot(path, units: str = "mm", all_faces: bool = False,
         raise ParseError(path, "no shell or solid elements in the d3plot (beams and thick "
                                "shells are not read)" + warnings.summary())
     n_shells = len(connectivity)
-    part_index = np.asarray(need(ArrayType.element_shell_part_indexes) if n_shells
-                            else np.zeros(0), dtype=np.int64)
+    part_index = np.asarray(_need(path, arrays, ArrayType.element_shell_part_indexes, warnings)
+                            if n_shells else np.zeros(0), dtype=np.int64)
     element_ids = arrays.get(ArrayType.element_shell_ids)
     element_ids = None if element_ids is None else np.asarray(element_ids, dtype=np.int64)
     face_of = np.zeros(0, np.int64)
     if len(solids):  # drawn by their boundary faces (every face with all_faces)
-        from .solids import boundary_surface
+        from ..solids import boundary_surface
 
-        solid_part_index = np.asarray(need(ArrayType.element_solid_part_indexes), np.int64)
+        solid_part_index = np.asarray(
+            _need(path, arrays, ArrayType.element_solid_part_indexes, warnings), np.int64)
         try:
             faces, face_part_index, face_of = boundary_surface(solids, nodes, solid_part_index,
                                                                all_faces)
@@ -165,30 +226,34 @@ def read_d3plot(path, units: str = "mm", all_faces: bool = False,
             element_ids = np.concatenate([shell_ids, np.asarray(solid_ids, np.int64)[face_of]])
         else:
             element_ids = None
+    return _Elements(nodes, connectivity, part_index, element_ids, face_of, n_shells,
+                     len(solids))
+
+
+def _parts(path: Path, arrays, ArrayType, warnings: _LassoWarnings,
+           part_index: np.ndarray) -> tuple[np.ndarray, dict[int, str]]:
+    """:func:`_part_ids` of the elements; ParseError when their part indexes are out of range."""
     try:
         if len(part_index) and part_index.min() < 0:
             raise ValueError(f"index {int(part_index.min())}")
-        parts, part_names = _part_ids(arrays, part_index, ArrayType)
+        return _part_ids(arrays, part_index, ArrayType)
     except (IndexError, ValueError) as exc:
         raise ParseError(path, f"element part indexes out of range ({exc}): the file is "
                                f"damaged" + warnings.summary()) from None
 
-    steps = times = None
-    if ArrayType.node_displacement in arrays and len(arrays[ArrayType.node_displacement]):
-        steps = np.asarray(arrays[ArrayType.node_displacement], dtype=np.float64)
-        times = np.asarray(arrays.get(ArrayType.global_timesteps, np.arange(len(steps))),
-                           dtype=np.float64)
-    n_states = 0 if steps is None else len(steps)
 
-    # Rigid-part shells have no stress, strain or thickness records in the state data.
+def _shell_fields(arrays, ArrayType, elements: _Elements, n_states: int,
+                  stress_components: bool) -> dict[str, np.ndarray]:
+    """The (T, M) shell fields of the module notes that the file holds, NaN on the solid faces
+    and on the shells of rigid parts (which have no stress, strain or thickness records)."""
+    n_shells = elements.n_shells
+    n_faces = len(elements.connectivity) - n_shells  # solid faces carry no shell field: NaN
     deformable = np.ones(n_shells, bool)
     if ArrayType.part_material_type in arrays:
         material = np.asarray(arrays[ArrayType.part_material_type])
-        shell_part_index = part_index[:n_shells]
+        shell_part_index = elements.part_index[:n_shells]
         inside = shell_part_index < len(material)
         deformable[inside] = material[shell_part_index[inside]] != RIGID_MATERIAL_TYPE
-
-    n_faces = len(connectivity) - n_shells  # solid faces carry no shell field: NaN
 
     def per_shell(values: np.ndarray) -> np.ndarray | None:
         values = np.asarray(values, dtype=np.float64)
@@ -204,36 +269,22 @@ def read_d3plot(path, units: str = "mm", all_faces: bool = False,
         return None
 
     fields = {}
-    if n_states:
-        if ArrayType.element_shell_stress in arrays:
-            fields["von_mises"] = per_shell(von_mises(mid_surface(
-                arrays[ArrayType.element_shell_stress], layer_axis=2)))
-            stress = np.asarray(arrays[ArrayType.element_shell_stress])
-            if stress_components and stress.ndim == 4 and stress.shape[3] == 6:
-                membrane = through_thickness_mean(stress, layer_axis=2)
-                for k, name in enumerate(STRESS_COMPONENTS):
-                    fields[f"stress_{name}"] = per_shell(membrane[..., k])
-        if ArrayType.element_shell_effective_plastic_strain in arrays:
-            fields["plastic_strain"] = per_shell(mid_surface(
-                arrays[ArrayType.element_shell_effective_plastic_strain], layer_axis=2))
-        if ArrayType.element_shell_thickness in arrays:
-            fields["thickness"] = per_shell(arrays[ArrayType.element_shell_thickness])
-        if ArrayType.element_shell_is_alive in arrays:
-            fields["alive"] = per_shell(arrays[ArrayType.element_shell_is_alive])
-    fields = {k: v for k, v in fields.items() if v is not None}
-    if n_states and len(solids):
-        _solid_fields(fields, arrays, ArrayType, face_of, n_shells, n_states)
-
-    node_ids = arrays.get(ArrayType.node_ids)
-    mesh = build_mesh(
-        path, nodes=nodes, elements=connectivity, parts=parts,
-        steps=steps, times=times, element_fields=fields, part_names=part_names,
-        node_ids=None if node_ids is None else np.asarray(node_ids, dtype=np.int64),
-        element_ids=element_ids, name=path.name, units=units)
-    for failure in warnings.failures:  # read, but with sections missing: say which
-        _warn(ParseWarning(path, f"lasso-python could not read {failure}: what it holds is "
-                                 f"missing"), stacklevel=2)
-    return mesh
+    if ArrayType.element_shell_stress in arrays:
+        fields["von_mises"] = per_shell(von_mises(mid_surface(
+            arrays[ArrayType.element_shell_stress], layer_axis=2)))
+        stress = np.asarray(arrays[ArrayType.element_shell_stress])
+        if stress_components and stress.ndim == 4 and stress.shape[3] == 6:
+            membrane = through_thickness_mean(stress, layer_axis=2)
+            for k, name in enumerate(STRESS_COMPONENTS):
+                fields[f"stress_{name}"] = per_shell(membrane[..., k])
+    if ArrayType.element_shell_effective_plastic_strain in arrays:
+        fields["plastic_strain"] = per_shell(mid_surface(
+            arrays[ArrayType.element_shell_effective_plastic_strain], layer_axis=2))
+    if ArrayType.element_shell_thickness in arrays:
+        fields["thickness"] = per_shell(arrays[ArrayType.element_shell_thickness])
+    if ArrayType.element_shell_is_alive in arrays:
+        fields["alive"] = per_shell(arrays[ArrayType.element_shell_is_alive])
+    return {k: v for k, v in fields.items() if v is not None}
 
 
 def _solid_fields(fields: dict, arrays, ArrayType, face_of: np.ndarray, n_shells: int,

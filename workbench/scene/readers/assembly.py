@@ -1,0 +1,173 @@
+"""The FEMesh of a read keyword deck: node and element ids mapped to indices, duplicates and
+undefined references refused, the shell thickness from thickness cards and sections, and the
+solids drawn by their faces (:mod:`workbench.scene.solids`).
+
+Every refusal is a :class:`~workbench.scene.readers.errors.ParseError` at the card that causes
+it (its file and 1-based line), found again from the chunks of lines each block was read from.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..mesh import FEMesh
+from .cards import _Chunk, _locate
+from .errors import ParseError, build_mesh
+
+if TYPE_CHECKING:
+    from .keyword import _Deck
+
+
+def deck_mesh(deck: _Deck, units: str, all_faces: bool = False) -> FEMesh:
+    """The FEMesh of what ``deck`` read: shells, then the faces of its solids (every face with
+    ``all_faces``), with ids, parts, part titles and the element field ``"thickness"``.
+
+    Refused: a deck without shell or solid elements, a node or element id defined twice, an
+    element naming an undefined node, a part id beyond 32 bits, a solid of an unknown node
+    pattern, and what :class:`FEMesh` refuses.
+    """
+    n_shells = sum(len(ids) for ids in deck.shell_ids)
+    if n_shells + sum(len(ids) for ids in deck.solid_ids) == 0:
+        others = ", ".join(f"*{k}" for k in sorted(deck.skipped))
+        raise ParseError(deck.master, "no shell or solid elements (*ELEMENT_SHELL, "
+                         "*ELEMENT_SOLID) in the deck"
+                         + (f"; it has {others}, which are not read" if others else ""))
+    node_ids = np.concatenate(deck.node_ids) if deck.node_ids else np.zeros(0, np.int64)
+    xyz = np.concatenate(deck.node_xyz) if deck.node_xyz else np.zeros((0, 3))
+    order, sorted_ids = _unique_or_raise(node_ids, deck.node_chunks, "node")
+    element_ids = np.concatenate([*deck.shell_ids, *deck.solid_ids])
+    # shells and solids number their elements apart, as LS-DYNA's element types do
+    _unique_or_raise(element_ids[:n_shells], deck.shell_chunks, "element")
+    _unique_or_raise(element_ids[n_shells:], deck.solid_chunks, "solid element")
+
+    shell_ids = element_ids[:n_shells]
+    pids = np.concatenate(deck.shell_parts) if n_shells else np.zeros(0, np.int64)
+    refs = np.concatenate(deck.shell_nodes) if n_shells else np.zeros((0, 4), np.int64)
+    if not (node_ids == 0).any():  # n4 left blank on a triangle
+        blank4 = refs[:, 3] == 0
+        refs[blank4, 3] = refs[blank4, 2]
+    elements = _node_indices(refs, order, sorted_ids, shell_ids, deck.shell_chunks,
+                             "ELEMENT_SHELL")
+    _check_part_ids(pids, deck.shell_chunks, "ELEMENT_SHELL")
+    thickness, sections_used = (_shell_thickness(deck, pids, elements) if n_shells
+                                else (np.zeros(0), False))
+    if deck.solid_ids:
+        faces, face_pids, face_ids = _solid_faces(deck, element_ids[n_shells:], xyz, order,
+                                                  sorted_ids, all_faces)
+        elements = np.concatenate([elements, faces])
+        pids = np.concatenate([pids, face_pids])
+        shell_ids = np.concatenate([shell_ids, face_ids])
+        thickness = np.concatenate([thickness, np.full(len(faces), np.nan)])
+
+    element_fields = {}
+    if np.isfinite(thickness).any() or sections_used:  # a section gave no number:
+        element_fields["thickness"] = thickness  # missing (NaN), not absent
+    used_parts = set(np.unique(pids).tolist())
+    part_names = {pid: part.title for pid, part in deck.parts.items()
+                  if part.title and pid in used_parts}
+    return build_mesh(deck.master, nodes=xyz, elements=elements, parts=pids,
+                      element_fields=element_fields, part_names=part_names,
+                      node_ids=node_ids, element_ids=shell_ids, name=deck.master.name,
+                      units=units)
+
+
+def _solid_faces(deck: _Deck, solid_ids: np.ndarray, xyz: np.ndarray, order: np.ndarray,
+                 sorted_ids: np.ndarray, all_faces: bool):
+    """(faces (F, 4) node indices, their part ids, their solids' ids) of the boundary faces
+    of the deck's solids, or of every face with ``all_faces``."""
+    from ..solids import boundary_surface, solid_kinds
+
+    solid_pids = np.concatenate(deck.solid_parts)
+    _check_part_ids(solid_pids, deck.solid_chunks, "ELEMENT_SOLID")
+    node_refs = np.concatenate(deck.solid_nodes)
+    solids = _node_indices(node_refs, order, sorted_ids, solid_ids, deck.solid_chunks,
+                           "ELEMENT_SOLID")
+    unknown = np.flatnonzero(solid_kinds(solids) == 0)
+    if len(unknown):
+        src, row = _locate(deck.solid_chunks, int(unknown[0]))
+        raise src.error(f"{len(unknown)} solid(s) of a node pattern LS-DYNA does not "
+                        f"define; expected a hexahedron (n1..n8 distinct), pentahedron "
+                        f"(n1 n2 n3 n4 n5 n5 n6 n6) or tetrahedron (n1 n2 n3 n4 n4 n4 "
+                        f"n4 n4)", row, "ELEMENT_SOLID")
+    try:
+        faces, face_pids, face_of = boundary_surface(solids, xyz, solid_pids, all_faces)
+    except ValueError as exc:
+        raise ParseError(deck.master, f"*ELEMENT_SOLID: {exc}") from None
+    return faces, face_pids, solid_ids[face_of]
+
+
+def _shell_thickness(deck: _Deck, pids: np.ndarray,
+                     elements: np.ndarray) -> tuple[np.ndarray, bool]:
+    """(M,) mean nodal thickness: element thickness cards, zeros and gaps from the section;
+    and whether a part's ``*SECTION_SHELL`` gave the thickness of its shells."""
+    nodal = np.concatenate(deck.shell_thickness)
+    unique, inverse = np.unique(pids, return_inverse=True)
+    section_of_part = {}
+    for pid in unique.tolist():
+        part = deck.parts.get(pid)
+        section = None if part is None else deck.sections.get(part.secid)
+        if section is None:
+            continue
+        t = np.array([deck.parameters.thickness(text, section.src, section.row)
+                      for text in section.thickness])
+        t[1:][t[1:] == 0] = t[0]  # T2..T4 default to T1
+        section_of_part[pid] = t
+    fallback = np.full((len(pids), 4), np.nan)
+    if section_of_part:
+        table = np.array([section_of_part.get(p, [np.nan] * 4) for p in unique.tolist()])
+        fallback = table[inverse.reshape(-1)]
+    use_section = np.isnan(nodal) | (nodal == 0)
+    nodal = np.where(use_section, fallback, nodal)
+    triangle = elements[:, 3] == elements[:, 2]
+    return (np.where(triangle, nodal[:, :3].mean(axis=1), nodal.mean(axis=1)),
+            bool(section_of_part))
+
+
+def _node_indices(refs: np.ndarray, order: np.ndarray, sorted_ids: np.ndarray,
+                  element_ids: np.ndarray, chunks: list[_Chunk], keyword: str) -> np.ndarray:
+    """The node indices of the node ids ``refs`` (E, k); ParseError at the first element that
+    names an undefined node, listing up to five (element id, node id) pairs."""
+    if len(sorted_ids):
+        pos = np.searchsorted(sorted_ids, refs).clip(max=len(sorted_ids) - 1)
+        found = sorted_ids[pos] == refs
+        indices = order[pos]
+    else:
+        found = np.zeros(refs.shape, bool)
+        indices = np.zeros(refs.shape, np.int64)
+    if not found.all():
+        bad = np.flatnonzero(~found.all(axis=1))
+        pairs = [(int(element_ids[e]), int(refs[e][~found[e]][0])) for e in bad[:5]]
+        src, row = _locate(chunks, int(bad[0]))
+        listed = ", ".join(f"({e}, {n})" for e, n in pairs)
+        raise src.error(f"{len(bad)} element(s) reference undefined node ids; first "
+                        f"(element id, node id): {listed}", row, keyword)
+    return indices
+
+
+def _check_part_ids(pids: np.ndarray, chunks: list[_Chunk], keyword: str) -> None:
+    """ParseError at the first part id that does not fit in 32 bits (FEMesh keeps int32)."""
+    limits = np.iinfo(np.int32)
+    too_big = (pids < limits.min) | (pids > limits.max)
+    if too_big.any():
+        src, row = _locate(chunks, int(np.argmax(too_big)))
+        raise src.error(f"part id {int(pids[too_big][0])} does not fit in 32 bits", row, keyword)
+
+
+def _unique_or_raise(ids: np.ndarray, chunks: list[_Chunk], what: str):
+    """(order, sorted ids) of ``ids``; a repeated id raises ParseError at its second definition."""
+    order = np.argsort(ids, kind="stable")
+    sorted_ids = ids[order]
+    repeated = np.flatnonzero(sorted_ids[1:] == sorted_ids[:-1])
+    if len(repeated):
+        later = order[repeated + 1]
+        second = int(later.min())
+        first = int(order[np.searchsorted(sorted_ids, ids[second])])
+        src0, row0 = _locate(chunks, first)
+        src, row = _locate(chunks, second)
+        keyword = {"node": "NODE", "element": "ELEMENT_SHELL"}.get(what, "ELEMENT_SOLID")
+        raise src.error(f"{what} id {int(ids[second])} is defined twice (first at "
+                        f"{src0.path.name}:{row0 + 1}); {len(repeated)} repeated id(s)", row,
+                        keyword)
+    return order, sorted_ids
