@@ -41,7 +41,7 @@ from workbench import data
 from workbench.algo.bvh import TriangleBVH
 from workbench.algo.hierarchy import ElementHierarchy, local_origin, used_nodes
 from workbench.scene.generators import refine
-from workbench.scene.io import load
+from workbench.scene.readers import load
 
 REL_TOL = 1e-12
 
