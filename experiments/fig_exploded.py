@@ -55,7 +55,7 @@ scenes with offset <= o_max; where the reveal needs more than o_max, >= 99 % of 
 pixels showing through the ghosted half; occlusion-driven revealing more than uniform and fixed
 offset at equal displacement; the occlusion queries at most 1x the draw.
 
-Run: ``workbench run fig_exploded [--quick]`` or ``python experiments/fig_exploded.py [--quick]``.
+Run: ``workbench run fig_exploded [--quick]``.
 """
 
 from __future__ import annotations
@@ -71,7 +71,8 @@ from workbench.algo.explode import o_max_of, occlusion_ratio, uniform_explosion
 from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.figures import save_animation, save_image_grid, with_progress_bar
 from workbench.experiment.measure import default_camera
-from workbench.experiment.registry import experiment, main
+from workbench.experiment.context import ExperimentContext
+from workbench.experiment.registry import experiment
 from workbench.experiment.tables import write_table
 from workbench.gl import Framebuffer, GpuTimer, create_context, renderer
 from workbench.gl.camera import up_frame
@@ -377,8 +378,8 @@ def load_car(say):
 
 @experiment("fig_exploded", "ghost2013: occlusion-driven ghosted exploded views over view "
             "angles on the car and a box of panels, against uniform and fixed-offset explosions")
-def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
-    say = progress or (lambda msg: None)
+def run(exp: ExperimentContext) -> list[dict]:
+    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
     size = (200, 150) if quick else (400, 300)
     frames = 40 if quick else 60
     ctx = create_context()
@@ -418,6 +419,3 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
                       "manual plane")
     return rows
 
-
-if __name__ == "__main__":
-    raise SystemExit(main("fig_exploded", run.__doc__ or ""))

@@ -34,7 +34,7 @@ Outputs in ``figures/fig_pixel_exact/``:
   polygons: raw polygons, lines over and behind the fill, lines with quadrisection, skirts) and
   ``fig8_height.png`` (the height field, per vertex against per pixel).
 
-Run: ``workbench run fig_pixel_exact [--quick]`` or ``python experiments/fig_pixel_exact.py``.
+Run: ``workbench run fig_pixel_exact [--quick]``.
 """
 
 from __future__ import annotations
@@ -53,7 +53,8 @@ from workbench.algo.spacetime.slicing import TimeSlicer, polygon_areas, quadrise
 from workbench.experiment.compare import crack_pixels
 from workbench.experiment.figures import save_field_figure, save_image_grid
 from workbench.experiment.measure import measure
-from workbench.experiment.registry import experiment, main
+from workbench.experiment.context import ExperimentContext
+from workbench.experiment.registry import experiment
 from workbench.experiment.tables import atomic_open, write_table
 from workbench.experiment.timing import time_call
 from workbench.gl import Camera, create_context, renderer
@@ -488,8 +489,8 @@ def crop_to_cracks(images: list) -> list:
 
 @experiment("fig_pixel_exact", "st2005: pixel-exact rendering of spacetime FE solutions, "
                                "per vertex against per pixel, with exact images")
-def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
-    say = progress or (lambda msg: None)
+def run(exp: ExperimentContext) -> list[dict]:
+    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
     r = Renderer(width=400 if quick else 1000, repeat=5 if quick else 9)
     try:
         say(f"slice sizes on {r.name}")
@@ -511,6 +512,3 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
         r.release()
     return rows
 
-
-if __name__ == "__main__":
-    raise SystemExit(main("fig_pixel_exact", run.__doc__ or "st2005 pixel-exact rendering"))

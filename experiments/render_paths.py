@@ -15,7 +15,7 @@ the same culling and comparable lighting (SSIM against our Gouraud image shows t
 is like for like), and a bare position-only draw gives the floor. ``targets.md`` holds the
 ratios the foundation is judged by.
 
-Run: ``workbench run render_paths [--quick]`` or ``python experiments/render_paths.py [--quick]``.
+Run: ``workbench run render_paths [--quick]``.
 """
 
 from __future__ import annotations
@@ -30,7 +30,8 @@ from workbench.experiment.compare import compare_drawn, difference_image
 from workbench.experiment.figures import save_field_figure, save_image_grid
 from workbench.experiment.measure import measure
 from workbench.experiment.reference import PyrenderReference
-from workbench.experiment.registry import experiment, main
+from workbench.experiment.context import ExperimentContext
+from workbench.experiment.registry import experiment
 from workbench.experiment.tables import write_table
 from workbench.experiment.timing import time_call
 from workbench.gl import Camera, create_context, renderer
@@ -92,8 +93,8 @@ def path_configs(step: int, field: str, element_field: str | None, value_range, 
 
 @experiment("render_paths", "first render paths on the car and the es2008 semicylinders: time against "
                             "error, pyrender and a bare draw beside them")
-def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
-    say = progress or (lambda msg: None)
+def run(exp: ExperimentContext) -> list[dict]:
+    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
     ctx = create_context()
     gl_renderer = renderer(ctx)
     repeat = 5 if quick else 9
@@ -204,6 +205,3 @@ def needs_saving(mesh, needs, style, costs: dict) -> dict:
     return {"derive_ms": sum(ms for ms, _ in derived), "derive_bytes": sum(b for _, b in derived),
             "skipped_ms": sum(ms for ms, _ in skipped), "skipped_bytes": sum(b for _, b in skipped)}
 
-
-if __name__ == "__main__":
-    raise SystemExit(main('render_paths', __doc__.splitlines()[0]))

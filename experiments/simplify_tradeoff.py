@@ -34,8 +34,7 @@ meshoptimizer (whole mesh) needs at that distance (``meshoptimizer_at_this_error
 Figures (``<mesh>_tradeoff.png``): one-sided Hausdorff against triangles and against time, one
 line per method and scope, log axes.
 
-Run: ``workbench run simplify_tradeoff [--quick]`` or
-``python experiments/simplify_tradeoff.py [--quick]``.
+Run: ``workbench run simplify_tradeoff [--quick]``.
 """
 
 from __future__ import annotations
@@ -50,7 +49,8 @@ from workbench.algo.bvh import TriangleBVH
 from workbench.algo.hausdorff import hausdorff
 from workbench.algo.simplify import hausdorff_decimate
 from workbench.data import CAR_DECK, D3PLOT, shared_file
-from workbench.experiment.registry import experiment, main
+from workbench.experiment.context import ExperimentContext
+from workbench.experiment.registry import experiment
 from workbench.experiment.simplifiers import (PART_SIMPLIFIERS, SIMPLIFIERS, igl_hausdorff,
                                               open3d_distances, part_border_vertices,
                                               pymeshlab_hausdorff, simplify_per_part,
@@ -513,8 +513,8 @@ def save_tradeoff_figure(path: Path, rows: list[dict], title: str) -> None:
 
 @experiment("simplify_tradeoff", "crash2000 §3.2: Hausdorff-bounded decimation against pymeshlab, "
                                  "libigl, open3d and meshoptimizer, with a certified metric")
-def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
-    say = progress or (lambda msg: None)
+def run(exp: ExperimentContext) -> list[dict]:
+    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
     tolerances = QUICK_TOLERANCES_PCT if quick else TOLERANCES_PCT
     samples = 10_000 if quick else 100_000
     rows = []
@@ -536,6 +536,3 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
     save_equal_error_figure(out_dir / "equal_error.png", sweep)
     return rows
 
-
-if __name__ == "__main__":
-    raise SystemExit(main('simplify_tradeoff', __doc__.splitlines()[0]))

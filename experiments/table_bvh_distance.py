@@ -28,8 +28,7 @@ hierarchy and checked against brute force.
 
 Without the shared car deck, generated stamped panels stand in (and the rows say so).
 
-Run: ``workbench run table_bvh_distance [--quick]`` or
-``python experiments/table_bvh_distance.py [--quick]``.
+Run: ``workbench run table_bvh_distance [--quick]``.
 """
 
 from __future__ import annotations
@@ -49,7 +48,8 @@ from workbench.experiment.distance_refs import (TOOLS, compare_with_exact,
                                                 reference_part_distances)
 from workbench.experiment.figures import save_field_figure, save_image_grid
 from workbench.experiment.measure import default_camera, measure
-from workbench.experiment.registry import experiment, main
+from workbench.experiment.context import ExperimentContext
+from workbench.experiment.registry import experiment
 from workbench.experiment.tables import atomic_open, write_table
 from workbench.gl import create_context
 from workbench.paths import Style
@@ -348,8 +348,8 @@ def save_tube_frames(ctx, model, tube, path: Path, quick: bool) -> None:
 
 @experiment("table_bvh_distance", "crash2000 Table 2: part distances through AABB/OBB "
             "hierarchies against libigl/open3d/trimesh/coal; flanges; force tubes")
-def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
-    say = progress or (lambda msg: None)
+def run(exp: ExperimentContext) -> list[dict]:
+    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
     rows, ours = hierarchy_rows(quick, say)
     write_table(reference_rows(ours, quick, say), out_dir, "references",
                 title=f"Distances to other parts within {CUTOFF} mm: today's tools on the same "
@@ -364,6 +364,3 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
                 title="Force tubes: the closed form, and the car's rails under a crush")
     return rows
 
-
-if __name__ == "__main__":
-    raise SystemExit(main("table_bvh_distance", __doc__.splitlines()[0]))

@@ -42,8 +42,7 @@ car itself, generated stamped panels) and each of the paper's parameter sets A a
 Lighting follows the workbench's two-sided headlight; the original is Gouraud-shaded with the
 crease angle of set A, the simplified surfaces shade per pixel from the normal map.
 
-Run: ``workbench run table_fe_texture_wireframe [--quick]`` or
-``python experiments/table_fe_texture_wireframe.py [--quick]``.
+Run: ``workbench run table_fe_texture_wireframe [--quick]``.
 """
 
 from __future__ import annotations
@@ -67,7 +66,8 @@ from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.compare import compare_images, wire_agreement
 from workbench.experiment.figures import save_image_grid
 from workbench.experiment.measure import measure
-from workbench.experiment.registry import experiment, main
+from workbench.experiment.context import ExperimentContext
+from workbench.experiment.registry import experiment
 from workbench.experiment.tables import atomic_open, write_table
 from workbench.gl import Camera, create_context, renderer
 from workbench.paths import Style
@@ -395,8 +395,8 @@ def crop(image: np.ndarray, box) -> np.ndarray:
 
 @experiment("table_fe_texture_wireframe", "fe2003 Tables 1-3: simplified FE meshes with normal "
                                           "maps and a wire-frame texture against line overdraw")
-def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
-    say = progress or (lambda msg: None)
+def run(exp: ExperimentContext) -> list[dict]:
+    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
     size = (500, 375) if quick else (1000, 750)
     repeat = 5 if quick else 9
     ctx = create_context()
@@ -453,6 +453,3 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
                           f"{sweep[0]['mesh']}: simplified + wire texture, speed against error")
     return rows
 
-
-if __name__ == "__main__":
-    raise SystemExit(main("table_fe_texture_wireframe", __doc__.splitlines()[0]))

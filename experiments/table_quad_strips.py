@@ -18,8 +18,7 @@ The wire-frame rows compare the single-pass wire pixels with the line overdraw's
 **Cutoff sweep** (``cutoff.md``, ``cutoff.png``): vertex share and strip count against the
 bandification cutoff.
 
-Run: ``workbench run table_quad_strips [--quick]`` or
-``python experiments/table_quad_strips.py [--quick]``.
+Run: ``workbench run table_quad_strips [--quick]``.
 """
 
 from __future__ import annotations
@@ -32,7 +31,8 @@ from workbench.data import CAR_DECK, D3PLOT, shared_file
 from workbench.experiment.compare import difference_map, wire_agreement
 from workbench.experiment.figures import save_image_grid
 from workbench.experiment.measure import measure
-from workbench.experiment.registry import experiment, main
+from workbench.experiment.context import ExperimentContext
+from workbench.experiment.registry import experiment
 from workbench.experiment.tables import atomic_open, write_table
 from workbench.experiment.timing import time_call
 from workbench.gl import Camera, VertexShaderInvocations, create_context, renderer
@@ -237,8 +237,8 @@ def draw_rows(ctx, model: Model, size, repeat: int, say) -> tuple[list[dict], di
 
 @experiment("table_quad_strips", "crash2000 Table 1: quad strips by bandification against "
                                  "meshoptimizer triangle strips, drawn stripped and unstripped")
-def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
-    say = progress or (lambda msg: None)
+def run(exp: ExperimentContext) -> list[dict]:
+    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
     repeat = 5 if quick else 9
     suite = list(models(say))
     rows = []
@@ -275,6 +275,3 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
                                               "(Gouraud shading)")
     return rows
 
-
-if __name__ == "__main__":
-    raise SystemExit(main('table_quad_strips', __doc__.splitlines()[0]))

@@ -28,8 +28,7 @@ and by part), rendered by the software rasterizer on a LocalCluster of 2 worker 
 composited by binary tree and binary swap: equality with the one-process image, bytes moved
 between workers, render and compositing seconds.
 
-Run: ``workbench run table_software_raster [--quick]`` or
-``python experiments/table_software_raster.py [--quick]``.
+Run: ``workbench run table_software_raster [--quick]``.
 """
 
 from __future__ import annotations
@@ -48,7 +47,8 @@ from workbench.algo.softraster.spantable import PAPER_MB, build_span_table, forg
 from workbench.experiment.compare import compare_images, difference_map
 from workbench.experiment.figures import save_image_grid
 from workbench.experiment.measure import default_camera, measure
-from workbench.experiment.registry import experiment, main
+from workbench.experiment.context import ExperimentContext
+from workbench.experiment.registry import experiment
 from workbench.experiment.tables import atomic_open, write_table
 from workbench.gl import create_context, renderer
 from workbench.paths import SoftwareRasterizer, Style
@@ -345,8 +345,8 @@ def save_images(out_dir: Path, images: dict) -> None:
 
 @experiment("table_software_raster", "es2008 Tables 2-3: the software rasterizer with a span "
             "look-up table against llvmpipe, per-step times, sort-last compositing on Dask")
-def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
-    say = progress or (lambda msg: None)
+def run(exp: ExperimentContext) -> list[dict]:
+    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
     repeats = 5 if quick else 7
     ctx = create_context()
     say(f"renderer: {renderer(ctx)}")
@@ -378,6 +378,3 @@ def run(out_dir: Path, quick: bool, progress=None) -> list[dict]:
         row.pop("steps_ms", None)
     return rows
 
-
-if __name__ == "__main__":
-    raise SystemExit(main("table_software_raster", run.__doc__ or ""))

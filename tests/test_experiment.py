@@ -2,6 +2,7 @@
 
 import math
 import tempfile
+from dataclasses import dataclass
 
 import numpy as np
 import pytest
@@ -45,9 +46,22 @@ def ctx():
     return create_context()
 
 
+@dataclass
+class Quad:
+    """The scene of :class:`QuadDraw`: four corners and their normals."""
+
+    corners: np.ndarray
+    normals: np.ndarray
+    name: str = "quad"
+    kind = "quad"
+
+    def bounds(self):
+        return self.corners.min(axis=0), self.corners.max(axis=0)
+
+
 class QuadDraw(RenderPath):
-    """A lit quad as a tiny render path, kept out of the registry: ``prepare(ctx, (corners,
-    normals), camera)`` makes the GL objects once, ``draw()`` draws into the bound target."""
+    """A lit quad as a tiny render path, kept out of the registry: ``prepare(ctx, Quad,
+    camera)`` makes the GL objects once, ``draw()`` draws into the bound target."""
 
     needs = frozenset()
 
@@ -57,7 +71,7 @@ class QuadDraw(RenderPath):
         self._objects = []
 
     def prepare(self, ctx, scene, camera):
-        corners, normals = scene
+        corners, normals = scene.corners, scene.normals
         self.ctx = ctx
         self.prog = ctx.program(vertex_shader=VERT, fragment_shader=FRAG)
         self.set_camera(camera)
@@ -91,7 +105,7 @@ class QuadDraw(RenderPath):
 def quad_path(ctx, camera, corners, normals) -> QuadDraw:
     """A prepared :class:`QuadDraw` of the quad."""
     path = QuadDraw()
-    path.prepare(ctx, (corners, normals), camera)
+    path.prepare(ctx, Quad(corners, normals), camera)
     return path
 
 
@@ -310,9 +324,9 @@ def test_run_experiment_writes_table(tmp_path):
     seen = {}
 
     @experiment("dummy-harness-check", "two rows for the harness test")
-    def run(out_dir, quick, progress):
-        seen.update(out_dir=out_dir, quick=quick)
-        progress("halfway")
+    def run(exp):
+        seen.update(out_dir=exp.out_dir, quick=exp.quick, size=exp.size)
+        exp.say("halfway")
         return [{"case": "a", "ms": 1.5}, {"case": "b", "ms": 2.5, "extra": 3}]
 
     messages = []
@@ -325,7 +339,7 @@ def test_run_experiment_writes_table(tmp_path):
     # the experiment wrote into a staging folder beside it, swapped in whole afterwards
     assert seen["out_dir"].parent == out_dir.parent and not seen["out_dir"].exists()
     assert sorted(p.name for p in out_dir.parent.iterdir()) == ["dummy-harness-check"]
-    assert seen["quick"] is True and messages == ["halfway"]
+    assert seen["quick"] is True and seen["size"] == "quick" and messages == ["halfway"]
     assert read_table(out_dir / "table.csv") == [{"case": "a", "ms": 1.5, "extra": None},
                                                  {"case": "b", "ms": 2.5, "extra": 3}]
     assert (out_dir / "table.md").read_text().startswith("# dummy-harness-check")
@@ -339,7 +353,7 @@ def test_discover_imports_every_module(tmp_path, monkeypatch):
         (package / f"{name}.py").write_text(
             "from workbench.experiment import experiment\n"
             f"@experiment('probe-{name}', 'registered on import')\n"
-            "def run(out_dir, quick, progress):\n    return []\n")
+            "def run(exp):\n    return []\n")
     (package / "_private.py").write_text("raise RuntimeError('private modules are skipped')\n")
     monkeypatch.syspath_prepend(str(tmp_path))
     try:
@@ -353,7 +367,7 @@ def test_discover_imports_every_module(tmp_path, monkeypatch):
 
 def test_unknown_experiment_lists_known_ones(tmp_path):
     @experiment("dummy-known", "")
-    def run(out_dir, quick, progress):
+    def run(exp):
         return []
 
     try:
@@ -447,7 +461,7 @@ def test_image_grid_places_panels_side_by_side(tmp_path):
 
 def render_ours(ctx, camera, corners, normals, size):
     """(H, W, 4) uint8 image of one untimed draw of the quad on white."""
-    return measure(ctx, (corners, normals), QuadDraw(), camera=camera, size=size,
+    return measure(ctx, Quad(corners, normals), QuadDraw(), camera=camera, size=size,
                    timed=False).image
 
 
@@ -550,9 +564,9 @@ def test_experiment_outputs_are_replaced_as_a_set(tmp_path):
     calls = []
 
     @experiment("dummy-set", "outputs as a set")
-    def run(out_dir, quick, progress):
-        calls.append(out_dir)
-        (out_dir / "figure.txt").write_text(f"run {len(calls)}")
+    def run(exp):
+        calls.append(exp.out_dir)
+        exp.file("figure.txt").write_text(f"run {len(calls)}")
         if len(calls) == 2:
             raise RuntimeError("failed halfway")
         return [{"run": len(calls)}]

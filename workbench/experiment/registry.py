@@ -2,7 +2,9 @@
 
 An experiment script in the top-level ``experiments/`` folder (the package
 ``workbench.experiments``) registers a function with :func:`experiment`; the function
-``run(out_dir, quick, progress)`` writes its figures into ``out_dir`` and returns its rows.
+``run(exp)`` receives an :class:`~workbench.experiment.context.ExperimentContext` (size,
+output folder, progress, GL context, measurement defaults, the shared-data guard), writes its
+figures and further tables into the context's folder and returns its rows.
 :func:`run_experiment` then writes ``table.csv``/``table.md`` from those rows.
 """
 
@@ -19,10 +21,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
+from .context import SIZES, ExperimentContext
 from .tables import write_table
 
 Progress = Callable[[str], None]
-RunFunction = Callable[[Path, bool, "Progress | None"], list]
+RunFunction = Callable[[ExperimentContext], list]
 
 EXPERIMENTS_PACKAGE = "workbench.experiments"
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
@@ -31,7 +34,7 @@ _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 @dataclass(frozen=True)
 class Experiment:
     """A registered experiment: its name (also its figures folder), a one-line description and
-    the function ``run(out_dir: Path, quick: bool, progress) -> list[dict]``."""
+    the function ``run(exp: ExperimentContext) -> list[dict]``."""
 
     name: str
     description: str
@@ -95,8 +98,12 @@ def get_experiment(name: str) -> Experiment:
 
 
 def run_experiment(name: str, figures_root: Path = Path("figures"), quick: bool = False,
-                   progress: Progress | None = None) -> tuple[list[dict], Path]:
+                   progress: Progress | None = None,
+                   size: str | None = None) -> tuple[list[dict], Path]:
     """Run experiment ``name`` into ``figures_root/<name>/`` and write its table there.
+
+    ``size`` is "full", "quick" or "tiny" (see :mod:`workbench.experiment.context`); by
+    default "quick" with ``quick`` and "full" without.
 
     The experiment writes into a fresh staging folder beside the output folder
     (``.<name>.<random>.<pid>.partial``); its ``table.csv`` and ``table.md`` (titled with the
@@ -107,6 +114,9 @@ def run_experiment(name: str, figures_root: Path = Path("figures"), quick: bool 
     Unknown names raise KeyError listing the known ones; rows that are not dicts raise TypeError.
     """
     exp = get_experiment(name)
+    size = size if size is not None else ("quick" if quick else "full")
+    if size not in SIZES:
+        raise ValueError(f"experiment size must be one of {SIZES}, got {size!r}")
     root = Path(figures_root)
     root.mkdir(parents=True, exist_ok=True)
     out_dir = root / exp.name
@@ -114,7 +124,7 @@ def run_experiment(name: str, figures_root: Path = Path("figures"), quick: bool 
     staging = Path(tempfile.mkdtemp(dir=root, prefix=f".{exp.name}.",
                                     suffix=f".{os.getpid()}.partial"))
     try:
-        rows = exp.function(staging, bool(quick), progress)
+        rows = exp.function(ExperimentContext(exp.name, staging, size, progress))
         if rows is None:
             raise TypeError(f"experiment {name!r} returned None instead of a list of rows")
         rows = list(rows)
@@ -176,18 +186,3 @@ def clean_dead_runs(root: Path, name: str) -> list[Path]:
             tmp.unlink(missing_ok=True)
             done.append(tmp)
     return done
-
-
-def main(name: str, description: str, argv: list[str] | None = None) -> int:
-    """Command line of an experiment script (``python experiments/<name>.py [--quick]``): run
-    experiment ``name`` into ``--figures`` (default ``figures/``) and print where it went."""
-    import argparse
-
-    parser = argparse.ArgumentParser(description=description)
-    parser.add_argument("--quick", action="store_true", help="small sizes and few repetitions")
-    parser.add_argument("--figures", default="figures", help="output folder (default figures/)")
-    args = parser.parse_args(argv)
-    rows, out = run_experiment(name, figures_root=Path(args.figures), quick=args.quick,
-                               progress=print)
-    print(f"{len(rows)} rows -> {out}")
-    return 0

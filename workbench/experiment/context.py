@@ -1,0 +1,130 @@
+"""What an experiment receives: one context with its size, output folder, progress, GL context,
+measurement defaults and the shared-data guard, so that an experiment holds only its own cases
+and tables.
+
+An experiment is a function ``run(exp: ExperimentContext) -> list[dict]`` registered with
+:func:`workbench.experiment.registry.experiment`. Its rows become ``table.csv``/``table.md``;
+further tables go through :meth:`ExperimentContext.table`, figures into
+:meth:`ExperimentContext.file`. Sizes:
+
+* ``"full"`` — the papers' sizes (``workbench run NAME``);
+* ``"quick"`` — small sizes and few repetitions (``--quick``), every table with its rows;
+* ``"tiny"`` — the smallest cases that still give every table, row kind and column, for the
+  tests of an experiment's shape (seconds, not minutes). Its numbers mean nothing.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+
+from ..data import shared_file
+from .tables import write_table
+
+SIZES = ("full", "quick", "tiny")
+FULL_REPEATS, QUICK_REPEATS = 9, 5
+
+
+@dataclass
+class ExperimentContext:
+    """The context of one experiment run: ``name``, ``out_dir`` (the run's own folder, swapped
+    into place whole when the run ends), ``size`` (one of :data:`SIZES`) and ``progress`` (a
+    callback taking one line, or None)."""
+
+    name: str
+    out_dir: Path
+    size: str = "full"
+    progress: Callable[[str], None] | None = None
+    skipped: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if self.size not in SIZES:
+            raise ValueError(f"experiment size must be one of {SIZES}, got {self.size!r}")
+        self.out_dir = Path(self.out_dir)
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def quick(self) -> bool:
+        """Whether this is a small run ("quick" or "tiny")."""
+        return self.size != "full"
+
+    @property
+    def tiny(self) -> bool:
+        return self.size == "tiny"
+
+    def pick(self, full, quick, tiny=None):
+        """The value for this run's size: ``full``, ``quick``, or ``tiny`` (default ``quick``)."""
+        if self.size == "full":
+            return full
+        if self.size == "tiny" and tiny is not None:
+            return tiny
+        return quick
+
+    @property
+    def repeats(self) -> int:
+        """Timed draws per measurement: 9 at full size, 5 (the least a median and spread need)
+        otherwise."""
+        return FULL_REPEATS if self.size == "full" else QUICK_REPEATS
+
+    # ------------------------------------------------------------------ output
+    def say(self, message: str) -> None:
+        """One progress line."""
+        if self.progress is not None:
+            self.progress(message)
+
+    def file(self, name: str) -> Path:
+        """The path of output file ``name`` inside the run's folder."""
+        return self.out_dir / name
+
+    def table(self, rows: Sequence[dict], name: str, title: str,
+              columns: Sequence[str] | None = None) -> None:
+        """Write ``rows`` as ``<name>.csv`` and ``<name>.md`` (titled) into the run's folder."""
+        write_table(rows, self.out_dir, name, columns=columns, title=title)
+
+    # ------------------------------------------------------------------ data and drawing
+    def shared(self, relative: Path | str, what: str) -> Path | None:
+        """The shared data file ``relative``, or None after saying that ``what`` is skipped
+        (and why) and recording it in ``skipped``."""
+        path = shared_file(relative)
+        if path is None:
+            self.skipped.append(what)
+            self.say(f"{what} skipped: {relative} not found (set WORKBENCH_DATA to the shared "
+                     f"data folder)")
+        return path
+
+    def builtin(self, name: str, what: str | None = None):
+        """The built-in scene ``name`` (at this run's size where it has one); None, said and
+        recorded, where its shared data is absent."""
+        from ..scene.builtin import builtin_scene
+
+        try:
+            return builtin_scene(name, quick=self.quick)
+        except FileNotFoundError as exc:
+            what = what or name
+            self.skipped.append(what)
+            self.say(f"{what} skipped: {exc}")
+            return None
+
+    @cached_property
+    def gl(self):
+        """The run's headless GL context, created on first use."""
+        from ..gl import create_context
+
+        return create_context()
+
+    @property
+    def renderer(self) -> str:
+        """The GL renderer rows name."""
+        from ..gl import renderer
+
+        return renderer(self.gl)
+
+    def measure(self, scene, path, style=None, *, backend=None, **options):
+        """:func:`~workbench.experiment.measure.measure` on ``backend`` (default the run's GL
+        context) with this run's repeats unless ``repeats`` is given."""
+        from .measure import measure
+
+        options.setdefault("repeats", self.repeats)
+        return measure(self.gl if backend is None else backend, scene, path, style, **options)
