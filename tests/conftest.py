@@ -1,16 +1,37 @@
-"""Test-wide settings: property tests draw the same examples on every CI run (set CI=1); an
-offscreen GL context per test module, skipped with the reason where none can be made."""
+"""Test-wide settings and fixtures.
+
+* Property tests draw the same examples on every CI run (set CI=1).
+* ``ctx``: an offscreen GL context per test module, skipped with the reason where none can be
+  made; a test using it is marked ``gl``.
+* ``car``, ``car_deck``, ``d3plot_file``: the shared LS-DYNA car deck (as a fresh mesh, and as
+  a file) and the shared d3plot, skipped with the reason where the shared data is absent; a
+  test using one is marked ``shared_data``.
+* Markers: ``slow`` (end-to-end experiment runs and cluster sweeps; ``pytest`` leaves them out,
+  ``pytest -m "slow or not slow"`` runs everything), ``gl``, ``shared_data``.
+"""
 
 import os
 
 import pytest
 from hypothesis import settings
 
+from workbench.data import CAR_DECK, D3PLOT, shared_file
 from workbench.gl import GLUnavailable, create_context
 
 settings.register_profile("ci", derandomize=True, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
+
+SHARED_FIXTURES = {"car", "car_deck", "d3plot_file"}
+
+
+def pytest_collection_modifyitems(items):
+    for item in items:
+        names = set(getattr(item, "fixturenames", ()))
+        if "ctx" in names:
+            item.add_marker(pytest.mark.gl)
+        if names & SHARED_FIXTURES:
+            item.add_marker(pytest.mark.shared_data)
 
 
 @pytest.fixture(scope="module")
@@ -19,3 +40,32 @@ def ctx():
         return create_context()
     except GLUnavailable as exc:
         pytest.skip(str(exc))
+
+
+def _shared(relative):
+    path = shared_file(relative)
+    if path is None:
+        pytest.skip(f"shared data absent: {relative} (set WORKBENCH_DATA to the shared data "
+                    f"folder)")
+    return path
+
+
+@pytest.fixture(scope="session")
+def car_deck():
+    """The path of the shared LS-DYNA car deck."""
+    return _shared(CAR_DECK)
+
+
+@pytest.fixture(scope="session")
+def d3plot_file():
+    """The path of the shared d3plot result."""
+    return _shared(D3PLOT)
+
+
+@pytest.fixture
+def car(car_deck):
+    """The shared car deck as an FE mesh of its own (read once per session; its arrays shared,
+    its derived data and fields fresh for each test)."""
+    from workbench.scene.builtin import fresh_scene
+
+    return fresh_scene("car")

@@ -27,6 +27,16 @@ SIZES = ("full", "quick", "tiny")
 FULL_REPEATS, QUICK_REPEATS = 9, 5
 
 
+@dataclass(frozen=True)
+class Case:
+    """A scene an experiment measures, under the ``label`` its rows carry in the ``scene``
+    column, with an optional ``kind`` (say "paper size", "car part")."""
+
+    label: str
+    scene: object
+    kind: str = ""
+
+
 @dataclass
 class ExperimentContext:
     """The context of one experiment run: ``name``, ``out_dir`` (the run's own folder, swapped

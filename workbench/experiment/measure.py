@@ -78,7 +78,7 @@ def measure(backend, scene, path, style=None, camera: Camera | None = None,
     draw, or the time of ``set_step``). The image is not read again after it.
 
     The row: ``scene``, ``path``, ``style`` (fields off their defaults), ``renderer``,
-    ``width``, ``height``, ``samples``, ``triangles``, ``vertices``, ``vertices_sent``,
+    ``size`` ("WxH"), ``samples`` (MSAA), ``triangles``, ``vertices``, ``vertices_sent``,
     ``strips``, ``edges``, ``bytes_uploaded``, ``bytes_per_step``, ``derive_ms`` and
     ``derive_bytes`` (what the scene derived for this path now: 0 when cached), ``prepare_ms``,
     then ``gpu_ms``, ``gpu_ms_min``, ``gpu_ms_max``, ``wall_ms``, ``wall_ms_min``,
@@ -126,7 +126,7 @@ def measure(backend, scene, path, style=None, camera: Camera | None = None,
         fb.release()
     back = np.round(np.asarray(background) * 255).astype(np.uint8)
     row = dict(scene=scene.name, path=path.name, style=style_summary(path.style),
-               renderer=backend.renderer_of(path), width=width, height=height, samples=samples,
+               renderer=backend.renderer_of(path), size=f"{width}x{height}", samples=samples,
                triangles=path.triangles, vertices=path.vertices,
                vertices_sent=path.vertices_sent, strips=path.strips, edges=path.edges,
                bytes_uploaded=path.bytes_uploaded, bytes_per_step=path.bytes_per_step,
