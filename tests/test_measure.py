@@ -1,9 +1,7 @@
 """The one path protocol and the one measurement function: every registered path, drawn through
 ``measure``, released in all cases; scenes derive only what paths declare."""
 
-import ast
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,7 +20,6 @@ from workbench.paths.spacetime import SpacetimeStyle
 from workbench.scene import generators
 from workbench.scene.needs import MESH_ITEMS, derivation_cost, derive, derived_items
 
-ROOT = Path(__file__).resolve().parents[1]
 SIZE = (96, 72)
 
 
@@ -163,77 +160,6 @@ def test_derivation_cost_accounts_every_item_once():
     assert part.nbytes == mesh.triangulation.triangles.nbytes + mesh.triangulation.element_of.nbytes \
         + mesh.triangulation.corners.nbytes
     assert everything.nbytes > part.nbytes
-
-
-def _module_imports(path: Path, package: str) -> set[str]:
-    """Modules of ``package`` that ``path`` imports, at module level or inside functions."""
-    tree = ast.parse(path.read_text())
-    module = ".".join(path.relative_to(ROOT).with_suffix("").parts)
-    parent = module.rsplit(".", 1)[0] if path.name != "__init__.py" else module
-    found = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = parent.rsplit(".", node.level - 1)[0] if node.level > 1 else parent
-                target = f"{base}.{node.module}" if node.module else base
-                names = [f"{target}.{a.name}" for a in node.names] + [target]
-            else:
-                names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
-            found |= {n for n in names if n.startswith(package)}
-        elif isinstance(node, ast.Import):
-            found |= {a.name for a in node.names if a.name.startswith(package)}
-    return found
-
-
-def _cycles(modules: dict[str, set[str]]) -> list[list[str]]:
-    cycles, state = [], {}
-
-    def visit(m, stack):
-        state[m] = 1
-        for n in sorted(modules.get(m, ())):
-            if n not in modules:
-                continue
-            if state.get(n) == 1:
-                cycles.append(stack[stack.index(n):] + [n])
-            elif n not in state:
-                visit(n, stack + [n])
-        state[m] = 2
-
-    for m in sorted(modules):
-        if m not in state:
-            visit(m, [m])
-    return cycles
-
-
-@pytest.mark.parametrize("package", ["workbench.paths", "workbench.scene"])
-def test_no_import_cycles_between_modules(package):
-    folder = ROOT.joinpath(*package.split("."))
-    modules = {}
-    for path in folder.glob("*.py"):
-        name = package if path.name == "__init__.py" else f"{package}.{path.stem}"
-        modules[name] = _module_imports(path, package) - {name}
-    # a package's __init__ importing its modules is not a cycle through them
-    graph = {m: {n for n in deps if n != package} for m, deps in modules.items() if m != package}
-    assert _cycles(graph) == []
-
-
-def test_no_private_names_imported_across_packages():
-    offenders = []
-    for path in [*ROOT.joinpath("workbench").rglob("*.py"), *ROOT.joinpath("experiments").glob("*.py")]:
-        package = ".".join(path.relative_to(ROOT).parent.parts)
-        for node in ast.walk(ast.parse(path.read_text())):
-            if not isinstance(node, ast.ImportFrom):
-                continue
-            if node.level:
-                base = package.rsplit(".", node.level - 1)[0] if node.level > 1 else package
-                target = f"{base}.{node.module}" if node.module else base
-            else:
-                target = node.module
-            private = [a.name for a in node.names if a.name.startswith("_")
-                       and not a.name.startswith("__")]
-            if private and target.rsplit(".", 1)[0] != package:
-                offenders.append(f"{path.relative_to(ROOT)}: {target} {private}")
-    assert offenders == []
 
 
 def test_measure_refuses_too_few_repeats(ctx):

@@ -8,20 +8,16 @@ it (its file and 1-based line), found again from the chunks of lines each block 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from ..mesh import FEMesh
 from .cards import _Chunk, _locate
 from .errors import ParseError, build_mesh
 
-if TYPE_CHECKING:
-    from .keyword import _Deck
 
-
-def deck_mesh(deck: _Deck, units: str, all_faces: bool = False) -> FEMesh:
-    """The FEMesh of what ``deck`` read: shells, then the faces of its solids (every face with
+def deck_mesh(deck, units: str, all_faces: bool = False) -> FEMesh:
+    """The FEMesh of what ``deck`` (the deck walk of :mod:`~workbench.scene.readers.keyword`)
+    read: shells, then the faces of its solids (every face with
     ``all_faces``), with ids, parts, part titles and the element field ``"thickness"``.
 
     Refused: a deck without shell or solid elements, a node or element id defined twice, an
@@ -73,7 +69,7 @@ def deck_mesh(deck: _Deck, units: str, all_faces: bool = False) -> FEMesh:
                       units=units)
 
 
-def _solid_faces(deck: _Deck, solid_ids: np.ndarray, xyz: np.ndarray, order: np.ndarray,
+def _solid_faces(deck, solid_ids: np.ndarray, xyz: np.ndarray, order: np.ndarray,
                  sorted_ids: np.ndarray, all_faces: bool):
     """(faces (F, 4) node indices, their part ids, their solids' ids) of the boundary faces
     of the deck's solids, or of every face with ``all_faces``."""
@@ -98,7 +94,7 @@ def _solid_faces(deck: _Deck, solid_ids: np.ndarray, xyz: np.ndarray, order: np.
     return faces, face_pids, solid_ids[face_of]
 
 
-def _shell_thickness(deck: _Deck, pids: np.ndarray,
+def _shell_thickness(deck, pids: np.ndarray,
                      elements: np.ndarray) -> tuple[np.ndarray, bool]:
     """(M,) mean nodal thickness: element thickness cards, zeros and gaps from the section;
     and whether a part's ``*SECTION_SHELL`` gave the thickness of its shells."""

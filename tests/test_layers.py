@@ -1,0 +1,175 @@
+"""The shape of the package: every layer imports only downward, no module imports another in a
+circle, and no private name is imported across packages.
+
+Layers, bottom to top: ``gl``, ``scene`` (with ``data``) → ``algo`` → ``paths`` →
+``experiment`` → ``sweep`` → ``reliability`` → ``cli``, and the experiment scripts on top. A
+module may import its own layer and the layers below. Imports inside functions count: a lazy
+import that points up, or closes a circle, is the same coupling. The checks are tested on a
+small package with the faults they exist to catch.
+"""
+
+import ast
+import textwrap
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+LAYERS = {"gl": 0, "scene": 0, "data": 0, "algo": 1, "paths": 2, "experiment": 3, "sweep": 4,
+          "reliability": 5, "cli": 6, "experiments": 7, "__init__": 0}
+PACKAGE_DIRS = {"workbench": ROOT / "workbench", "workbench.experiments": ROOT / "experiments"}
+
+
+def modules_of(package: str, folder: Path) -> dict[str, Path]:
+    """Every module of ``package`` (in ``folder``) by dotted name."""
+    found = {}
+    for path in sorted(folder.rglob("*.py")):
+        parts = path.relative_to(folder).with_suffix("").parts
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        found[".".join((package, *parts))] = path
+    return found
+
+
+def imports_of(module: str, path: Path, known: set[str]) -> set[str]:
+    """The modules of ``known`` that ``module`` (its source at ``path``) imports, at module
+    level or inside functions: for ``from X import name`` the module ``X.name`` where it is one,
+    else ``X``."""
+    is_package = path.name == "__init__.py"
+    parent = module if is_package else module.rsplit(".", 1)[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = parent.rsplit(".", node.level - 1)[0] if node.level > 1 else parent
+                target = f"{base}.{node.module}" if node.module else base
+            else:
+                target = node.module or ""
+            for alias in node.names:
+                sub = f"{target}.{alias.name}"
+                found.add(sub if sub in known else target)
+        elif isinstance(node, ast.Import):
+            found |= {alias.name for alias in node.names}
+    return {name for name in found if name in known and name != module}
+
+
+def layer_of(module: str) -> str:
+    """The layer of a dotted module name (``workbench.paths.mesh`` → ``paths``)."""
+    parts = module.split(".")
+    if parts[:2] == ["workbench", "experiments"]:
+        return "experiments"
+    return parts[1] if len(parts) > 1 else "__init__"
+
+
+def import_graph(dirs: dict[str, Path]) -> dict[str, set[str]]:
+    modules = {}
+    for package, folder in dirs.items():
+        modules.update(modules_of(package, folder))
+    known = set(modules)
+    return {name: imports_of(name, path, known) for name, path in modules.items()}
+
+
+def upward_imports(graph: dict[str, set[str]], layers: dict[str, int]) -> list[str]:
+    """``"a imports b (x over y)"`` for every import of a higher layer; a module outside every
+    layer is reported too."""
+    found = []
+    for module, targets in sorted(graph.items()):
+        layer = layer_of(module)
+        if layer not in layers:
+            found.append(f"{module} belongs to no layer")
+            continue
+        for target in sorted(targets):
+            other = layer_of(target)
+            if layers.get(other, -1) > layers[layer]:
+                found.append(f"{module} imports {target} ({other} over {layer})")
+    return found
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The import circles of ``graph``: one module list per strongly connected set of more than
+    one module (Tarjan)."""
+    index, low, stack, on_stack, found = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in sorted(graph.get(v, ())):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                found.append(sorted(component))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return found
+
+
+@pytest.fixture(scope="module")
+def graph():
+    return import_graph(PACKAGE_DIRS)
+
+
+def test_every_layer_imports_only_downward(graph):
+    assert upward_imports(graph, LAYERS) == []
+
+
+def test_no_import_cycles(graph):
+    assert cycles(graph) == []
+
+
+def test_no_private_names_imported_across_packages():
+    offenders = []
+    for path in [*ROOT.joinpath("workbench").rglob("*.py"), *ROOT.joinpath("experiments").glob("*.py")]:
+        package = ".".join(path.relative_to(ROOT).parent.parts)
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not isinstance(node, ast.ImportFrom):
+                continue
+            if node.level:
+                base = package.rsplit(".", node.level - 1)[0] if node.level > 1 else package
+                target = f"{base}.{node.module}" if node.module else base
+            else:
+                target = node.module
+            private = [a.name for a in node.names if a.name.startswith("_")
+                       and not a.name.startswith("__")]
+            if private and target.rsplit(".", 1)[0] != package:
+                offenders.append(f"{path.relative_to(ROOT)}: {target} {private}")
+    assert offenders == []
+
+
+def test_the_checks_find_an_upward_import_and_a_cycle(tmp_path):
+    """The checks themselves, on a package with one upward import (algo → paths, inside a
+    function) and one circle (scene.a → scene.b → scene.a)."""
+    root = tmp_path / "workbench"
+    files = {
+        "__init__.py": "",
+        "scene/__init__.py": "",
+        "scene/a.py": "from . import b\n",
+        "scene/b.py": "def f():\n    from .a import thing\n",
+        "algo/__init__.py": "",
+        "algo/x.py": "from ..scene import a\n\ndef g():\n    from ..paths.p import draw\n",
+        "paths/__init__.py": "",
+        "paths/p.py": "from ..algo.x import g\n",
+        "extra.py": "",
+    }
+    for name, text in files.items():
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_text(textwrap.dedent(text))
+    found = import_graph({"workbench": root})
+    assert upward_imports(found, LAYERS) == [
+        "workbench.algo.x imports workbench.paths.p (paths over algo)",
+        "workbench.extra belongs to no layer"]
+    assert sorted(cycles(found)) == [["workbench.algo.x", "workbench.paths.p"],
+                                     ["workbench.scene.a", "workbench.scene.b"]]
