@@ -12,11 +12,10 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from workbench.scene import FEMesh
+from workbench.scene.crease import GouraudSplit, gouraud_split
 from workbench.scene.derived import (
-    GouraudSplit,
     Triangulation,
     element_normals,
-    gouraud_split,
     node_normals,
     triangulate,
     unique_edges,
@@ -581,7 +580,7 @@ def test_mesh_properties_use_the_derived_functions():
 
 
 def test_triangle_arrays_are_padded_and_stable_order_falls_back_for_wide_keys():
-    from workbench.scene import derived
+    from workbench.scene import crease
 
     nodes = random_coords(5, 4)
     tris = np.array([[0, 1, 2], [2, 1, 3]])
@@ -590,9 +589,9 @@ def test_triangle_arrays_are_padded_and_stable_order_falls_back_for_wide_keys():
     assert np.array_equal(unique_edges(tris), unique_edges(padded))
     assert np.array_equal(element_normals(tris, nodes), element_normals(padded, nodes))
     keys = np.random.default_rng(0).integers(0, 50, 200) * 2**56  # too wide to pack
-    assert np.array_equal(derived._stable_order(keys), np.argsort(keys, kind="stable"))
+    assert np.array_equal(crease._stable_order(keys), np.argsort(keys, kind="stable"))
     narrow = keys >> 56
-    assert np.array_equal(derived._stable_order(narrow), np.argsort(narrow, kind="stable"))
+    assert np.array_equal(crease._stable_order(narrow), np.argsort(narrow, kind="stable"))
 
 
 # --------------------------------------------------------------------------- refusals

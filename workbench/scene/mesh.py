@@ -241,7 +241,7 @@ class FEMesh:
         return node_normals(self.elements, self.coordinates(step))
 
     def gouraud(self, crease_deg: float = 30.0):
-        """:class:`~workbench.scene.derived.GouraudSplit` for this crease angle (derived once
+        """:class:`~workbench.scene.crease.GouraudSplit` for this crease angle (derived once
         per angle). Creases are detected on the first and last time steps together
         (crash2000, Fig. 2)."""
         from .needs import gouraud

@@ -135,9 +135,9 @@ def edges(mesh) -> np.ndarray:
               from_style=lambda style: (getattr(style, "crease_deg", 30.0),),
               brings=("triangles",))
 def gouraud(mesh, crease_deg: float):
-    """:class:`~workbench.scene.derived.GouraudSplit` of ``mesh`` at ``crease_deg`` degrees.
+    """:class:`~workbench.scene.crease.GouraudSplit` of ``mesh`` at ``crease_deg`` degrees.
     Creases are detected on the first and last time steps together (crash2000, Fig. 2)."""
-    from .derived import gouraud_split
+    from .crease import gouraud_split
 
     coords = [mesh.coordinates(0)]
     if mesh.n_steps > 1:

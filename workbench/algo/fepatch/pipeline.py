@@ -38,7 +38,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...scene.derived import as_coords, as_elements, gouraud_split, triangulate
+from ...scene.crease import gouraud_split
+from ...scene.derived import as_coords, as_elements, triangulate
 from .atlas import build_atlas
 from .borders import BorderNetwork, border_network, unpinched
 from .distance_bound import CertifiedSurface, certified_triangles
