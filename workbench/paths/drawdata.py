@@ -46,10 +46,6 @@ class Topology:
     element_vertex: np.ndarray | None = None
     attributes: list = field(default_factory=list)
 
-    @property
-    def n_vertices(self) -> int:
-        return len(self.vertex_node) if self.vertex_node is not None else -1
-
 
 @dataclass(eq=False)
 class Layout:

@@ -24,7 +24,6 @@ from ..gl import Camera, load_program
 from .base import GLPath
 from .colormap import ColorScale, scale_for
 from .drawdata import Layout, MeshDrawData, Topology, compact, vertex_of_node
-from .style import Style
 
 PRIMITIVE_MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP}
 
@@ -243,5 +242,3 @@ class MeshPath(GLPath):
         self.ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
         self._render(self.mode)
 
-
-__all__ = ["MeshPath", "Style", "field_kind"]
