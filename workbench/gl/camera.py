@@ -14,15 +14,19 @@ and elevation 0 then look along +Y from the −Y side.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 PROJECTIONS = ("orthographic", "perspective")
 # columns: the world directions of the Y-up frame's x, y, z axes
 _UP_FRAMES = {"y": np.eye(3), "z": np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])}
 
 
-def check_resolvable(lo, hi) -> None:
+def check_resolvable(lo: ArrayLike, hi: ArrayLike) -> None:
     """Refuse (ValueError) a bounding box ``lo``–``hi`` (float64, model units) that cannot be
     drawn: not finite, of zero extent, or so far from the origin that float64 coordinates
     cannot tell its points apart to 1/10 000 of its extent (they would draw as one point)."""
@@ -75,9 +79,10 @@ class Camera:
     far: float = 10.0
 
     @classmethod
-    def fit(cls, center, radius: float, *, azimuth: float = 0.0, elevation: float = 0.0,
-            roll: float = 0.0, projection: str = "orthographic", fov_deg: float = 30.0,
-            aspect: float = 1.0, margin: float = 1.05, origin=None, up: str = "y") -> "Camera":
+    def fit(cls, center: ArrayLike, radius: float, *, azimuth: float = 0.0,
+            elevation: float = 0.0, roll: float = 0.0, projection: str = "orthographic",
+            fov_deg: float = 30.0, aspect: float = 1.0, margin: float = 1.05,
+            origin: ArrayLike | None = None, up: str = "y") -> Camera:
         """A camera that sees the whole sphere (``center``, ``radius``) from the given angles.
 
         Near and far planes enclose the sphere tightly (``margin`` times its radius); the
@@ -115,7 +120,7 @@ class Camera:
                    aspect=aspect, near=near, far=distance + r)
 
     @classmethod
-    def fit_box(cls, lo, hi, **kwargs) -> "Camera":
+    def fit_box(cls, lo: ArrayLike, hi: ArrayLike, **kwargs: Any) -> Camera:
         """A camera fitted to the axis-aligned box ``lo``–``hi`` (float64 corners).
 
         Like :meth:`fit` on the box's bounding sphere (same keywords, same near/far), but an
@@ -168,11 +173,11 @@ class Camera:
         """The view matrix as float32 column-major bytes for a ``mat4`` uniform."""
         return self.view_matrix().T.astype(np.float32).tobytes()
 
-    def relative(self, points) -> np.ndarray:
+    def relative(self, points: ArrayLike) -> np.ndarray:
         """float32 coordinates relative to ``origin``: what is uploaded for float64 ``points``."""
         return (np.asarray(points, np.float64) - self.origin).astype(np.float32)
 
-    def project(self, points, size: tuple[int, int]) -> np.ndarray:
+    def project(self, points: ArrayLike, size: tuple[int, int]) -> np.ndarray:
         """(N, 3) float64 window coordinates (x right, y down from the top, depth in [0, 1]).
 
         Pixel (i, j) of a read-back image covers x in [j, j+1), y in [i, i+1); its centre is

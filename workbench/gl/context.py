@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from types import ModuleType
 
 import moderngl
 
@@ -38,7 +39,7 @@ def gl_version(ctx: moderngl.Context) -> str:
     return str(ctx.info["GL_VERSION"])
 
 
-def raw_gl():
+def raw_gl() -> ModuleType:
     """PyOpenGL's ``GL`` module bound through EGL, for the few calls moderngl does not wrap.
 
     Calls act on whatever context is current (a moderngl standalone context is current after

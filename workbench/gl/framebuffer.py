@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from contextlib import contextmanager
 
 import moderngl
@@ -23,7 +24,8 @@ def sample_counts(ctx: moderngl.Context) -> tuple[int, ...]:
 
 
 @contextmanager
-def write_masks(ctx: moderngl.Context, color: bool = True, depth: bool = True):
+def write_masks(ctx: moderngl.Context, color: bool = True,
+                depth: bool = True) -> Iterator[moderngl.Framebuffer]:
     """Within the block the bound framebuffer (``ctx.fbo``) writes colour and depth only as
     asked; its previous masks and the viewport are restored after.
 
@@ -120,7 +122,8 @@ class Framebuffer:
         self.fbo.use()
         self.ctx.viewport = (0, 0, *self.size)
 
-    def clear(self, color=(1.0, 1.0, 1.0, 1.0), depth: float = 1.0) -> None:
+    def clear(self, color: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0),
+              depth: float = 1.0) -> None:
         self.use()
         self.fbo.clear(*color, depth=depth)
 

@@ -6,6 +6,8 @@ for those commands to finish. moderngl frees a query when it is garbage-collecte
 
 from __future__ import annotations
 
+from typing import Any, Self
+
 import moderngl
 import numpy as np
 
@@ -16,11 +18,11 @@ class _Query:
     def __init__(self, ctx: moderngl.Context) -> None:
         self.query = ctx.query(**self.kind)
 
-    def __enter__(self):
+    def __enter__(self) -> Self:
         self.query.__enter__()
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: Any) -> None:
         self.query.__exit__(*exc)
 
 
@@ -80,12 +82,12 @@ class VertexShaderInvocations:
     def supported(ctx: moderngl.Context) -> bool:
         return ctx.version_code >= 460 or "GL_ARB_pipeline_statistics_query" in ctx.extensions
 
-    def __enter__(self):
+    def __enter__(self) -> Self:
         self._count = None
         self._gl.glBeginQuery(GL_VERTEX_SHADER_INVOCATIONS, self._id)
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         self._gl.glEndQuery(GL_VERTEX_SHADER_INVOCATIONS)
 
     @property

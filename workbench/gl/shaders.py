@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from functools import lru_cache
 from importlib import resources
 
@@ -21,7 +22,7 @@ def shader_source(name: str) -> str:
     return _INCLUDE.sub(lambda m: shader_source(m.group(1)), text)
 
 
-def _with_defines(source: str, defines: dict | None) -> str:
+def _with_defines(source: str, defines: Mapping[str, object] | None) -> str:
     if not defines:
         return source
     lines = "".join(f"#define {key} {value}\n" for key, value in defines.items())
@@ -32,7 +33,8 @@ def _with_defines(source: str, defines: dict | None) -> str:
 
 
 def load_program(ctx: moderngl.Context, vertex: str, fragment: str | None = None,
-                 geometry: str | None = None, defines: dict | None = None) -> moderngl.Program:
+                 geometry: str | None = None,
+                 defines: Mapping[str, object] | None = None) -> moderngl.Program:
     """A program from shader files in ``glsl/``, with ``#define key value`` lines after ``#version``."""
     return ctx.program(
         vertex_shader=_with_defines(shader_source(vertex), defines),

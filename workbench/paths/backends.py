@@ -19,6 +19,7 @@ needs to draw and time a path the same way on either renderer:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import moderngl
 
@@ -27,6 +28,11 @@ from ..gl import Framebuffer, GpuTimer, renderer
 from .base import RenderPath
 from .registry import make_path
 from .software import SoftwarePath, SoftwareTarget
+
+if TYPE_CHECKING:
+    from ..gl.camera import Camera
+    from ..scene.protocol import Scene
+    from .style import Style
 
 
 class GLBackend:
@@ -41,7 +47,7 @@ class GLBackend:
     def renderer(self) -> str:
         return renderer(self.ctx)
 
-    def path(self, path, style=None) -> RenderPath:
+    def path(self, path: str | RenderPath, style: object | None = None) -> RenderPath:
         """``path`` (a registry name, made with ``style``, or a GL path) ready to prepare;
         ValueError for a software path."""
         if isinstance(path, str):
@@ -56,7 +62,7 @@ class GLBackend:
     def target(self, size: tuple[int, int], samples: int = 0) -> Framebuffer:
         return Framebuffer(self.ctx, size, samples=samples)
 
-    def prepare(self, path: RenderPath, scene, camera) -> None:
+    def prepare(self, path: RenderPath, scene: Scene, camera: Camera) -> None:
         path.prepare(self.ctx, scene, camera)
         self.ctx.finish()  # the uploads count as preparation
 
@@ -85,7 +91,7 @@ class SoftwareRasterizer:
     def renderer(self) -> str:
         return SoftwarePath("position", options=self.options).renderer
 
-    def path(self, path, style=None) -> SoftwarePath:
+    def path(self, path: str | RenderPath, style: Style | None = None) -> SoftwarePath:
         """The software path of ``path``: a registry name (made with ``style``), a mesh path
         (its name and style) or a software path (as it is)."""
         if isinstance(path, SoftwarePath):
@@ -103,7 +109,7 @@ class SoftwareRasterizer:
             raise ValueError("the software rasterizer draws without MSAA: samples must be 0")
         return SoftwareTarget(size)
 
-    def prepare(self, path: SoftwarePath, scene, camera) -> None:
+    def prepare(self, path: SoftwarePath, scene: Scene, camera: Camera) -> None:
         path.prepare(None, scene, camera)
 
     def bind(self, path: SoftwarePath, target: SoftwareTarget) -> None:
@@ -123,7 +129,7 @@ class SoftwareRasterizer:
 Backend = GLBackend | SoftwareRasterizer
 
 
-def as_backend(backend) -> Backend:
+def as_backend(backend: moderngl.Context | Backend) -> Backend:
     """``backend`` itself, or the GL backend of a moderngl context; TypeError otherwise."""
     if isinstance(backend, (GLBackend, SoftwareRasterizer)):
         return backend

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from contextlib import contextmanager
-from typing import ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Self
 
 import moderngl
 import numpy as np
@@ -52,6 +52,11 @@ from ..gl.camera import check_resolvable
 from ..scene.needs import known_items
 from .registry import register
 from .style import Style
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from ..scene.protocol import Scene
 
 GL_CLIP_DISTANCE0 = 0x3000
 POLYGON_OFFSET = (1.0, 1.0)  # fill pass under a wire frame: (factor, units)
@@ -86,8 +91,9 @@ class RenderPath(ABC):
     style_class: ClassVar[type] = Style
     scene_kinds: ClassVar[frozenset[str]] = frozenset({"mesh"})
     fixed_options: ClassVar[frozenset[str]] = frozenset()
+    style: Any  # an instance of style_class; each path family names its own
 
-    def __init__(self, style=None) -> None:
+    def __init__(self, style: object | None = None) -> None:
         style = style if style is not None else self.style_class()
         if not isinstance(style, self.style_class):
             raise TypeError(f"path {self.name!r} takes a {self.style_class.__name__}, "
@@ -101,16 +107,19 @@ class RenderPath(ABC):
         self.missing_values = 0
 
     @classmethod
-    def default_camera(cls, scene, size: tuple[int, int], *, view=(30.0, 25.0),
-                       projection: str = "orthographic", up: str = "z", style=None) -> Camera:
+    def default_camera(cls, scene: Scene, size: tuple[int, int], *,
+                       view: tuple[float, float] = (30.0, 25.0),
+                       projection: str = "orthographic", up: str = "z",
+                       style: object | None = None) -> Camera:
         """A camera showing all of ``scene`` at ``size`` (W, H): :meth:`Camera.fit_box` over
         ``scene.bounds()`` at azimuth and elevation ``view`` (degrees). Path families whose
         scenes change over time or live in a plane override it."""
         return cls.fit_camera(*scene.bounds(), size, view=view, projection=projection, up=up)
 
     @staticmethod
-    def fit_camera(lo, hi, size: tuple[int, int], *, view=(30.0, 25.0),
-                   projection: str = "orthographic", up: str = "z") -> Camera:
+    def fit_camera(lo: ArrayLike, hi: ArrayLike, size: tuple[int, int], *,
+                   view: tuple[float, float] = (30.0, 25.0), projection: str = "orthographic",
+                   up: str = "z") -> Camera:
         """:meth:`Camera.fit_box` over ``lo``–``hi`` for an image of ``size`` (W, H), after
         :func:`~workbench.gl.camera.check_resolvable` refused a box that cannot be drawn."""
         check_resolvable(lo, hi)
@@ -118,12 +127,12 @@ class RenderPath(ABC):
                               aspect=size[0] / size[1], up=up)
 
     @abstractmethod
-    def prepare(self, ctx: moderngl.Context, scene, camera) -> None:
+    def prepare(self, ctx: moderngl.Context, scene: Scene, camera: Camera) -> None:
         """Upload what the scene gives (derived data already cached by the scene), with
         ``style.step`` drawn, for ``camera``."""
 
     @abstractmethod
-    def set_camera(self, camera) -> None:
+    def set_camera(self, camera: Camera) -> None:
         """Set the camera uniforms; ``camera.origin`` must equal the one given to ``prepare``."""
 
     @abstractmethod
@@ -138,13 +147,13 @@ class RenderPath(ABC):
     def release(self) -> None:
         """Free every GL object the path holds; harmless when nothing is held."""
 
-    def __enter__(self) -> "RenderPath":
+    def __enter__(self) -> Self:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.release()
 
-    def __init_subclass__(cls, **kwargs) -> None:
+    def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
         if "name" in cls.__dict__:
             unknown = cls.needs - known_items()
@@ -165,15 +174,15 @@ class GLPath(RenderPath):
     ``_build`` raises, every object made so far is released.
     """
 
-    def __init__(self, style=None) -> None:
+    def __init__(self, style: object | None = None) -> None:
         super().__init__(style)
-        self.ctx = None
-        self.origin = None
+        self.ctx: moderngl.Context | None = None
+        self.origin: np.ndarray | None = None
         self._objects: list = []
         self._program = self._line_program = self._line_vao = None
         self._textures: list = []  # (texture, unit) bound before each draw
 
-    def prepare(self, ctx: moderngl.Context, scene, camera) -> None:
+    def prepare(self, ctx: moderngl.Context, scene: Scene, camera: Camera) -> None:
         if self.ctx is not None:
             self.release()
         self._check_scene(scene)
@@ -241,7 +250,7 @@ class GLPath(RenderPath):
             for i in range(count):
                 self.ctx.disable_direct(GL_CLIP_DISTANCE0 + i)
 
-    def set_camera(self, camera) -> None:
+    def set_camera(self, camera: Camera) -> None:
         """Camera uniforms for every program: ``mvp``, and where a program has them ``view``,
         ``perspective``, ``eye_position`` and ``eye_axis`` (unit vector from target to eye)."""
         self._require_prepared()

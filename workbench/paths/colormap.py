@@ -28,8 +28,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from ..scene.mesh import FEMesh
 
 LUT_SIZE = 256
 ALPHA_TEST = 0.5
@@ -101,7 +107,7 @@ class ColorScale:
         _lut(self.colormap)  # refuse an unknown name now, not at the first draw
 
     # ------------------------------------------------------------------ mapping
-    def normalise(self, values) -> np.ndarray:
+    def normalise(self, values: ArrayLike) -> np.ndarray:
         """float64 t = (v − lo)/(hi − lo), not clamped (the texture clamps). What is uploaded."""
         lo, hi = self.value_range
         return (np.asarray(values, np.float64) - lo) / (hi - lo)
@@ -146,7 +152,7 @@ class ColorScale:
             texels[(v >= self.hide_range[0]) & (v <= self.hide_range[1]), 3] = 0
         return texels
 
-    def lookup(self, t) -> np.ndarray:
+    def lookup(self, t: ArrayLike) -> np.ndarray:
         """(..., 4) float64 RGBA in [0, 1] that the texture returns for normalised values ``t``."""
         texels = self.texture_data()
         t = np.asarray(t, np.float64)
@@ -155,17 +161,18 @@ class ColorScale:
             return texels[k].astype(np.float64) / 255.0
         return _lerp_table(texels, t) / 255.0
 
-    def evaluate(self, values) -> np.ndarray:
+    def evaluate(self, values: ArrayLike) -> np.ndarray:
         """(..., 4) float64 RGBA in [0, 1] for float64 field ``values``: colour before lighting."""
         return self.lookup(self.normalise(values))
 
-    def visible(self, values) -> np.ndarray:
+    def visible(self, values: ArrayLike) -> np.ndarray:
         """bool: which values pass the alpha test (all of them without a hide_range)."""
         return self.evaluate(values)[..., 3] >= ALPHA_TEST
 
 
-def scale_for(mesh, field: str, colormap: str = "viridis", value_range=None, bands: int = 0,
-              hide_range=None) -> ColorScale:
+def scale_for(mesh: FEMesh, field: str, colormap: str = "viridis",
+              value_range: tuple[float, float] | None = None, bands: int = 0,
+              hide_range: tuple[float, float] | None = None) -> ColorScale:
     """The :class:`ColorScale` of a mesh field; the value range defaults to the field's range
     over all steps (a constant field gets ``(v, v + 1)``)."""
     if value_range is None:

@@ -19,11 +19,17 @@ The pieces a path's preparation produces, in order:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..algo.strips import RESTART, unstripify
 from .colormap import NO_VALUE, ColorScale
+
+if TYPE_CHECKING:
+    from ..scene.crease import GouraudSplit
+    from ..scene.mesh import FEMesh
+    from .style import Style
 
 PRIMITIVES = ("triangles", "triangle_strip")
 
@@ -41,10 +47,10 @@ class Topology:
 
     vertex_node: np.ndarray | None
     triangles: np.ndarray
-    split: object = None
+    split: GouraudSplit | None = None
     split_rows: np.ndarray | None = None
     element_vertex: np.ndarray | None = None
-    attributes: list = field(default_factory=list)
+    attributes: list[tuple[np.ndarray, str, str]] = field(default_factory=list)
 
 
 @dataclass(eq=False)
@@ -77,8 +83,8 @@ class MeshDrawData:
     line-overdraw wire frame (None without); ``triangle_element`` as :class:`Layout`.
     """
 
-    mesh: object
-    style: object
+    mesh: FEMesh
+    style: Style
     vertex_node: np.ndarray | None
     n_vertices: int
     index: np.ndarray
@@ -86,12 +92,12 @@ class MeshDrawData:
     triangles: int
     strips: int
     vertices_sent: int
-    split: object = None
+    split: GouraudSplit | None = None
     split_rows: np.ndarray | None = None
     field_per: str | None = None
     scale: ColorScale | None = None
     element_vertex: np.ndarray | None = None
-    attributes: list = field(default_factory=list)
+    attributes: list[tuple[np.ndarray, str, str]] = field(default_factory=list)
     edges: np.ndarray | None = None
     triangle_element: np.ndarray | None = None
 
@@ -165,7 +171,8 @@ class MeshDrawData:
         return unstripify(np.asarray(self.index, np.uint32)).astype(np.int64)
 
 
-def compact(topology: Topology, layout: Layout, n_nodes: int):
+def compact(topology: Topology, layout: Layout, n_nodes: int
+            ) -> tuple[np.ndarray | None, int, np.ndarray, np.ndarray | None, np.ndarray | None]:
     """Drop the vertices no triangle of ``topology`` uses and renumber: returns
     ``(vertex_node, n_vertices, index, split_rows, remap)`` where ``remap`` (V,) maps old
     vertex numbers to new ones (−1 dropped), None when every vertex is used."""

@@ -55,7 +55,9 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import moderngl
 import numpy as np
@@ -64,6 +66,12 @@ from ..gl import Framebuffer, GpuTimer, SamplesPassed, load_program, write_masks
 from .drawdata import Layout, Topology
 from .mesh import MeshPath
 from .style import Style
+
+if TYPE_CHECKING:
+    from ..algo.explode import ExplodeSettings
+    from ..gl.camera import Camera
+    from ..scene.mesh import FEMesh
+    from .colormap import ColorScale
 
 AXES = ("x", "y", "z")
 NO_PART = np.iinfo(np.int64).min  # what id_image() holds where no part was drawn
@@ -76,7 +84,7 @@ def _explode():
     return explode
 
 
-def parse_plane(spec) -> str | tuple[float, float, float]:
+def parse_plane(spec: str | Sequence[float] | np.ndarray) -> str | tuple[float, float, float]:
     """``"auto"``, an axis name, or a (a, b, c) normal from ``"a,b,c"`` or a 3-sequence;
     ValueError for anything else."""
     if isinstance(spec, str):
@@ -149,7 +157,7 @@ class ExplodeStyle(Style):
         self.focus_color = color
         super().__post_init__()
 
-    def animation_settings(self, o_max: float):
+    def animation_settings(self, o_max: float) -> ExplodeSettings:
         """The dynamics' :class:`~workbench.algo.explode.ExplodeSettings` for ``o_max`` (model
         units): ``speed``, ``dt``, ``ghost_start`` and ``ratio_exponent``, checked there."""
         return _explode().ExplodeSettings(o_max=o_max, speed=self.speed, dt=self.dt,
@@ -165,8 +173,9 @@ class ExplodedPath(MeshPath):
     style_class = ExplodeStyle
     vertex_shader, fragment_shader = "exploded.vert.glsl", "exploded.frag.glsl"
     pick_shader = "exploded_pick.frag.glsl"
+    style: ExplodeStyle
 
-    def __init__(self, style=None) -> None:
+    def __init__(self, style: ExplodeStyle | None = None) -> None:
         super().__init__(style)
         self._pick_program = self._pick_vao = None
         self._scratch: Framebuffer | None = None
@@ -178,7 +187,7 @@ class ExplodedPath(MeshPath):
         self.state = None  # the animation state, from prepare on
 
     # ------------------------------------------------------------------ prepare
-    def check_mesh(self, mesh):
+    def check_mesh(self, mesh: FEMesh) -> ColorScale | None:
         """Refuse as :class:`MeshPath` does, and a focus the mesh cannot show (see the module
         docstring)."""
         scale = super().check_mesh(mesh)
@@ -198,7 +207,7 @@ class ExplodedPath(MeshPath):
                              f"drawable triangle")
         return scale
 
-    def layout(self, mesh, topology: Topology) -> Layout:
+    def layout(self, mesh: FEMesh, topology: Topology) -> Layout:
         """The triangle list sorted by part, the focus first; records each part's range."""
         layout = super().layout(mesh, topology)  # a triangle list (style checked)
         part = mesh.parts[mesh.triangulation.element_of].astype(np.int64)
@@ -264,12 +273,13 @@ class ExplodedPath(MeshPath):
     def _programs(self) -> list:
         return [p for p in (self._program, self._pick_program) if p is not None]
 
-    def set_camera(self, camera) -> None:
+    def set_camera(self, camera: Camera) -> None:
         super().set_camera(camera)
         if self._plane_spec == "auto":
             self._choose_plane(camera)
         self._upload_plane()
-        self._unoccluded = {}  # p_unocc per image size, for this camera and step
+        # p_unocc per image size, for this camera and step
+        self._unoccluded: dict[tuple[tuple[int, ...], int | None], int] = {}
         self._frame_count = None
         if self.state is not None:  # a new view: a held explosion may shrink again
             self.state = _explode().release(self.state)
@@ -467,7 +477,7 @@ class ExplodedPath(MeshPath):
         return self._unoccluded[key], p_occ, dict(gpu_ms=gpu_ms, wall_ms=wall_ms,
                                                   unoccluded_counted=counted)
 
-    def measure_occlusion(self, size=None) -> tuple[int, int, float]:
+    def measure_occlusion(self, size: tuple[int, int] | None = None) -> tuple[int, int, float]:
         """(p_unocc, p_occ, gpu_ms): the focus's visible pixels drawn alone and drawn after both
         halves, counted by occlusion queries in the internal framebuffer (``size``, default the
         bound viewport's); the previously bound framebuffer and viewport are restored."""
@@ -496,11 +506,12 @@ class ExplodedPath(MeshPath):
                                    wall_ms=wall_ms, unoccluded_counted=counted)
         return p_unocc, p_occ
 
-    def occlusion_ratio(self, size=None) -> float:
+    def occlusion_ratio(self, size: tuple[int, int] | None = None) -> float:
         """r = (p_unocc − p_occ)/p_unocc: 1 hidden, 0 revealed (0 as well when off screen)."""
         return _explode().occlusion_ratio(*self.measure_occlusion(size)[:2])
 
-    def step_animation(self, settings=None, size=None) -> float:
+    def step_animation(self, settings: ExplodeSettings | None = None,
+                       size: tuple[int, int] | None = None) -> float:
         """One frame of the dynamics: r at the current offset (from the last frame's own count
         when :meth:`draw` drew the current state, else measured by :meth:`measure_occlusion`),
         advance the state with ``next_state`` (``settings`` default the style's), take its
@@ -518,7 +529,7 @@ class ExplodedPath(MeshPath):
         self.last_r = r
         return r
 
-    def id_image(self, size=None) -> np.ndarray:
+    def id_image(self, size: tuple[int, int] | None = None) -> np.ndarray:
         """(H, W) int64 part ids as picking sees them (row 0 at the top), ``NO_PART`` where
         nothing is drawn."""
         fb = self._draw_ids(size)
@@ -541,7 +552,7 @@ class ExplodedPath(MeshPath):
             self._restore(previous, viewport)
         return fb
 
-    def pick(self, x: int, y: int, size=None) -> int | None:
+    def pick(self, x: int, y: int, size: tuple[int, int] | None = None) -> int | None:
         """The part id drawn at pixel column ``x``, row ``y`` (row 0 at the top) of the current
         image (``size`` default the bound viewport's), None where nothing is drawn."""
         self._require_prepared()
@@ -565,7 +576,7 @@ class ExplodedPath(MeshPath):
         self._pick_program = self._pick_vao = None
 
 
-def exploded_camera(camera, mesh, o_max: float | None = None):
+def exploded_camera(camera: Camera, mesh: FEMesh, o_max: float | None = None) -> Camera:
     """``camera`` with its depth range widened by 2·``o_max`` (default the assembly's
     :func:`~workbench.algo.explode.o_max_of`) on both sides. A camera fitted to the assembly
     encloses the unexploded parts only: a half moved toward or away from the viewer would be

@@ -36,6 +36,8 @@ relative to ``camera.origin`` (float64 subtraction first); clip planes and the c
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import moderngl
 import numpy as np
 
@@ -43,6 +45,10 @@ from ..algo.fepatch.mesh_model import fepatch_model
 from ..algo.fepatch.surface import CORNER_ROW, corner_rows
 from ..gl import Camera, load_program
 from .base import GLPath
+
+if TYPE_CHECKING:
+    from ..scene.protocol import Scene
+    from .style import Style
 
 __all__ = ["FETexturePath", "FEWireTexturePath", "FENormalMapPath", "FENormalWirePath"]
 
@@ -71,6 +77,7 @@ class FETexturePath(GLPath):
     model_surface: str = "simplified"
     normal_map: bool = True
     wire_texture: bool = False
+    style: Style
 
     # ------------------------------------------------------------------ prepare
     def _check_style(self) -> None:
@@ -89,8 +96,10 @@ class FETexturePath(GLPath):
                              f"use strips='none'")
 
     @classmethod
-    def default_camera(cls, scene, size: tuple[int, int], *, view=(30.0, 25.0),
-                       projection: str = "orthographic", up: str = "z", style=None) -> Camera:
+    def default_camera(cls, scene: Scene, size: tuple[int, int], *,
+                       view: tuple[float, float] = (30.0, 25.0),
+                       projection: str = "orthographic", up: str = "z",
+                       style: object | None = None) -> Camera:
         """:meth:`Camera.fit_box` over the surface, or over every step of the mesh whose model
         is drawn."""
         lo, hi = scene.bounds(all_steps=True) if scene.kind == "mesh" else scene.bounds()

@@ -22,12 +22,19 @@ field to the nodes, or a node field to the elements, would be a different field)
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import maximum_bipartite_matching
 
 from .drawdata import Topology
 from .mesh import MeshPath
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from ..scene.mesh import FEMesh
 
 
 class VertexColorPath(MeshPath):
@@ -59,7 +66,7 @@ class ElementColorPath(MeshPath):
     vertex_shader, fragment_shader = "element_color.vert.glsl", "element_color.frag.glsl"
     field_per = "element"
 
-    def topology(self, mesh) -> Topology:
+    def topology(self, mesh: FEMesh) -> Topology:
         """The mesh nodes plus the duplicates :func:`provoking_vertices` needs, each element's
         triangles rotated so that its own vertex comes last."""
         vertex_node, triangles, provoking = provoking_vertices(
@@ -67,7 +74,8 @@ class ElementColorPath(MeshPath):
         return Topology(vertex_node, triangles, element_vertex=provoking)
 
 
-def provoking_vertices(triangles, element_of, n_nodes: int, n_elements: int):
+def provoking_vertices(triangles: ArrayLike, element_of: ArrayLike, n_nodes: int,
+                       n_elements: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Give every element its own provoking vertex, for ``flat`` per-element attributes.
 
     ``triangles`` (K, 3) node indices and ``element_of`` (K,) their elements, non-decreasing

@@ -23,12 +23,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..algo.part_distance import flange_distances
 from .fields import PixelColorPath
 from .style import Style
+
+if TYPE_CHECKING:
+    from ..scene.mesh import FEMesh
+    from .colormap import ColorScale
 
 FIELD = "part_distance"
 SHOWS = ("flanges", "distance")
@@ -81,8 +86,9 @@ class FlangePath(PixelColorPath):
     name = "flange"
     needs = frozenset({"gouraud", "part_distances"})
     style_class = FlangeStyle
+    style: FlangeStyle
 
-    def check_mesh(self, mesh):
+    def check_mesh(self, mesh: FEMesh) -> ColorScale | None:
         """Install the node field ``part_distance`` on ``mesh`` from its cached distances (far
         nodes hidden with the flanges, drawn in ``base_color`` on the map), then check as
         ``pixel_color`` does."""

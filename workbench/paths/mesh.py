@@ -14,7 +14,7 @@ may be overridden to number the vertices or lay out the index buffer differently
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import moderngl
 import numpy as np
@@ -25,10 +25,14 @@ from .base import GLPath
 from .colormap import ColorScale, scale_for
 from .drawdata import Layout, MeshDrawData, Topology, compact, vertex_of_node
 
+if TYPE_CHECKING:
+    from ..scene.mesh import FEMesh
+    from ..scene.protocol import Scene
+
 PRIMITIVE_MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP}
 
 
-def field_kind(mesh, name: str) -> str:
+def field_kind(mesh: FEMesh, name: str) -> str:
     """'node' or 'element' for a field of ``mesh``; KeyError listing the mesh's fields otherwise."""
     if name in mesh.node_fields:
         return "node"
@@ -45,17 +49,20 @@ class MeshPath(GLPath):
     fragment_shader: ClassVar[str]
     split: ClassVar[bool] = False
     field_per: ClassVar[str | None] = None
+    style: Style
 
     @classmethod
-    def default_camera(cls, scene, size: tuple[int, int], *, view=(30.0, 25.0),
-                       projection: str = "orthographic", up: str = "z", style=None) -> Camera:
+    def default_camera(cls, scene: Scene, size: tuple[int, int], *,
+                       view: tuple[float, float] = (30.0, 25.0),
+                       projection: str = "orthographic", up: str = "z",
+                       style: object | None = None) -> Camera:
         """:meth:`Camera.fit_box` over the bounds of every step of the mesh at azimuth and
         elevation ``view`` (degrees)."""
         return cls.fit_camera(*scene.bounds(all_steps=True), size, view=view,
                               projection=projection, up=up)
 
     # ------------------------------------------------------------------ draw data (GL-free)
-    def check_mesh(self, mesh) -> ColorScale | None:
+    def check_mesh(self, mesh: FEMesh) -> ColorScale | None:
         """Refuse a mesh or style this path cannot draw (ValueError, KeyError for an unknown
         field); the colour scale of the field drawn (None without a field)."""
         if getattr(mesh, "kind", None) != "mesh":
@@ -84,7 +91,7 @@ class MeshPath(GLPath):
             raise ValueError(f"path {self.name!r} draws {self.field_per} fields, {name!r} is "
                              f"{article} {kind} field: draw it with {other}")
 
-    def topology(self, mesh) -> Topology:
+    def topology(self, mesh: FEMesh) -> Topology:
         """The drawn vertices and triangles: the crease-split vertices (``split``) or the mesh
         nodes, triangles in the triangulation's order."""
         if self.split:
@@ -92,7 +99,7 @@ class MeshPath(GLPath):
             return Topology(np.asarray(split.vertex_node, np.int64), split.triangles, split=split)
         return Topology(None, mesh.triangles)
 
-    def layout(self, mesh, topology: Topology) -> Layout:
+    def layout(self, mesh: FEMesh, topology: Topology) -> Layout:
         """The index buffer for ``Style.strips`` and ``Style.quad_diagonal`` (see
         :class:`Layout`); ValueError for strips of a path whose vertices are not shared."""
         style, triangles = self.style, topology.triangles
@@ -120,7 +127,7 @@ class MeshPath(GLPath):
                           tri.n_vertices)
         return Layout(triangles, "triangles", len(triangles), 0, triangles.size)
 
-    def draw_data(self, mesh) -> MeshDrawData:
+    def draw_data(self, mesh: FEMesh) -> MeshDrawData:
         """What this path draws of ``mesh`` with its style, GL-free (refusals as
         :meth:`check_mesh` and :meth:`layout`)."""
         scale = self.check_mesh(mesh)

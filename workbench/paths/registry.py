@@ -7,18 +7,52 @@ itself on definition; :func:`make_path` makes one by name with its style's optio
 
 from __future__ import annotations
 
-PATHS: dict[str, type] = {}
+from typing import TYPE_CHECKING, Any, Protocol
+
+if TYPE_CHECKING:
+    from ..gl.camera import Camera
+    from ..scene.protocol import Scene
+
+
+class PathClass(Protocol):
+    """A registered path class as the registry sees it: a subclass of
+    :class:`~workbench.paths.base.RenderPath` (not imported here: that module imports this one
+    to register its subclasses), called with a style to make a path."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def style_class(self) -> type: ...
+
+    @property
+    def scene_kinds(self) -> frozenset[str]: ...
+
+    @property
+    def fixed_options(self) -> frozenset[str]: ...
+
+    @property
+    def needs(self) -> frozenset[str]: ...
+
+    def default_camera(self, scene: Scene, size: tuple[int, int], *,
+                       view: tuple[float, float] = ..., projection: str = ..., up: str = ...,
+                       style: object | None = None) -> Camera: ...
+
+    def __call__(self, style: Any = None) -> Any: ...
+
+
+PATHS: dict[str, PathClass] = {}
 
 # the path a scene of each kind is drawn with when none is named
 DEFAULT_PATHS = {"mesh": "gouraud", "spacetime": "spacetime_pixel", "surface": "fe_normal_map"}
 
 
-def register(cls: type) -> None:
+def register(cls: PathClass) -> None:
     """Put path class ``cls`` in the registry under ``cls.name``."""
     PATHS[cls.name] = cls
 
 
-def path_class(name: str) -> type:
+def path_class(name: str) -> PathClass:
     """The registered path class ``name``; ValueError listing the registry otherwise."""
     try:
         return PATHS[name]
@@ -26,7 +60,7 @@ def path_class(name: str) -> type:
         raise ValueError(f"unknown render path {name!r}; known paths: {sorted(PATHS)}") from None
 
 
-def make_path(name: str, style=None, **options):
+def make_path(name: str, style: object | None = None, **options: Any) -> Any:
     """A new, unprepared path of registry ``name`` with ``style`` (an instance of the path's
     ``style_class``) or, instead, ``options`` naming fields of that class; ValueError for an
     unknown path, or for an option the path does not take (naming it and the known ones)."""
@@ -45,7 +79,7 @@ def path_options(name: str) -> frozenset[str]:
     return frozenset(cls.style_class.__dataclass_fields__) - cls.fixed_options
 
 
-def check_options(name: str, options: dict) -> dict:
+def check_options(name: str, options: dict[str, Any]) -> dict[str, Any]:
     """``options`` unchanged when path ``name`` takes every key; ValueError naming the first
     unknown key and the known ones otherwise."""
     known = path_options(name)
@@ -62,7 +96,7 @@ def paths_for(kind: str) -> list[str]:
     return sorted(name for name, cls in PATHS.items() if kind in cls.scene_kinds)
 
 
-def default_path(scene, field: str | None = None) -> str:
+def default_path(scene: Scene, field: str | None = None) -> str:
     """The path ``scene`` is drawn with when none is named: for an FE mesh ``gouraud``, or with
     a ``field`` ``element_color`` (an element field) or ``pixel_color`` (a node field); the
     per-pixel path for a spacetime scene; the normal-map path for a textured surface."""

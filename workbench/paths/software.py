@@ -17,12 +17,22 @@ rasterizer is orthographic, as es2008's), MSAA samples.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
 from ..algo.softraster import Frame, RasterOptions, Shading, render
 from .base import RenderPath
 from .colormap import NO_VALUE
 from .registry import path_class
+
+if TYPE_CHECKING:
+    import moderngl
+    from numpy.typing import ArrayLike
+
+    from ..gl.camera import Camera
+    from ..scene.protocol import Scene
+    from .style import Style
 
 SHADING_OF = {"position": "constant", "flat": "flat", "gouraud": "gouraud",
               "vertex_color": "vertex_color", "pixel_color": "pixel_color",
@@ -43,7 +53,8 @@ class SoftwareTarget:
     def use(self) -> None:
         """Nothing to bind: the path draws into ``frame``."""
 
-    def clear(self, color=(1.0, 1.0, 1.0, 1.0), depth: float = 1.0) -> None:
+    def clear(self, color: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0),
+              depth: float = 1.0) -> None:
         rgba = np.rint(np.clip(np.asarray(color, np.float64), 0, 1) * 255).astype(np.uint8)
         self.frame.color[...] = rgba
         self.frame.depth[...] = depth
@@ -62,8 +73,9 @@ class SoftwarePath(RenderPath):
 
     rasterizer = "software"
     needs = frozenset({"triangles"})  # replaced by the drawn path's
+    style: Style
 
-    def __init__(self, name: str = "pixel_color", style=None,
+    def __init__(self, name: str = "pixel_color", style: Style | None = None,
                  options: RasterOptions = RasterOptions()) -> None:
         cls = path_class(name)
         if name not in SHADING_OF:
@@ -86,7 +98,7 @@ class SoftwarePath(RenderPath):
         self._workspace: dict = {}
 
     @classmethod
-    def default_camera(cls, scene, size, **kwargs):
+    def default_camera(cls, scene: Scene, size: tuple[int, int], **kwargs: Any) -> Camera:
         """The camera of the mesh paths."""
         return path_class("position").default_camera(scene, size, **kwargs)
 
@@ -107,7 +119,7 @@ class SoftwarePath(RenderPath):
         return self.target
 
     # ------------------------------------------------------------------ prepare
-    def prepare(self, ctx, mesh, camera) -> None:
+    def prepare(self, ctx: moderngl.Context | None, mesh: Scene, camera: Camera) -> None:
         """Build the drawn path's draw data for ``mesh`` (``ctx`` is not used: no GL)."""
         style = self.style
         if camera.projection != "orthographic":
@@ -132,7 +144,7 @@ class SoftwarePath(RenderPath):
         self.set_camera(camera)
         self.set_step(style.step)
 
-    def set_camera(self, camera) -> None:
+    def set_camera(self, camera: Camera) -> None:
         if self.mesh is None:
             raise RuntimeError(f"software path {self.name!r} is not prepared")
         if not np.array_equal(np.asarray(camera.origin, np.float64), self.origin):
@@ -181,7 +193,8 @@ class SoftwarePath(RenderPath):
             triangle_values=self._triangle_values, clip_planes=self._planes,
             frame=self.target.frame, vectorized=vectorized, workspace=self._workspace)
 
-    def render_triangles(self, ids, background=(255, 255, 255, 255)) -> Frame:
+    def render_triangles(self, ids: ArrayLike,
+                         background: tuple[int, int, int, int] = (255, 255, 255, 255)) -> Frame:
         """A new frame of :attr:`target`'s size (``make_target`` first) with only the triangles
         ``ids`` of the path's triangle list drawn, keeping their indices in that list as the
         frame's triangle indices: the frame of one domain for sort-last compositing."""

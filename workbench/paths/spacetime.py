@@ -43,6 +43,7 @@ evaluation at pixel centres is the exact image the paths are measured against.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import moderngl
 import numpy as np
@@ -55,6 +56,11 @@ from ..gl.camera import Camera
 from ..gl.texbuffer import TextureBuffer
 from .base import GLPath
 from .colormap import colormap_lut
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from ..scene.protocol import Scene
 
 SHADINGS = ("per_vertex", "per_pixel")
 OVERDRAWS = ("none", "over", "behind", "skirts")
@@ -99,7 +105,8 @@ class SpacetimeStyle:
             raise ValueError(f"height_scale must be non-negative and finite, got {self.height_scale}")
 
 
-def top_camera(grid, z_range: tuple[float, float] = (-1.0, 1.0), origin=None) -> Camera:
+def top_camera(grid: PixelGrid, z_range: tuple[float, float] = (-1.0, 1.0),
+               origin: ArrayLike | None = None) -> Camera:
     """An orthographic camera looking down −z whose pixels are exactly those of ``grid``
     (a :class:`workbench.algo.spacetime.raster.PixelGrid`): pixel centres of the image read
     back are the grid's centres, so the exact image and the rendered one match pixel for pixel.
@@ -129,6 +136,7 @@ class SpacetimePath(GLPath):
     needs = frozenset()
     style_class = SpacetimeStyle
     scene_kinds = frozenset({"spacetime"})
+    style: SpacetimeStyle
 
     def __init__(self, style: SpacetimeStyle | None = None) -> None:
         super().__init__(style)
@@ -146,8 +154,10 @@ class SpacetimePath(GLPath):
         return self.style.edge_overdraw in ("behind", "skirts")
 
     @classmethod
-    def default_camera(cls, scene, size: tuple[int, int], *, view=(30.0, 25.0),
-                       projection: str = "orthographic", up: str = "z", style=None) -> Camera:
+    def default_camera(cls, scene: Scene, size: tuple[int, int], *,
+                       view: tuple[float, float] = (30.0, 25.0),
+                       projection: str = "orthographic", up: str = "z",
+                       style: object | None = None) -> Camera:
         """The top view of the scene's drawing plane ((x, y) or (x, t), heights up z) whose
         pixel centres are those of :meth:`PixelGrid.fit`, so that the exact image matches; its
         depth range encloses the heights drawn with ``style.height_scale``. ``view``,

@@ -12,8 +12,12 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
 
 MAX_CLIP_PLANES = 4
 STRIPS = ("none", "triangle", "quad")
@@ -120,7 +124,7 @@ def _word(value) -> str:
     return f"{value:.6g}" if isinstance(value, float) else str(value)
 
 
-def style_summary(style) -> str:
+def style_summary(style: DataclassInstance) -> str:
     """The fields of ``style`` (any path's style dataclass) that differ from its class's
     defaults, as ``name=value`` words: :meth:`Style.summary` for the mesh styles."""
     if isinstance(style, Style):

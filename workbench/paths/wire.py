@@ -23,6 +23,7 @@ The coordinate is per strip, so the strips' vertices are uploaded once per strip
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -30,13 +31,18 @@ from ..algo.strips import RESTART, join_strips, quad_strips, unstripify
 from .drawdata import Layout, Topology
 from .mesh import MeshPath
 
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from ..scene.mesh import FEMesh
+
 # boundary bits of the flat per-triangle mask: which iso-lines of the wire coordinate are
 # element edges no other element shares
 U0, U1, V0, V1, W0 = 1, 2, 4, 8, 16
 TRIANGLE = 32  # u = 1 and v = 1 are corners of a triangle, not edges
 
 
-def single_use_edges(elements, pairs) -> np.ndarray:
+def single_use_edges(elements: ArrayLike, pairs: ArrayLike) -> np.ndarray:
     """(P,) bool: whether each node pair of ``pairs`` (P, 2) is an edge of exactly one
     non-degenerate element of ``elements`` ((M, 4) node indices, triangles repeating c)."""
     from ..scene.derived import classify_elements
@@ -70,7 +76,7 @@ class QuadWirePath(MeshPath):
     vertex_shader, fragment_shader = "quad_wire.vert.glsl", "quad_wire.frag.glsl"
     split = True
 
-    def topology(self, mesh) -> StripTopology:
+    def topology(self, mesh: FEMesh) -> StripTopology:
         """The crease-split vertices once per strip they belong to, with the wire coordinate
         and the boundary bits as static attributes; ValueError for a second wire frame or for
         anything but quad strips."""
@@ -139,7 +145,9 @@ class QuadWirePath(MeshPath):
             mask[first + 3 * np.arange(len(tri)) + 2] = bits
         return mask
 
-    def layout(self, mesh, topology: StripTopology) -> Layout:
+    # this path's layout is only ever given its own topology (draw_data passes it on)
+    def layout(self, mesh: FEMesh,  # type: ignore[override]
+               topology: StripTopology) -> Layout:
         """The strips over the strip vertices, each sent once."""
         return Layout(topology.draw_index, "triangle_strip", len(topology.triangles),
                       topology.n_strips, len(topology.vertex_node))

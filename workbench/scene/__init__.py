@@ -1,6 +1,7 @@
-"""FE scene model: the FEMesh data model, derived data, readers and generators."""
+"""FE scene model: FEMesh, the Scene protocol, derived data, readers and generators."""
 
 from .mesh import FEMesh, MeshError
+from .protocol import Scene
 from .readers import ParseError, load
 
-__all__ = ["FEMesh", "MeshError", "ParseError", "load"]
+__all__ = ["FEMesh", "MeshError", "ParseError", "Scene", "load"]

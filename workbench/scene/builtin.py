@@ -22,10 +22,18 @@ from dataclasses import dataclass
 from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
+from typing import TYPE_CHECKING, TypeVar
 
 from ..data import CAR_DECK, D3PLOT, shared_file
+from .protocol import Scene
+
+if TYPE_CHECKING:
+    from .mesh import FEMesh
 
 ENTRY_POINTS = "workbench.scenes"
+
+# a scene's make(size, quick), kept with its own signature by the decorator
+_Make = TypeVar("_Make", bound=Callable[[int | None, bool], Scene])
 
 
 @dataclass(frozen=True)
@@ -34,7 +42,7 @@ class BuiltinScene:
     ``name:SIZE``; ``description`` is one line for listings."""
 
     name: str
-    make: Callable
+    make: Callable[[int | None, bool], Scene]
     description: str
     sized: bool
 
@@ -43,11 +51,12 @@ SCENES: dict[str, BuiltinScene] = {}
 _discovered = False
 
 
-def builtin(name: str, description: str, *, sized: bool = False):
+def builtin(name: str, description: str, *,
+            sized: bool = False) -> Callable[[_Make], _Make]:
     """Decorator registering ``make(size, quick)`` as built-in scene ``name``; ``size`` is None
     unless the scene is ``sized`` and the spec gave one. Returns the function unchanged."""
 
-    def register(make: Callable) -> Callable:
+    def register(make: _Make) -> _Make:
         SCENES[name] = BuiltinScene(name, make, description, sized)
         return make
 
@@ -70,7 +79,7 @@ def scene_names() -> tuple[str, ...]:
     return tuple(sorted(discover()))
 
 
-def builtin_scene(name: str, quick: bool = False, size: int | None = None):
+def builtin_scene(name: str, quick: bool = False, size: int | None = None) -> Scene:
     """The built-in scene ``name`` (see the module docstring), ``size`` its size parameter
     where it takes one; KeyError for an unknown name, ValueError for a size it does not take,
     FileNotFoundError if its data is absent."""
@@ -106,7 +115,7 @@ def parse_scene_spec(spec: str) -> tuple[str, int | None] | None:
     return None
 
 
-def load_scene(spec: str, quick: bool = False, all_faces: bool = False):
+def load_scene(spec: str, quick: bool = False, all_faces: bool = False) -> Scene:
     """A built-in scene by name (see :func:`parse_scene_spec`), else a mesh file read by
     :func:`workbench.scene.readers.load` (``all_faces``: every face of its solids, not only
     their boundary); an existing file wins over a built-in name."""
@@ -119,7 +128,7 @@ def load_scene(spec: str, quick: bool = False, all_faces: bool = False):
     return load(spec, all_faces=all_faces)
 
 
-def fresh_scene(spec: str, quick: bool = False):
+def fresh_scene(spec: str, quick: bool = False) -> Scene:
     """Scene ``spec`` as nobody has drawn it yet, so that what a path derives is computed (and
     counted) anew: loaded once per process (:func:`load_scene`), an FE mesh is handed out as a
     new instance sharing the loaded arrays without their derived caches; other scenes derive
@@ -132,7 +141,7 @@ def fresh_scene(spec: str, quick: bool = False):
 
 
 @lru_cache(maxsize=4)
-def loaded_scene(spec: str, quick: bool = False):
+def loaded_scene(spec: str, quick: bool = False) -> Scene:
     """Scene ``spec`` loaded once per process (the last four specs kept) and shared: what it
     derives is kept for every later caller, so treat it as read-only."""
     return load_scene(spec, quick)
@@ -150,25 +159,25 @@ def _shared_mesh(name: str, relative: Path):
 
 
 @builtin("car", "the shared LS-DYNA car deck")
-def car(size: int | None, quick: bool):
+def car(size: int | None, quick: bool) -> FEMesh:
     return _shared_mesh("car", CAR_DECK)
 
 
 @builtin("d3plot", "the shared d3plot result")
-def d3plot(size: int | None, quick: bool):
+def d3plot(size: int | None, quick: bool) -> FEMesh:
     return _shared_mesh("d3plot", D3PLOT)
 
 
 @builtin("semicylinders", "the es2008 benchmark, N×N quads per sheet (default 250: 1 M "
                           "triangles)", sized=True)
-def semicylinders(size: int | None, quick: bool):
+def semicylinders(size: int | None, quick: bool) -> FEMesh:
     from .generators import semicylinders
 
     return semicylinders(n=size or (64 if quick else 250))
 
 
 @builtin("panels", "generated stamped sheet-metal parts, about Q quads", sized=True)
-def panels(size: int | None, quick: bool):
+def panels(size: int | None, quick: bool) -> FEMesh:
     from .generators import stamped_panels
 
     return stamped_panels(size or (26_284 if quick else 255_641))

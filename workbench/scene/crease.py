@@ -9,7 +9,9 @@ float64 coordinates in model units, degenerate elements yielding no smooth-group
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numba
 import numpy as np
@@ -27,6 +29,9 @@ from .derived import (
     as_elements,
     classify_elements,
 )
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["GouraudSplit", "gouraud_split"]
 
@@ -61,7 +66,7 @@ class GouraudSplit:
     def n_vertices(self) -> int:
         return len(self.vertex_node)
 
-    def normals(self, coords) -> np.ndarray:
+    def normals(self, coords: ArrayLike) -> np.ndarray:
         """(V, 3) float64 unit vertex normals for node coordinates ``coords`` (N, 3) of any step.
 
         Per vertex: the area-weighted average of the normals of the elements in its smooth
@@ -109,7 +114,8 @@ def _split_normals(elements, coords, corner_element, corner_vertex, corner_sign,
     return out
 
 
-def gouraud_split(elements, coords_list, crease_deg: float, triangulation: Triangulation) -> GouraudSplit:
+def gouraud_split(elements: ArrayLike, coords_list: np.ndarray | Sequence[ArrayLike],
+                  crease_deg: float, triangulation: Triangulation) -> GouraudSplit:
     """Duplicate vertices along creases so that each side of a crease gets its own normal.
 
     An edge shared by two elements is a crease when the angle between their element normals

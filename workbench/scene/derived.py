@@ -21,8 +21,12 @@ The crease split of the vertices, which builds on these, is :mod:`workbench.scen
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = [
     "Triangulation",
@@ -48,7 +52,7 @@ _NEXT = np.array([1, 2, 3, 0])
 
 
 # --------------------------------------------------------------------------- input checks
-def as_elements(elements) -> np.ndarray:
+def as_elements(elements: ArrayLike) -> np.ndarray:
     """``elements`` as (M, 4) int32 C-contiguous node indices (a view where it already is one).
 
     (M, 3) triangles are padded by repeating their third node. Refuses with ValueError any other
@@ -72,7 +76,7 @@ def as_elements(elements) -> np.ndarray:
     return np.ascontiguousarray(e, dtype=np.int32)
 
 
-def as_coords(coords, elements: np.ndarray, what: str = "coords") -> np.ndarray:
+def as_coords(coords: ArrayLike, elements: np.ndarray, what: str = "coords") -> np.ndarray:
     """``coords`` as (N, 3) float64 coordinates in model units (a view where it already is one).
 
     ``elements`` are node indices as returned by :func:`as_elements`. Refuses with ValueError,
@@ -175,7 +179,7 @@ class Triangulation:
         return len(self.triangles)
 
 
-def triangulate(elements, nodes) -> Triangulation:
+def triangulate(elements: ArrayLike, nodes: ArrayLike) -> Triangulation:
     """Split elements into triangles, quads along their shorter diagonal.
 
     A quad (a, b, c, d) becomes (a, b, c), (a, c, d) when |a - c| <= |b - d| (compared as squared
@@ -219,7 +223,7 @@ def triangulate(elements, nodes) -> Triangulation:
 
 
 # --------------------------------------------------------------------------- edges
-def unique_edges(elements) -> np.ndarray:
+def unique_edges(elements: ArrayLike) -> np.ndarray:
     """(E, 2) int32 unique element edges: each row (lo, hi), rows sorted lexicographically.
 
     The edges are the element's cyclic corner pairs (a, b), (b, c), (c, d), (d, a) -- quad edges,
@@ -242,7 +246,7 @@ def unique_edges(elements) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- normals
-def element_normals(elements, coords) -> np.ndarray:
+def element_normals(elements: ArrayLike, coords: ArrayLike) -> np.ndarray:
     """(M, 3) float64 unit normals of the elements at ``coords`` (N, 3).
 
     Quad normal: normalised cross(c - a, d - b) of the diagonals; triangle (a, b, c, c):
@@ -256,7 +260,7 @@ def element_normals(elements, coords) -> np.ndarray:
     return _unit_or_zero(n, ok)
 
 
-def node_normals(elements, coords) -> np.ndarray:
+def node_normals(elements: ArrayLike, coords: ArrayLike) -> np.ndarray:
     """(N, 3) float64 unit node normals: area-weighted average of the adjacent element normals.
 
     Each element adds its vector area (area times unit normal, as oriented by its winding) once

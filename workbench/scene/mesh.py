@@ -14,9 +14,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from .crease import GouraudSplit
+    from .derived import Triangulation
 
 
 class MeshError(ValueError):
@@ -45,7 +51,7 @@ class FEMesh:
     name: str = "mesh"
     units: str = "mm"
     # what render paths made the mesh derive, by cache key (see workbench.scene.needs)
-    derived: dict = field(default_factory=dict, init=False, repr=False)
+    derived: dict[tuple[Any, ...], Any] = field(default_factory=dict, init=False, repr=False)
 
     kind: ClassVar[str] = "mesh"
 
@@ -162,7 +168,7 @@ class FEMesh:
         lo, hi = self.bounds(step, all_steps)
         return (lo + hi) / 2.0, float(np.linalg.norm(hi - lo) / 2.0)
 
-    def translated(self, offset) -> "FEMesh":
+    def translated(self, offset: ArrayLike) -> FEMesh:
         """A copy moved by ``offset`` (model units); topology and fields are shared."""
         offset = np.asarray(offset, dtype=np.float64)
         return FEMesh(
@@ -208,7 +214,7 @@ class FEMesh:
 
     # ----------------------------------------------------------------- derived (cached)
     @property
-    def triangulation(self):
+    def triangulation(self) -> Triangulation:
         """:class:`~workbench.scene.derived.Triangulation`: quads split along the shorter
         diagonal (derived once, see :mod:`workbench.scene.needs`)."""
         from .needs import triangulation
@@ -240,7 +246,7 @@ class FEMesh:
 
         return node_normals(self.elements, self.coordinates(step))
 
-    def gouraud(self, crease_deg: float = 30.0):
+    def gouraud(self, crease_deg: float = 30.0) -> GouraudSplit:
         """:class:`~workbench.scene.crease.GouraudSplit` for this crease angle (derived once
         per angle). Creases are detected on the first and last time steps together
         (crash2000, Fig. 2)."""

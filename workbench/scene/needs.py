@@ -31,12 +31,35 @@ import functools
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol, TypeVar, cast
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from .crease import GouraudSplit
+    from .derived import Triangulation
+
 # the items derived for the mesh paths; "fepatch" is the texture paths' own and far costlier
 MESH_ITEMS = ("triangles", "edges", "gouraud")
+
+_Compute = TypeVar("_Compute", bound=Callable[..., Any])
+
+
+class MeshLike(Protocol):
+    """What this module reads of a mesh; an :class:`~workbench.scene.mesh.FEMesh` meets it.
+    (The mesh class is not imported here: :mod:`workbench.scene.mesh` imports this module.)"""
+
+    __dataclass_fields__: ClassVar[dict[str, Any]]
+    nodes: np.ndarray
+    elements: np.ndarray
+    parts: np.ndarray | None
+    steps: np.ndarray | None
+    derived: dict[tuple[Any, ...], Any]
+
+    @property
+    def n_steps(self) -> int: ...
+
+    def coordinates(self, step: int | None = None) -> np.ndarray: ...
 
 
 @dataclass(frozen=True)
@@ -52,7 +75,7 @@ class DerivedItem:
     from_style: Callable[[Any], tuple]
     brings: tuple[str, ...] = ()
 
-    def cache_key(self, *arguments) -> tuple:
+    def cache_key(self, *arguments: Any) -> tuple:
         return (self.name, *self.key(*arguments))
 
 
@@ -65,7 +88,7 @@ def _no_parameters() -> tuple:
 
 def derived_item(name: str, *, key: Callable[..., tuple] = _no_parameters,
                  from_style: Callable[[Any], tuple] = lambda style: (),
-                 brings: tuple[str, ...] = ()):
+                 brings: tuple[str, ...] = ()) -> Callable[[_Compute], _Compute]:
     """Register ``compute(mesh, *parameters)`` as derived item ``name`` and return its cached
     accessor (same signature): the first call per mesh and parameters computes, later calls
     return the value kept in ``mesh.derived``. ``key`` normalises the accessor's arguments into
@@ -73,7 +96,7 @@ def derived_item(name: str, *, key: Callable[..., tuple] = _no_parameters,
     ``from_style`` gives those arguments from a path's style. Refuses (ValueError) a name that
     is already registered by another function."""
 
-    def register(compute: Callable[..., Any]) -> Callable[..., Any]:
+    def register(compute: _Compute) -> _Compute:
         old = ITEMS.get(name)
         if old is not None and (old.compute.__module__, old.compute.__qualname__) != (
                 compute.__module__, compute.__qualname__):
@@ -86,7 +109,7 @@ def derived_item(name: str, *, key: Callable[..., tuple] = _no_parameters,
         def cached(mesh, *arguments):
             return _value(mesh, item, item.key(*arguments))
 
-        return cached
+        return cast(_Compute, cached)
 
     return register
 
@@ -115,7 +138,7 @@ def known_items() -> frozenset[str]:
 
 # ------------------------------------------------------------------------- the mesh's own items
 @derived_item("triangles")
-def triangulation(mesh):
+def triangulation(mesh: MeshLike) -> Triangulation:
     """:class:`~workbench.scene.derived.Triangulation` of ``mesh``: quads split along the shorter
     diagonal."""
     from .derived import triangulate
@@ -124,7 +147,7 @@ def triangulation(mesh):
 
 
 @derived_item("edges")
-def edges(mesh) -> np.ndarray:
+def edges(mesh: MeshLike) -> np.ndarray:
     """(E, 2) int32 unique element edges of ``mesh`` (quad edges only, no diagonals)."""
     from .derived import unique_edges
 
@@ -134,7 +157,7 @@ def edges(mesh) -> np.ndarray:
 @derived_item("gouraud", key=lambda crease_deg=30.0: (float(crease_deg),),
               from_style=lambda style: (getattr(style, "crease_deg", 30.0),),
               brings=("triangles",))
-def gouraud(mesh, crease_deg: float):
+def gouraud(mesh: MeshLike, crease_deg: float) -> GouraudSplit:
     """:class:`~workbench.scene.crease.GouraudSplit` of ``mesh`` at ``crease_deg`` degrees.
     Creases are detected on the first and last time steps together (crash2000, Fig. 2)."""
     from .crease import gouraud_split
@@ -151,7 +174,7 @@ class Derivation:
     """What one :func:`derive` call computed: ``items`` (name → (ms, bytes)) of the items that
     were not cached yet; ``ms`` and ``nbytes`` are their totals (0 when all were cached)."""
 
-    items: dict
+    items: dict[str, tuple[float, int]]
 
     @property
     def ms(self) -> float:
@@ -162,7 +185,7 @@ class Derivation:
         return int(sum(nbytes for _, nbytes in self.items.values()))
 
 
-def derived_items(mesh) -> set[tuple]:
+def derived_items(mesh: MeshLike) -> set[tuple]:
     """The cache keys ``mesh`` holds now (see the module docstring)."""
     return set(mesh.derived)
 
@@ -182,7 +205,7 @@ def _order(needs: Iterable[str]) -> list[str]:
     return order
 
 
-def needed_items(needs: Iterable[str], style) -> set[tuple]:
+def needed_items(needs: Iterable[str], style: object) -> set[tuple]:
     """The cache keys that ``needs`` asks for under ``style``, with what the items bring."""
     keys = set()
     for name in _order(needs):
@@ -191,7 +214,7 @@ def needed_items(needs: Iterable[str], style) -> set[tuple]:
     return keys
 
 
-def nbytes_of(value, exclude=()) -> int:
+def nbytes_of(value: object, exclude: Iterable[np.ndarray] = ()) -> int:
     """Bytes of the numpy arrays held by ``value`` (an array, a dataclass or object of arrays,
     or a list/tuple/dict of them), shared arrays counted once and the arrays of ``exclude``
     (say, the mesh's own nodes and elements) not at all."""
@@ -217,7 +240,7 @@ def nbytes_of(value, exclude=()) -> int:
     return walk(value)
 
 
-def derive(mesh, needs: Iterable[str], style) -> Derivation:
+def derive(mesh: MeshLike, needs: Iterable[str], style: object) -> Derivation:
     """Compute on ``mesh`` the items of ``needs`` (and what they bring) it does not hold yet,
     with the parameters ``style`` gives (crease angle, fe2003 parameters …); returns their cost
     in ms and bytes. A brought item goes first, so that, say, a Gouraud split's cost excludes
@@ -244,7 +267,7 @@ def _arrays_of(mesh, name: str, style) -> list[np.ndarray]:
     return [] if value is None else [a for a in vars(value).values() if isinstance(a, np.ndarray)]
 
 
-def derivation_cost(mesh, needs: Iterable[str], style) -> Derivation:
+def derivation_cost(mesh: MeshLike, needs: Iterable[str], style: object) -> Derivation:
     """What deriving ``needs`` costs from nothing: :func:`derive` on a fresh copy of ``mesh``
     (same arrays, no cached items), so the mesh given keeps its caches untouched."""
     fresh = dataclasses.replace(mesh)

@@ -3,6 +3,8 @@ and per-element plastic strain."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from ..derived import element_normals, node_normals
@@ -14,7 +16,7 @@ _AXES = {"x": 0, "y": 1, "z": 2}
 
 def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str = "-x", *,
                    fold_wavelength: float | None = None, duration: float = 0.1,
-                   still_parts=()) -> FEMesh:
+                   still_parts: Sequence[int] = ()) -> FEMesh:
     """A copy of ``mesh`` with ``steps`` time steps of a smooth, progressive front crush.
 
     The impactor comes from the ``axis`` side (one of "x", "y", "z", "-x", "-y", "-z": "x" makes

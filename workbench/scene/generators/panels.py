@@ -6,6 +6,8 @@ the crash2000 Table 1 model sizes. Lengths are millimetres.
 
 from __future__ import annotations
 
+from collections.abc import Collection
+
 import numpy as np
 
 from ..mesh import FEMesh
@@ -15,9 +17,9 @@ from .panel_plan import _SIDES, _check_share, _draw_features, _draw_plan, _grid_
 
 
 def stamped_panel(nx: int, ny: int, length: float = 600.0, width: float = 400.0, *,
-                  flange_depth: float = 25.0, flanges=_SIDES, beads: int | None = None,
-                  holes: int | None = None, triangle_share: float = 0.03,
-                  seed: int = 0) -> FEMesh:
+                  flange_depth: float = 25.0, flanges: Collection[str] = _SIDES,
+                  beads: int | None = None, holes: int | None = None,
+                  triangle_share: float = 0.03, seed: int = 0) -> FEMesh:
     """One stamped sheet-metal part: a structured nx × ny grid over the flat blank, formed in 3-D.
 
     The blank is the ``length`` × ``width`` top face (mm, x and y) plus a ``flange_depth`` strip

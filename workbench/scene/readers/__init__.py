@@ -56,7 +56,7 @@ def supported_formats() -> str:
             f"trimesh surfaces ({', '.join(TRIMESH_SUFFIXES)})")
 
 
-def detect_format(path) -> str:
+def detect_format(path: str | os.PathLike[str]) -> str:
     """The reader for ``path`` by its name: "keyword", "d3plot", "meshio" or "trimesh".
 
     Refuses an unknown suffix with :class:`ParseError` listing the supported formats.
@@ -73,7 +73,7 @@ def detect_format(path) -> str:
                            f"supported: {supported_formats()}")
 
 
-def load(path, *, format: str | None = None, units: str = "mm",
+def load(path: str | os.PathLike[str], *, format: str | None = None, units: str = "mm",
          all_faces: bool = False) -> FEMesh:
     """Read the shell mesh in ``path`` (a str or Path) into an :class:`FEMesh`.
 

@@ -8,14 +8,46 @@ it (its file and 1-based line), found again from the chunks of lines each block 
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol
+
 import numpy as np
 
 from ..mesh import FEMesh
 from .cards import _Chunk, _locate
 from .errors import ParseError, build_mesh
 
+if TYPE_CHECKING:
+    from .parameters import _Parameters
 
-def deck_mesh(deck, units: str, all_faces: bool = False) -> FEMesh:
+
+class KeywordDeck(Protocol):
+    """What :func:`deck_mesh` reads of a deck walk (the keyword reader's deck, which is not
+    imported here: :mod:`~workbench.scene.readers.keyword` imports this module). Per block in
+    reading order: the node ids and coordinates, the shell and solid ids, part ids, node ids
+    and the shells' nodal thickness, each with the chunk of lines it came from; the parts and
+    sections by id, the parameters, the keywords skipped (name → count) and the master file."""
+
+    master: Path
+    node_ids: list[np.ndarray]
+    node_xyz: list[np.ndarray]
+    node_chunks: list[_Chunk]
+    shell_ids: list[np.ndarray]
+    shell_parts: list[np.ndarray]
+    shell_nodes: list[np.ndarray]
+    shell_thickness: list[np.ndarray]
+    shell_chunks: list[_Chunk]
+    solid_ids: list[np.ndarray]
+    solid_parts: list[np.ndarray]
+    solid_nodes: list[np.ndarray]
+    solid_chunks: list[_Chunk]
+    parts: dict[int, Any]
+    sections: dict[object, Any]
+    parameters: _Parameters
+    skipped: dict[str, int]
+
+
+def deck_mesh(deck: KeywordDeck, units: str, all_faces: bool = False) -> FEMesh:
     """The FEMesh of what ``deck`` (the deck walk of :mod:`~workbench.scene.readers.keyword`)
     read: shells, then the faces of its solids (every face with
     ``all_faces``), with ids, parts, part titles and the element field ``"thickness"``.

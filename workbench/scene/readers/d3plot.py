@@ -37,6 +37,7 @@ read, or one without shell or solid elements.
 from __future__ import annotations
 
 import logging
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -99,7 +100,7 @@ def through_thickness_mean(values: np.ndarray, layer_axis: int = 2) -> np.ndarra
     return values.mean(axis=layer_axis)
 
 
-def read_d3plot(path, units: str = "mm", all_faces: bool = False,
+def read_d3plot(path: str | os.PathLike[str], units: str = "mm", all_faces: bool = False,
                 stress_components: bool = True) -> FEMesh:
     """Read a d3plot family (``d3plot``, ``d3plot01``, ...) into an :class:`FEMesh` with steps.
 

@@ -9,7 +9,9 @@ so that no reader depends on the module that dispatches to it.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
+from typing import Any
 
 from ..mesh import FEMesh, MeshError
 
@@ -22,8 +24,8 @@ class ParseError(ValueError):
     ``"file.k:123: *NODE: expected 3 coordinates, got 'abc' in '...'"``.
     """
 
-    def __init__(self, path, message: str, line: int | None = None, card: str | None = None,
-                 keyword: str | None = None):
+    def __init__(self, path: str | os.PathLike[str], message: str, line: int | None = None,
+                 card: str | None = None, keyword: str | None = None) -> None:
         self.path = Path(path)
         self.message = message
         self.line = line
@@ -41,7 +43,7 @@ class ParseError(ValueError):
             text += f" in {self.card!r}"
         return text
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[type[ParseError], tuple[Any, ...]]:
         return (type(self), (self.path, self.message, self.line, self.card, self.keyword))
 
 
@@ -50,13 +52,14 @@ class ParseWarning(UserWarning):
     file: ``str()`` reads ``"file.k:12: *SECTION_SHELL: parameter 't1' is not defined ..."``.
     Issued with :func:`warnings.warn`; ``workbench`` prints each as one line on stderr."""
 
-    def __init__(self, path, message: str, line: int | None = None, keyword: str | None = None):
+    def __init__(self, path: str | os.PathLike[str], message: str, line: int | None = None,
+                 keyword: str | None = None) -> None:
         self.path, self.message, self.line, self.keyword = Path(path), message, line, keyword
         where = str(self.path) if line is None else f"{self.path}:{line}"
         super().__init__(f"{where}: " + (f"*{keyword}: " if keyword else "") + message)
 
 
-def build_mesh(path, **kwargs) -> FEMesh:
+def build_mesh(path: str | os.PathLike[str], **kwargs: Any) -> FEMesh:
     """``FEMesh(**kwargs)``, with a refusal of the model reported as :class:`ParseError` on
     ``path``."""
     try:

@@ -43,6 +43,7 @@ the FEMesh in :mod:`~workbench.scene.readers.assembly`.
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -82,7 +83,8 @@ _KEYWORD_LINE = re.compile(r"\*\s*([A-Za-z0-9_]+)\s*([%+-])?(.*)$")
 _SUFFIX_FORMAT = {"%": "i10", "+": "long", "-": "small"}
 
 
-def read_keyword(path, units: str = "mm", all_faces: bool = False) -> FEMesh:
+def read_keyword(path: str | os.PathLike[str], units: str = "mm",
+                 all_faces: bool = False) -> FEMesh:
     """Read the LS-DYNA keyword deck ``path`` (with its includes) into an :class:`FEMesh`.
 
     See the module notes for what is read and what is refused. ``units`` labels the

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import os
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +23,7 @@ _MESHIO_SHELLS = {"quad": 4, "quad8": 4, "quad9": 4, "triangle": 3, "triangle6":
 
 
 # --------------------------------------------------------------------------- meshio
-def read_meshio(path, units: str = "mm") -> FEMesh:
+def read_meshio(path: str | os.PathLike[str], units: str = "mm") -> FEMesh:
     """Read a meshio-supported FE file: its quad and triangle cells become elements.
 
     Higher-order quads and triangles (quad8/9, triangle6/7) keep their corner nodes; other cells
@@ -114,7 +115,7 @@ def read_meshio(path, units: str = "mm") -> FEMesh:
 
 
 # --------------------------------------------------------------------------- trimesh
-def read_trimesh(path, units: str = "mm") -> FEMesh:
+def read_trimesh(path: str | os.PathLike[str], units: str = "mm") -> FEMesh:
     """Read a triangle surface through trimesh; every element is a triangle (``e[3] == e[2]``).
 
     A scene with several geometries (glTF) gives one part per geometry (1.., named after it),
