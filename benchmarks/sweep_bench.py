@@ -32,7 +32,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-SWEEP = [sys.executable, "-m", "workbench.experiment.sweep"]
+SWEEP = [sys.executable, "-m", "workbench.cli.sweep"]
 
 SKIP_GRID = """
     name = "skip_1000"
@@ -66,7 +66,7 @@ def _config(folder: Path, text: str, name: str) -> Path:
 
 def bench_skip(folder: Path) -> dict:
     """Median ms to skip a cached point, over a 1 000-point sweep run twice."""
-    from workbench.experiment.sweep import load_config, run_sweep
+    from workbench.sweep import load_config, run_sweep
 
     config = load_config(_config(folder, SKIP_GRID.format(bands=", ".join(map(str, range(250)))),
                                  "skip"))
@@ -112,7 +112,7 @@ def machine_scaling() -> float:
 def bench_scaling(folder: Path, bands: int = 15, rounds: int = 2) -> dict:
     """Points per second of error-only points on 1 and on 2 workers, the best of ``rounds``
     alternating runs each (other programs on the machine only ever slow a run down)."""
-    from workbench.experiment.sweep import load_config, run_sweep
+    from workbench.sweep import load_config, run_sweep
 
     config = load_config(_config(
         folder, SCALING_GRID.format(bands=", ".join(map(str, range(bands)))), "scaling"))
@@ -133,8 +133,8 @@ def _stamps(points: Path) -> dict[str, tuple[int, int]]:
 
 
 def _stable(out: Path) -> list[dict]:
-    from workbench.experiment.sweep import stable_row
     from workbench.experiment.tables import read_table
+    from workbench.sweep import stable_row
 
     return [stable_row(r) for r in read_table(out / "table.csv")]
 

@@ -4,9 +4,14 @@ paths as they are, and each check fails when its property is broken."""
 import numpy as np
 import pytest
 
-from workbench import render_stress
-from workbench.render_stress import (RenderStressReport, check_determinism, check_far_offset,
-                                     check_soak, run_render_stress)
+from workbench.reliability import (
+    RenderStressReport,
+    check_determinism,
+    check_far_offset,
+    check_soak,
+    run_render_stress,
+)
+from workbench.reliability import render as render_stress
 
 
 def test_render_stress_passes(capsys):

@@ -1,4 +1,4 @@
-"""The reader reliability suite (workbench.stress): a bounded run, its checks, and the reader
+"""The reader reliability suite (workbench.reliability): a bounded run, its checks, and the reader
 defects it found."""
 
 import argparse
@@ -7,16 +7,13 @@ import warnings
 import numpy as np
 import pytest
 
+from workbench.cli.stress import add_parser as add_stress_parser
 from workbench.data import D3PLOT, shared_file
-from workbench.scene.readers import ParseError
-from workbench.scene.readers.keyword import read_keyword
-from workbench.stress import (
+from workbench.reliability import (
     BENIGN,
     BOM,
     KINDS,
     OUTCOMES,
-    _read,
-    add_stress_parser,
     comma_deck,
     default_decks,
     fixed_deck,
@@ -27,6 +24,9 @@ from workbench.stress import (
     strict_count,
     thickness_deck,
 )
+from workbench.reliability import read_outcome as _read
+from workbench.scene.readers import ParseError
+from workbench.scene.readers.keyword import read_keyword
 
 
 @pytest.fixture(scope="module")
@@ -158,7 +158,7 @@ def test_regression_bom_keeps_line_numbers(tmp_path):
 # --------------------------------------------------------------------------- damaged d3plots
 @pytest.mark.skipif(shared_file(D3PLOT) is None, reason="shared d3plot absent (set WORKBENCH_DATA)")
 def test_damaged_d3plots_are_read_or_refused_never_anything_else():
-    from workbench.stress import run_d3plot_stress
+    from workbench.reliability import run_d3plot_stress
 
     report = run_d3plot_stress(300, seed=0)
     assert report.ok, report.failures
@@ -169,9 +169,9 @@ def test_damaged_d3plots_are_read_or_refused_never_anything_else():
 @pytest.mark.skipif(shared_file(D3PLOT) is None, reason="shared d3plot absent (set WORKBENCH_DATA)")
 def test_regression_garbled_part_index_is_a_parse_error(tmp_path):
     """Damage 175 of seed 0 garbles a shell part index to -1.6e9: once an IndexError."""
+    from workbench.reliability import damaged_d3plot
     from workbench.scene.readers import ParseError
     from workbench.scene.readers.d3plot import read_d3plot
-    from workbench.stress import damaged_d3plot
 
     kind, data = damaged_d3plot(shared_file(D3PLOT).read_bytes(), 175, 0)
     (tmp_path / "d3plot").write_bytes(data)

@@ -18,12 +18,20 @@ import pytest
 
 import workbench.scene.readers as scene_readers
 from workbench.data import CAR_DECK, shared_file
-from workbench.experiment.sweep import (glsl_folder, grid_points, load_config, point_key,
-                                        point_sources, run_sweep, stable_row)
-from workbench.experiment.sweep_points import Point, simplified_scene
 from workbench.experiment.tables import read_table
+from workbench.sweep import (
+    Point,
+    glsl_folder,
+    grid_points,
+    load_config,
+    point_key,
+    point_sources,
+    run_sweep,
+    simplified_scene,
+    stable_row,
+)
 
-SWEEP = [sys.executable, "-m", "workbench.experiment.sweep"]
+SWEEP = [sys.executable, "-m", "workbench.cli.sweep"]
 # 4 scenes x 2 paths x 2 band counts: enough points that a kill lands mid-run
 SMALL = """
     name = "small"
@@ -360,8 +368,7 @@ def test_quadrisection_sweep_brings_per_vertex_closer_to_per_pixel(tmp_path):
 def test_a_point_drawn_by_the_software_rasterizer(ctx):
     """``rasterizer = "software"`` draws the path on the CPU; its key and sources differ from
     the GL point's, its image is compared with the GL reference path."""
-    from workbench.experiment.sweep import point_sources
-    from workbench.experiment.sweep_points import measured_columns
+    from workbench.sweep import measured_columns, point_sources
 
     options = dict(field="distance", bands=6)
     common = dict(index=0, scene="semicylinders:8", path="pixel_color", options=options,

@@ -14,6 +14,7 @@ measurement; error-only work takes no lock and runs in parallel.
 from __future__ import annotations
 
 import asyncio
+import importlib
 import logging
 import os
 import socket
@@ -42,8 +43,9 @@ class GLContextPlugin(WorkerPlugin):
 
     name = PLUGIN_NAME
 
-    def __init__(self) -> None:
+    def __init__(self, imports: tuple[str, ...] = ()) -> None:
         self.renderer: str | None = None
+        self.imports = tuple(imports)
         self._contexts: dict[int, object] = {}
 
     async def setup(self, worker) -> None:
@@ -52,13 +54,17 @@ class GLContextPlugin(WorkerPlugin):
         await asyncio.get_running_loop().run_in_executor(executor, self._start)
 
     def _start(self) -> None:
-        """Create the first context and import what every point uses, so that the first
-        point's time is not spent importing."""
+        """Create the first context and import what every task uses (the paths, the
+        measurement, the image comparison, and the caller's ``imports``), so that the first
+        task's time is not spent importing."""
         self.context()
         from skimage.metrics import structural_similarity  # noqa: F401
 
         from .. import paths  # noqa: F401  (registers every path)
-        from . import compare, measure, sweep_points  # noqa: F401
+        from . import compare, measure  # noqa: F401
+
+        for module in self.imports:
+            importlib.import_module(module)
 
     def context(self):
         """The moderngl context of the calling thread, created on first use."""
@@ -143,10 +149,15 @@ def _renderer_of(client: Client) -> str:
 
 @contextmanager
 def sweep_cluster(workers: int | None = None, scheduler: str | None = None, *,
-                  raster_threads: int | None = None, gl: bool = True) -> Iterator[SweepCluster]:
+                  raster_threads: int | None = None, gl: bool = True,
+                  imports: tuple[str, ...] = ()) -> Iterator[SweepCluster]:
     """A :class:`SweepCluster`: a new LocalCluster of ``workers`` processes (default
     ``os.cpu_count()``, one thread each), or the cluster at ``scheduler``
     (``tcp://host:port``), with :class:`GLContextPlugin` registered on every worker.
+
+    ``imports`` names the modules (``"package.module"``) every worker imports once its GL
+    context exists, so that the first task does not spend its time importing them (with
+    ``gl=True`` only).
 
     ``gl=False`` registers no GL context on the workers (work that draws with the software
     rasterizer only: the workers need no EGL; ``renderer`` is then "software").
@@ -185,7 +196,7 @@ def sweep_cluster(workers: int | None = None, scheduler: str | None = None, *,
             except TimeoutError as exc:
                 raise OSError(f"scheduler {scheduler}: {exc or 'no workers'}") from None
         if gl:
-            client.register_plugin(GLContextPlugin(), name=PLUGIN_NAME)
+            client.register_plugin(GLContextPlugin(imports), name=PLUGIN_NAME)
         count = len(client.scheduler_info(n_workers=-1)["workers"])
         yield SweepCluster(client, count, _renderer_of(client) if gl else "software",
                            client.scheduler.address)

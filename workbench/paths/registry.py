@@ -103,3 +103,22 @@ def default_path(scene: Scene, field: str | None = None) -> str:
     if scene.kind == "mesh" and field is not None:
         return "element_color" if field in scene.element_fields else "pixel_color"
     return DEFAULT_PATHS[scene.kind]
+
+
+# how a refusal names a scene of each kind
+SCENE_KIND_NAMES = {"mesh": "an FE mesh", "spacetime": "a spacetime scene",
+                    "surface": "a textured surface"}
+
+
+def scene_path(scene, name: str | None = None, field: str | None = None, *,
+               source: str | None = None) -> str:
+    """The registry name of the path that draws ``scene``: ``name``, or when none is named the
+    :func:`default_path` for ``field``. ValueError for an unknown path, or for one that does
+    not draw scenes of ``scene.kind`` (naming the scene as ``source``, default its name)."""
+    name = name or default_path(scene, field)
+    kinds = path_class(name).scene_kinds
+    if scene.kind not in kinds:
+        what = SCENE_KIND_NAMES.get(scene.kind, f"a {scene.kind} scene")
+        raise ValueError(f"path {name!r} draws {' or '.join(sorted(kinds))} scenes; "
+                         f"{source or scene.name!r} is {what}")
+    return name

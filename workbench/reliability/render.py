@@ -31,6 +31,9 @@ SIZE = (160, 120)
 RSS_LIMIT_MIB = 32.0
 WARMUP_CYCLES = 20
 CHECKED_PATHS = ("position", "flat", "gouraud", "pixel_color", "vertex_color", "quad_wire")
+# the child process of check_determinism: prints the digest of its argument path's image
+_DIGEST_CHILD = ("import json, sys; from workbench.reliability.render import image_digest; "
+                 "print(json.dumps({'sha256': image_digest(sys.argv[1])}))")
 
 
 @dataclass
@@ -64,19 +67,19 @@ class RenderStressReport:
 def stress_scene():
     """The scene every check draws: the es2008 semicylinders, 8 × 8 quads per sheet, with its
     node field ``distance``."""
-    from .scene import generators
+    from ..scene import generators
 
     return generators.semicylinders(n=8)
 
 
 def _style(name: str):
-    from .paths import Style
+    from ..paths import Style
 
     return Style(field="distance", bands=6) if name in ("pixel_color", "vertex_color") else Style()
 
 
 def _image(ctx, mesh, name: str) -> np.ndarray:
-    from .experiment.measure import measure
+    from ..experiment.measure import measure
 
     return measure(ctx, mesh, name, _style(name), size=SIZE, timed=False).image
 
@@ -104,8 +107,8 @@ def resident_mib() -> float:
 def check_soak(ctx, report: RenderStressReport, cycles: int, name: str = "pixel_color") -> None:
     """``cycles`` prepare/draw/read/release cycles of path ``name``: no GL object kept after a
     release, RSS growth after :data:`WARMUP_CYCLES` within :data:`RSS_LIMIT_MIB`."""
-    from .experiment.measure import measure
-    from .paths import make_path
+    from ..experiment.measure import measure
+    from ..paths import make_path
 
     mesh = stress_scene()
     kept, start = 0, None
@@ -122,7 +125,7 @@ def check_soak(ctx, report: RenderStressReport, cycles: int, name: str = "pixel_
 
 def image_digest(name: str) -> str:
     """SHA-256 of path ``name``'s image of :func:`stress_scene` on a new context."""
-    from .gl import create_context
+    from ..gl import create_context
 
     return hashlib.sha256(_image(create_context(), stress_scene(), name).tobytes()).hexdigest()
 
@@ -133,7 +136,7 @@ def check_determinism(ctx, report: RenderStressReport, name: str = "gouraud",
     here = hashlib.sha256(_image(ctx, stress_scene(), name).tobytes()).hexdigest()
     digests = []
     for _ in range(processes):
-        out = subprocess.run([sys.executable, "-m", "workbench.render_stress", name],
+        out = subprocess.run([sys.executable, "-c", _DIGEST_CHILD, name],
                              capture_output=True, text=True, timeout=300)
         digests.append(json.loads(out.stdout.strip().splitlines()[-1])["sha256"]
                        if out.returncode == 0 else f"exit {out.returncode}: {out.stderr[-200:]}")
@@ -144,7 +147,7 @@ def check_determinism(ctx, report: RenderStressReport, name: str = "gouraud",
 
 def run_render_stress(cycles: int = 300) -> RenderStressReport:
     """All three checks on one new context; ``cycles`` soak cycles."""
-    from .gl import create_context
+    from ..gl import create_context
 
     start = time.perf_counter()
     ctx = create_context()
@@ -155,6 +158,3 @@ def run_render_stress(cycles: int = 300) -> RenderStressReport:
     report.seconds = time.perf_counter() - start
     return report
 
-
-if __name__ == "__main__":  # the child of check_determinism: print the image's digest
-    print(json.dumps({"sha256": image_digest(sys.argv[1])}))

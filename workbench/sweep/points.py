@@ -30,7 +30,7 @@ HAUSDORFF_BRACKET = 1e-6
 def simplifier_names() -> tuple[str, ...]:
     """Every simplifier a grid may name: "none", "ours" (Hausdorff-bounded decimation), then
     the reference simplifiers of :data:`workbench.experiment.simplifiers.SIMPLIFIERS`."""
-    from .simplifiers import SIMPLIFIERS
+    from ..experiment.simplifiers import SIMPLIFIERS
 
     return (NO_SIMPLIFIER, OURS, *SIMPLIFIERS)
 
@@ -42,10 +42,11 @@ class Point:
     ``samples`` (MSAA), ``view`` (azimuth, elevation in degrees), ``simplifier`` and
     ``tolerance`` (% of each part's bounding-sphere diameter; both None without
     simplification), ``quadrisection`` (a spacetime scene's polygons split down to this fraction
-    of their mean area, None: not split), ``reference`` (path name whose image gives the error, or None) with
-    ``reference_options`` (the grid's options that path takes), ``repeats`` (timed draws),
-    ``timed`` and ``quick`` (smaller built-in scenes), ``rasterizer`` ("gl", or "software":
-    the es2008 rasterizer draws the path, :class:`~workbench.paths.software.SoftwarePath`).
+    of their mean area, None: not split), ``reference`` (path name whose image gives the error,
+    or None) with ``reference_options`` (the grid's options that path takes), ``repeats``
+    (timed draws), ``timed`` and ``quick`` (smaller built-in scenes), ``rasterizer`` ("gl", or
+    "software": the es2008 rasterizer draws the path,
+    :class:`~workbench.paths.software.SoftwarePath`).
     ``index`` is the position in the grid.
     """
 
@@ -137,8 +138,8 @@ def simplified_scene(mesh, point: Point):
     fails or returns nothing raises RuntimeError; a scene that is no FE mesh, ValueError.
     """
     from ..algo.hausdorff import hausdorff
+    from ..experiment.simplifiers import simplify_with
     from ..scene.mesh import FEMesh
-    from .simplifiers import simplify_with
 
     if not isinstance(mesh, FEMesh):
         raise ValueError(f"simplifier {point.simplifier!r} needs an FE mesh scene, "
@@ -178,7 +179,7 @@ def simplified_scene(mesh, point: Point):
 def _reference_image(ctx, point: Point, scene, camera, measured):
     """The reference path's image of the unsimplified, unsplit scene with the point's options:
     the point's own image when it draws the reference path on that very scene."""
-    from .measure import measure
+    from ..experiment.measure import measure
 
     if point.reference == point.path and point.simplifier in (None, NO_SIMPLIFIER) \
             and point.quadrisection is None:
@@ -196,11 +197,11 @@ def measured_columns(point: Point, ctx) -> dict:
     lock), the simplification columns, and ``diff_*`` (:meth:`ImageDiff.as_row`: max and mean
     absolute difference in 1/255, share of pixels differing, PSNR in dB, SSIM) against the
     reference image."""
+    from ..experiment.cluster import draw_lock
+    from ..experiment.compare import compare_images
+    from ..experiment.measure import measure
     from ..paths import SoftwareRasterizer, make_path
     from ..scene.builtin import fresh_scene
-    from .cluster import draw_lock
-    from .compare import compare_images
-    from .measure import measure
 
     original = fresh_scene(point.scene, point.quick)
     path = make_path(point.path, **point.options)
@@ -241,7 +242,7 @@ def run_point(point: Point, workers: int, run_id: str) -> dict:
     :func:`measured_columns`, ``point_ms`` (wall ms of the whole point), ``workers`` (the
     cluster's worker count), ``host``, ``run_id`` (the run that computed it) — or, when the
     point raises, its columns with ``error`` (one line ``Type: message``)."""
-    from .cluster import worker_context
+    from ..experiment.cluster import worker_context
 
     start = time.perf_counter()
     extra = dict(workers=workers, host=socket.gethostname(), run_id=run_id)

@@ -1,0 +1,66 @@
+"""What the ``workbench`` command's modules share: argument types ("A,B", "WxH", KEY=VALUE),
+the parser whose refusals are one line, and the one-line report of refused input with exit
+status :data:`EXIT_BAD_INPUT`."""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import math
+import sys
+
+EXIT_BAD_INPUT = 2
+
+
+def pair(text: str, sep: str, kind=float) -> tuple:
+    """Two finite numbers separated by ``sep``."""
+    try:
+        a, b = text.lower().split(sep)
+        values = kind(a), kind(b)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected two numbers separated by {sep!r}, got {text!r}") from None
+    if not all(math.isfinite(v) for v in values):
+        raise argparse.ArgumentTypeError(f"expected two finite numbers, got {text!r}")
+    return values
+
+
+def view_angles(text: str) -> tuple[float, float]:
+    """``AZ,EL`` of ``--view``: azimuth and elevation in degrees."""
+    return pair(text, ",")
+
+
+def image_size(text: str) -> tuple[int, int]:
+    """``WxH`` of ``--size``: a positive width and height in pixels."""
+    w, h = pair(text, "x", int)
+    if w <= 0 or h <= 0:
+        raise argparse.ArgumentTypeError(f"size must be positive, got {text!r}")
+    return w, h
+
+
+def key_value(text: str) -> tuple[str, object]:
+    """``KEY=VALUE`` of ``--option``: VALUE read as a Python literal (number, tuple, bool), else
+    kept as a string."""
+    key, sep, value = text.partition("=")
+    if not sep or not key:
+        raise argparse.ArgumentTypeError(f"expected KEY=VALUE, got {text!r}")
+    try:
+        return key.strip(), ast.literal_eval(value)
+    except (ValueError, SyntaxError):
+        return key.strip(), value
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose refusals are one line (``PROG: error: …``) and exit status 2,
+    without the usage block (``--help`` shows it)."""
+
+    def error(self, message: str):
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
+
+
+def refused(exc: BaseException) -> int:
+    """Report input a command refused as one line on stderr, ``workbench: error: MESSAGE`` (a
+    KeyError's message without its quotes); returns :data:`EXIT_BAD_INPUT`."""
+    message = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
+    print(f"workbench: error: {message}", file=sys.stderr)
+    return EXIT_BAD_INPUT

@@ -1,0 +1,227 @@
+"""``workbench render``: one scene drawn offscreen through the one measurement function
+(untimed) and written as a PNG, with a colour bar when a field is shown; on the headless GL
+context or the es2008 software rasterizer. ``--domains D`` (sort-last) splits the mesh into D
+domains, draws them with the software rasterizer on Dask workers and composites them by depth.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .arguments import image_size, key_value, view_angles
+
+
+def add_parser(subparsers) -> None:
+    """Add ``render`` to the ``workbench`` command's subparsers."""
+    from ..paths.registry import paths_for
+
+    mesh_paths = paths_for("mesh")
+    spacetime_paths = paths_for("spacetime")
+    p = subparsers.add_parser(
+        "render", help="render one scene to a PNG",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Render a mesh file (LS-DYNA .k, d3plot, meshio or trimesh formats), a "
+                    "built-in scene (car, d3plot, semicylinders[:N], panels[:Q]) or a spacetime "
+                    "scene (spacetime:radial[:N], spacetime:bar) offscreen, through the one "
+                    "measurement function (untimed).",
+        epilog="render paths:\n  FE meshes:        " + ", ".join(mesh_paths) +
+               "\n  spacetime scenes: " + ", ".join(spacetime_paths) +
+               "\nany option of a path's style: --option KEY=VALUE (e.g. "
+               "--option edge_overdraw=skirts"
+               "\n  --option height_scale=800 for a spacetime path, "
+               "--option clip_planes=((1,0,0,0),))")
+    p.add_argument("mesh", help="mesh file or built-in scene name")
+    p.add_argument("-o", "--output", required=True, help="PNG file to write")
+    p.add_argument("--field", help="node or element field to colour by")
+    p.add_argument("--path", metavar="PATH",
+                   help="render path (default: gouraud; pixel_color or element_color with --field; "
+                        "spacetime_pixel on a spacetime scene); listed below")
+    p.add_argument("-O", "--option", type=key_value, action="append", metavar="KEY=VALUE",
+                   help="any style option of the path (repeatable)")
+    p.add_argument("--wireframe", action="store_true", help="overdraw element edges")
+    p.add_argument("--all-faces", action="store_true",
+                   help="draw every face of solid elements, not only the boundary faces")
+    p.add_argument("--strips", choices=("none", "triangle", "quad"), default="none",
+                   help="draw a triangle list (default), meshoptimizer triangle strips or quad "
+                        "strips")
+    p.add_argument("--fepatch", default="A", metavar="SET",
+                   help="fe2003 parameters of the fe_* texture paths: A, B or "
+                        "'alpha_g1,d,l_outer,l_inner' in degrees and mm (default A)")
+    p.add_argument("--view", type=view_angles, default=(30.0, 25.0), metavar="AZ,EL",
+                   help="azimuth and elevation in degrees (default 30,25)")
+    p.add_argument("--up", choices=("y", "z"), default="z",
+                   help="world axis shown upwards (default z, as in most CAE models)")
+    p.add_argument("--size", type=image_size, default=(1000, 800), metavar="WxH",
+                   help="image size (default 1000x800)")
+    p.add_argument("--projection", choices=("orthographic", "perspective"), default="orthographic")
+    p.add_argument("--step", type=int, default=0, help="time step to draw (default 0)")
+    p.add_argument("--bands", type=int, default=0, help="number of contour bands (0: smooth)")
+    p.add_argument("--colormap", help="matplotlib colormap name (default: the path's own)")
+    p.add_argument("--crease", type=float, default=30.0, help="Gouraud crease angle in degrees")
+    p.add_argument("--samples", type=int, default=0, help="MSAA samples (0: none)")
+    p.add_argument("--units", default="", help="units of the field, for the colour bar label")
+    p.add_argument("--raw", action="store_true", help="write the bare image without a colour bar")
+    _add_software_arguments(p)
+    _add_sortlast_arguments(p)
+    p.set_defaults(func=cmd_render)
+
+
+def _add_software_arguments(p) -> None:
+    """``--rasterizer`` and the software rasterizer's settings."""
+    p.add_argument("--rasterizer", choices=("gl", "software"), default="gl",
+                   help="draw through the headless GL context (default) or with the es2008 "
+                        "software rasterizer on the CPU (mesh paths, orthographic views)")
+    p.add_argument("--generator", choices=("halfspace", "table"), default="halfspace",
+                   help="software fragment generator: half-space tests (default) or the span "
+                        "look-up table (needs --subpixel-bits 0, its default)")
+    p.add_argument("--table-size", type=int, default=10, metavar="S",
+                   help="span table size S in pixels (default 10; 15 and 20 as in es2008)")
+    p.add_argument("--subpixel-bits", type=int, metavar="B",
+                   help="software vertex snapping: 8 as llvmpipe (default), 0 for the table")
+    p.add_argument("--threads", type=int, help="software rasterizer threads (default: all cores)")
+
+
+def _add_sortlast_arguments(p) -> None:
+    """``--domains`` and how the domains are made, composited and drawn on Dask."""
+    p.add_argument("--domains", type=int, metavar="D",
+                   help="sort-last: split the mesh into D domains, draw them with the software "
+                        "rasterizer on Dask workers and composite them by depth")
+    p.add_argument("--split", choices=("space", "part"), default="space",
+                   help="domains by recursive bisection in space (default) or by whole parts")
+    p.add_argument("--composite", choices=("tree", "swap"), default="tree",
+                   help="compositing schedule: binary tree (default) or binary swap")
+    p.add_argument("--workers", type=int,
+                   help="local Dask worker processes (default: one per core)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="an existing Dask scheduler (tcp://host:port) instead of a local cluster")
+
+
+def _check_field_and_step(scene, args) -> None:
+    """KeyError for a ``--field`` the mesh does not have, ValueError for a ``--step`` outside
+    its steps."""
+    fields = [*scene.node_fields, *scene.element_fields]
+    if args.field is not None and args.field not in fields:
+        known = sorted(fields) or ["(none)"]
+        raise KeyError(f"{scene.name} has no field {args.field!r}; fields: {', '.join(known)}")
+    if not 0 <= args.step < scene.n_steps:
+        raise ValueError(f"{scene.name} has {scene.n_steps} steps; --step {args.step} is outside")
+
+
+def _render_options(args, kind: str) -> dict:
+    """The path options of ``workbench render``: the mesh flags (mesh paths only; set on a
+    spacetime path they are refused), ``--colormap`` and every ``--option``."""
+    flags = {"field": args.field, "step": args.step, "bands": args.bands,
+             "wireframe": args.wireframe, "crease_deg": args.crease, "strips": args.strips,
+             "fepatch": args.fepatch}
+    if kind == "mesh":
+        options = dict(flags)
+    else:
+        from ..paths import Style
+
+        default = Style()
+        given = [k for k, v in flags.items() if v != getattr(default, k)]
+        if given:
+            raise ValueError(f"--{given[0].replace('_deg', '').replace('_', '-')} applies to the "
+                             f"mesh paths, not to a spacetime scene")
+        options = {}
+    if args.colormap is not None:
+        options["colormap"] = args.colormap
+    options.update(dict(args.option or ()))
+    return options
+
+
+def _backend(args, path):
+    """(backend, path drawn on it): the GL context, or the software rasterizer of
+    ``--generator`` … with the path it draws (``--subpixel-bits`` by default 0 for the span
+    table, 8 for the half-space tests)."""
+    if args.rasterizer != "software":
+        from ..gl import create_context
+
+        return create_context(), path
+    from ..algo.softraster import RasterOptions
+    from ..paths import SoftwareRasterizer
+
+    bits = args.subpixel_bits
+    if bits is None:
+        bits = 0 if args.generator == "table" else 8
+    backend = SoftwareRasterizer(RasterOptions(
+        generator=args.generator, table_size=args.table_size, subpixel_bits=bits,
+        threads=args.threads))
+    return backend, backend.path(path)
+
+
+def _write_image(out: Path, image, path, field: str | None, args, title: str) -> None:
+    """``image`` as a PNG at ``out``: with a colour bar of ``field`` when there is one and a
+    colour scale, unless ``--raw``."""
+    from ..experiment.figures import save_field_figure, save_png
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    scale = getattr(path, "scale", None)
+    if field is not None and not args.raw and scale is not None:
+        save_field_figure(out, image, value_range=scale.value_range,
+                          colormap=path.style.colormap, label=field, units=args.units,
+                          title=title, bands=args.bands)
+    else:
+        save_png(out, image)
+
+
+def cmd_render(args) -> int:
+    """Draw the scene, write ``--output``, print what was drawn; 0."""
+    from ..experiment.measure import measure
+    from ..paths import make_path, path_class
+    from ..paths.registry import scene_path
+    from ..scene.builtin import load_scene
+
+    scene = load_scene(args.mesh, all_faces=args.all_faces)
+    is_mesh = scene.kind == "mesh"
+    if is_mesh:
+        _check_field_and_step(scene, args)
+    path_name = scene_path(scene, args.path, args.field, source=args.mesh)
+    kind = "mesh" if "mesh" in path_class(path_name).scene_kinds else "spacetime"
+    path = make_path(path_name, **_render_options(args, kind))
+    backend, path = _backend(args, path)
+    size = args.size
+    camera = path.default_camera(scene, size, view=args.view, projection=args.projection,
+                                 up=args.up, style=path.style)
+    if args.domains is not None:
+        return _render_sortlast(args, scene, path, camera, size)
+    result = measure(backend, scene, path, camera=camera, size=size, samples=args.samples,
+                     timed=False)
+    out = Path(args.output)
+    field = args.field if args.field is not None else getattr(path.style, "field", None)
+    _write_image(out, result.image, path, field if is_mesh else None, args,
+                 f"{scene.name} ({path_name})")
+    strips = f", {path.strips} strip{'s' * (path.strips != 1)}" if path.strips else ""
+    print(f"{out}: {result.row['scene']}, {path.triangles} triangles, {path.vertices_sent} "
+          f"vertices sent{strips}, path {path_name}"
+          + (f", {result.row['renderer']}" if args.rasterizer == "software" else ""))
+    return 0
+
+
+def _render_sortlast(args, mesh, path, camera, size) -> int:
+    """``render --domains D``: the mesh split into D domains, drawn by the software rasterizer
+    on Dask workers and composited by depth (sort-last), written like a plain render."""
+    from ..experiment.cluster import sweep_cluster
+    from ..experiment.sortlast import SoftwareDomains, render_sortlast
+    from ..scene.domains import split_domains
+
+    if args.rasterizer != "software":
+        raise ValueError("--domains draws the domains with the software rasterizer: add "
+                         "--rasterizer software")
+    if args.all_faces:
+        raise ValueError("--domains loads the scene again on each worker; --all-faces is not "
+                         "passed on")
+    domains = split_domains(mesh, args.domains, by=args.split)
+    render_domain = SoftwareDomains(args.mesh, path.name, path.style, camera, size, path.options)
+    with sweep_cluster(args.workers, args.scheduler, gl=False) as cluster:
+        frame, stats = render_sortlast(cluster.client, render_domain, domains,
+                                       method=args.composite)
+    out = Path(args.output)
+    path.prepare(None, mesh, camera)  # the colour scale of the bar
+    _write_image(out, frame.color, path, args.field, args,
+                 f"{mesh.name} ({path.name}, {args.domains} domains)")
+    print(f"{out}: {mesh.name}, {len(mesh.triangles)} triangles in {args.domains} domains "
+          f"by {args.split} on {stats.workers} workers; {args.composite} compositing "
+          f"{stats.composite_s:.3f} s, {stats.bytes_moved / 1e6:.1f} MB moved between workers")
+    return 0
