@@ -67,6 +67,7 @@ def small(tmp_path_factory):
     return config_path, out, result
 
 
+@pytest.mark.slow
 def test_sweep_on_local_cluster(small):
     _, out, result = small
     assert (result.computed, result.cached, result.failed) == (16, 0, 0)
@@ -87,6 +88,7 @@ def test_sweep_on_local_cluster(small):
     assert len(list((out / "points").glob("*.json"))) == 16
 
 
+@pytest.mark.slow
 def test_rerun_comes_from_cache(small):
     config_path, out, first = small
     before = {p.name: p.stat().st_mtime_ns for p in (out / "points").glob("*.json")}
@@ -98,6 +100,7 @@ def test_rerun_comes_from_cache(small):
     assert again.summary == "sweep small: 16 points, 0 computed, 16 from cache, 0 failed"
 
 
+@pytest.mark.slow
 def test_resume_after_sigkill(small, tmp_path):
     config_path, clean_out, _ = small
     out = tmp_path / "killed"
@@ -166,6 +169,7 @@ def test_point_key_follows_the_shaders_a_path_loads(tmp_path):
     assert point_key(quick, "llvmpipe") != keys["vertex_color"]
 
 
+@pytest.mark.slow
 def test_failing_point_is_recorded_and_exit_status_is_1(tmp_path):
     config_path = write_config(tmp_path, """
         name = "failing"
@@ -248,6 +252,7 @@ def test_bad_configs_are_refused_naming_file_and_key(tmp_path, text, message):
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.slow
 def test_on_a_scheduler_and_workers_started_apart(tmp_path):
     config_path = write_config(tmp_path, """
         name = "remote"
@@ -332,6 +337,7 @@ def test_car_decimation_config_is_valid_and_simplifies_the_car():
     assert 0 < columns["hausdorff"] <= columns["hausdorff_upper"]
 
 
+@pytest.mark.slow
 def test_quadrisection_sweep_brings_per_vertex_closer_to_per_pixel(tmp_path):
     """st2005 §4.2 on a spacetime scene: splitting the polygons lowers the per-vertex error
     against the per-pixel image of the unsplit slice; a mesh scene refuses the key."""

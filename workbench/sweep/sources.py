@@ -31,7 +31,7 @@ def _file_digest(path: Path) -> str:
 
 
 def glsl_folder() -> Path:
-    """The folder of the workbench's shaders (the top-level glsl/, shipped as workbench.glsl)."""
+    """The folder of the workbench's shaders (the package ``workbench.glsl``)."""
     return Path(str(resources.files("workbench.glsl")))
 
 
@@ -90,7 +90,9 @@ def point_sources(point: Point, glsl_dir=None) -> dict[str, str]:
 
     glsl = Path(glsl_dir) if glsl_dir is not None else glsl_folder()
     paths = [point.path] + ([point.reference] if point.reference else [])
-    modules = {Path(inspect.getsourcefile(path_class(name))).resolve() for name in paths}
+    # the modules of the path classes and of every workbench class they derive from
+    modules = {Path(inspect.getsourcefile(cls)).resolve() for name in paths
+               for cls in path_class(name).__mro__ if cls.__module__.startswith("workbench.")}
     shaders = _shader_files(sorted(modules | package_modules("paths/base")), glsl)
     modules |= package_modules(*POINT_MODULES)
     if point.reference:
@@ -107,9 +109,11 @@ def point_sources(point: Point, glsl_dir=None) -> dict[str, str]:
 
 
 def _scene_modules(spec: str) -> set[Path]:
-    """The modules that make scene ``spec`` and what the paths derive from it: the spacetime
-    builders, the generators or the readers, with the derived-data modules."""
-    modules = package_modules("scene/mesh", "scene/derived", "scene/needs")
+    """The modules that make scene ``spec`` and what the paths derive from it: the built-in
+    scenes with the spacetime builders, the generators or the readers, and the derived-data
+    modules."""
+    modules = package_modules("scene/mesh", "scene/derived", "scene/crease", "scene/needs",
+                              "scene/builtin")
     name = spec.split(":")[0]
     if name == "spacetime" and not Path(spec).is_file():
         return modules | package_modules("algo/spacetime")
