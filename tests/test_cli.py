@@ -138,6 +138,15 @@ def test_missing_file_and_unknown_field_are_bad_input(deck, tmp_path, capsys):
     assert "none.k" in err and "no field 'stress'" in err
 
 
+@pytest.mark.parametrize("command", [["hausdorff", "spacetime:bar", "semicylinders:4"],
+                                     ["simplify", "spacetime:bar"],
+                                     ["explode", "spacetime:bar", "--focus", "1", "-o", "x.gif"]])
+def test_mesh_commands_refuse_a_spacetime_scene_in_one_line(command, capsys):
+    assert main(command) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "spacetime" in err[0] and "FE mesh" in err[0]
+
+
 def test_list_names_the_render_paths_experiment(capsys):
     assert main(["list"]) == 0
     assert "render_paths" in capsys.readouterr().out

@@ -64,13 +64,9 @@ def _progress(frames: int):
 def _focus_mesh(spec: str, focus: int):
     """The FE mesh ``spec``; ValueError for another kind of scene, KeyError when it has no
     part ``focus``."""
-    from ..scene.builtin import load_scene
-    from ..scene.mesh import FEMesh
+    from ..scene.builtin import load_mesh
 
-    scene = load_scene(spec)
-    if not isinstance(scene, FEMesh):
-        raise ValueError(f"{spec!r} is not an FE mesh: the exploded view splits the parts "
-                         f"of a mesh")
+    scene = load_mesh(spec)
     ids = sorted(int(p) for p in np.unique(scene.parts))
     if focus not in ids:
         raise KeyError(f"{scene.name} has no part {focus}; part ids: {ids}")

@@ -22,9 +22,9 @@ def add_parser(subparsers) -> None:
 def cmd_hausdorff(args) -> int:
     """Print the bracket, its share of A's diagonal, and where it is attained; 0."""
     from ..algo.hausdorff import hausdorff
-    from ..scene.builtin import load_scene
+    from ..scene.builtin import load_mesh
 
-    a, b = load_scene(args.mesh_a), load_scene(args.mesh_b)
+    a, b = load_mesh(args.mesh_a), load_mesh(args.mesh_b)
     va, fa = a.coordinates(args.step), a.triangles
     vb, fb = b.coordinates(args.step if args.step < b.n_steps else 0), b.triangles
     lo, hi = va[a.used_nodes()].min(axis=0), va[a.used_nodes()].max(axis=0)

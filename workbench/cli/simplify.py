@@ -21,9 +21,9 @@ def cmd_simplify(args) -> int:
     """Print the triangle counts, time, tolerance and collapses, and write ``--output``; 0."""
     from ..algo.simplify import hausdorff_decimate
     from ..experiment.export import write_surface
-    from ..scene.builtin import load_scene
+    from ..scene.builtin import load_mesh
 
-    mesh = load_scene(args.mesh)
+    mesh = load_mesh(args.mesh)
     tri = mesh.triangulation
     d = hausdorff_decimate(mesh.nodes, tri.triangles, args.tol / 100.0, relative=True,
                            parts=mesh.parts[tri.element_of])

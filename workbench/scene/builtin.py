@@ -128,6 +128,16 @@ def load_scene(spec: str, quick: bool = False, all_faces: bool = False) -> Scene
     return load(spec, all_faces=all_faces)
 
 
+def load_mesh(spec: str, quick: bool = False, all_faces: bool = False) -> FEMesh:
+    """:func:`load_scene` for commands that take an FE mesh: ValueError naming the kind of a
+    scene that is not one (a spacetime scene, say)."""
+    scene = load_scene(spec, quick, all_faces)
+    if scene.kind != "mesh":
+        raise ValueError(f"{spec!r} is a {scene.kind} scene; this takes an FE mesh (a mesh file, "
+                         f"car, d3plot, semicylinders[:N] or panels[:Q])")
+    return scene
+
+
 def fresh_scene(spec: str, quick: bool = False) -> Scene:
     """Scene ``spec`` as nobody has drawn it yet, so that what a path derives is computed (and
     counted) anew: loaded once per process (:func:`load_scene`), an FE mesh is handed out as a
