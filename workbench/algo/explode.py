@@ -318,15 +318,15 @@ def cull_back_faces(plane: SplitPlane, offset, eye, side: int) -> bool:
 # ---------------------------------------------------------------------------- planes
 def o_max_of(mesh_or_bounds) -> float:
     """The maximum offset: the diagonal (model units) of the assembly's axis-aligned bounding
-    box. Takes anything with a ``bounds()`` method returning ``(lo, hi)`` (an FEMesh, reference
-    nodes) or a ``(lo, hi)`` pair of 3-vectors. A zero or non-finite diagonal is refused."""
-    if hasattr(mesh_or_bounds, "bounds"):
-        lo, hi = mesh_or_bounds.bounds()
-    else:
+    box. Takes a scene (its ``bounds()``: an FEMesh's reference nodes) or a ``(lo, hi)`` pair
+    of 3-vectors. A zero or non-finite diagonal is refused."""
+    if isinstance(mesh_or_bounds, (tuple, list, np.ndarray)):
         b = np.asarray(mesh_or_bounds, dtype=np.float64)
         if b.shape != (2, 3):
             raise ValueError(f"bounds must be a (lo, hi) pair of 3-vectors, got shape {b.shape}")
         lo, hi = b
+    else:
+        lo, hi = mesh_or_bounds.bounds()
     lo, hi = _vector(lo, "bounds lo"), _vector(hi, "bounds hi")
     diagonal = float(np.linalg.norm(hi - lo))
     if diagonal <= 0.0:

@@ -52,11 +52,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def _progress(frames: int):
-    """(iterable of frame numbers, write-a-line function): tqdm's bar where installed."""
-    try:
-        from tqdm import tqdm
-    except ImportError:
-        return range(frames), print
+    """(tqdm bar over the frame numbers, its write-a-line function), on stderr."""
+    from tqdm import tqdm
+
     bar = tqdm(range(frames), desc="explode", unit="frame", file=sys.stderr)
     return bar, bar.write
 
@@ -102,8 +100,7 @@ def cmd_explode(args) -> int:
         run = explode_animation(ctx, scene, path, camera, args.size, args.frames, steps=steps,
                                 on_frame=report)
     finally:
-        if hasattr(steps, "close"):
-            steps.close()
+        steps.close()
     out.parent.mkdir(parents=True, exist_ok=True)
     save_animation(out, run.frames)
     print(f"{out}: {len(run.frames)} frames of {scene.name}, focus part {args.focus}")

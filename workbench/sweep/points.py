@@ -140,10 +140,9 @@ def simplified_scene(mesh, point: Point):
     from ..algo.hausdorff import hausdorff
     from ..experiment.simplifiers import simplify_with
     from ..scene.mesh import FEMesh
-
-    if not isinstance(mesh, FEMesh):
+    if mesh.kind != "mesh":
         raise ValueError(f"simplifier {point.simplifier!r} needs an FE mesh scene, "
-                         f"{point.scene!r} is a {type(mesh).__name__}")
+                         f"{point.scene!r} is a {mesh.kind} scene")
     if point.simplifier == NO_SIMPLIFIER:  # drawn as it is, quads included
         triangles = mesh.n_elements + mesh.n_quads
         return mesh, dict(triangles_before=triangles, triangles_after=triangles, simplify_s=0.0,
