@@ -80,9 +80,9 @@ def test_sweep_on_local_cluster(small):
         assert row["workers"] == 2 and row["host"] and not row.get("error")
         assert row["wall_ms"] > 0 and row["repeats"] == 5 and row["renderer"] == result.renderer
         if row["path"] == "pixel_color":
-            assert row["diff_mean_abs"] == 0 and row["diff_max_abs"] == 0
+            assert row["mean_diff_255"] == 0 and row["max_diff_255"] == 0
     banded = [r for r in rows if r["path"] == "vertex_color" and r["bands"] == 4]
-    assert all(r["diff_mean_abs"] > 0 and r["diff_share_differing"] > 0 for r in banded)
+    assert all(r["mean_diff_255"] > 0 and r["share_differing"] > 0 for r in banded)
     assert (out / "table.md").read_text().startswith("# Sweep small")
     assert (out / "pareto.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert len(list((out / "points").glob("*.json"))) == 16
@@ -292,7 +292,7 @@ def test_on_a_scheduler_and_workers_started_apart(tmp_path):
         assert (result.computed, result.failed, result.workers) == (4, 0, 2)
         rows = read_table(out / "table.csv")
         assert all(r["workers"] == 2 and r["host"] and r["wall_ms"] > 0 for r in rows)
-        assert [r["diff_mean_abs"] > 0 for r in rows] == [True, True, False, False]
+        assert [r["mean_diff_255"] > 0 for r in rows] == [True, True, False, False]
     finally:
         for proc in reversed(started):
             proc.terminate()
@@ -312,11 +312,11 @@ def test_simplification_point_on_the_semicylinders():
     simplified, columns = simplified_scene(mesh, point)
     assert columns["triangles_before"] == 8 * 6 * 6 * 2
     assert 0 < columns["triangles_after"] == len(simplified.elements) < columns["triangles_before"]
-    assert 0 <= columns["hausdorff"] <= columns["hausdorff_upper"]
-    assert columns["hausdorff_pct"] < 2.0  # within the tolerance of the largest part
+    assert 0 <= columns["hausdorff_lower_mm"] <= columns["hausdorff_mm"]
+    assert columns["hausdorff_pct_diag"] < 2.0  # within the tolerance of the largest part
     none, same = simplified_scene(mesh, Point(index=0, scene="semicylinders:6", path="gouraud",
                                               simplifier="none"))
-    assert none is mesh and same["hausdorff"] == 0
+    assert none is mesh and same["hausdorff_lower_mm"] == 0
 
 
 @pytest.mark.skipif(shared_file(CAR_DECK) is None,
@@ -327,14 +327,14 @@ def test_car_decimation_config_is_valid_and_simplifies_the_car():
     root = Path(__file__).resolve().parents[1]
     config = load_config(root / "sweeps" / "car_decimation.toml")
     points = grid_points(config, quick=True)
-    assert config.metric == "hausdorff_pct" and {p.scene for p in points} == {"car"}
+    assert config.metric == "hausdorff_pct_diag" and {p.scene for p in points} == {"car"}
     assert sum(p.simplifier == "none" for p in points) == 1  # tolerance means nothing there
     car = load_scene("car")
     ours = next(p for p in points if p.simplifier == "ours")
     simplified, columns = simplified_scene(car, ours)
     assert len(simplified.elements) == columns["triangles_after"]
     assert columns["triangles_after"] < columns["triangles_before"] == len(car.triangles)
-    assert 0 < columns["hausdorff"] <= columns["hausdorff_upper"]
+    assert 0 < columns["hausdorff_lower_mm"] <= columns["hausdorff_mm"]
 
 
 @pytest.mark.slow
@@ -357,7 +357,7 @@ def test_quadrisection_sweep_brings_per_vertex_closer_to_per_pixel(tmp_path):
     assert result.failed == 0
     rows = sorted(result.rows, key=lambda r: -r["quadrisection"])
     polygons = [r["polygons"] for r in rows]
-    errors = [r["diff_mean_abs"] for r in rows]
+    errors = [r["mean_diff_255"] for r in rows]
     assert polygons[0] < polygons[1] < polygons[2]
     assert errors[2] < 0.75 * errors[0]
     mesh_config = write_config(tmp_path, """
@@ -385,7 +385,7 @@ def test_a_point_drawn_by_the_software_rasterizer(ctx):
     assert "workbench/algo/softraster/pipeline.py" not in point_sources(gl)
     row = measured_columns(soft, ctx)
     assert row["renderer"].startswith("software rasterizer")
-    assert row["diff_share_differing"] <= 0.005
+    assert row["share_differing"] <= 0.005
     assert soft.columns()["rasterizer"] == "software" and "rasterizer" not in gl.columns()
 
 

@@ -30,10 +30,11 @@ class ImageDiff:
     psnr: float
     ssim: float
 
-    def as_row(self, prefix: str = "") -> dict[str, float | int]:
-        """Flat table columns, names optionally prefixed."""
-        return {prefix + k: getattr(self, k)
-                for k in ("max_abs", "mean_abs", "share_differing", "psnr", "ssim")}
+    def as_row(self) -> dict[str, float | int]:
+        """Flat table columns, named as in every table: ``max_diff_255``, ``mean_diff_255``,
+        ``share_differing``, ``psnr_db`` and ``ssim``."""
+        return {"max_diff_255": self.max_abs, "mean_diff_255": self.mean_abs,
+                "share_differing": self.share_differing, "psnr_db": self.psnr, "ssim": self.ssim}
 
 
 def _check_image(image, name: str) -> np.ndarray:

@@ -4,9 +4,9 @@ A config::
 
     name = "bands_vertex_pixel"     # default: the file's stem
     repeats = 7                     # timed draws per point (>= 5; --quick lowers it to 5)
-    reference = "pixel_color"       # optional: the path whose image gives the diff_* columns
+    reference = "pixel_color"       # optional: the path whose image gives the image-difference columns
     timed = true                    # false: every point draws once, untimed (error-only)
-    metric = "diff_mean_abs"        # optional: the error plotted in pareto.png
+    metric = "mean_diff_255"        # optional: the error plotted in pareto.png
 
     [grid]
     scene = ["semicylinders:16", "semicylinders:32"]
@@ -47,9 +47,9 @@ the scene, measures the certified one-sided Hausdorff distance original → simp
 the simplified mesh (see :func:`workbench.sweep.points.simplified_scene`).
 
 **Error**: with ``reference``, every point's image is compared with the reference path's image
-of the same (unsimplified) scene and options (``diff_max_abs``, ``diff_mean_abs`` in 1/255,
-``diff_share_differing``, ``diff_psnr``, ``diff_ssim``); ``metric`` picks the one plotted
-(default ``hausdorff_pct`` when the grid simplifies, else ``diff_mean_abs``).
+of the same (unsimplified) scene and options (``max_diff_255``, ``mean_diff_255`` in 1/255,
+``share_differing``, ``psnr_db``, ``ssim``); ``metric`` picks the one plotted
+(default ``hausdorff_pct_diag`` when the grid simplifies, else ``mean_diff_255``).
 
 **Timing**: timed draws hold the host's draw lock (one at a time per machine); untimed work runs
 in parallel. ``timed = false`` (or ``workbench sweep --untimed``) makes every point error-only:

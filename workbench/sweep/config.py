@@ -20,8 +20,8 @@ SIMPLIFY_KEYS = ("simplifier", "tolerance", "quadrisection")  # preprocessing of
 # how deeply nested one value of a sequence-valued key is (a list of numbers: 1)
 VALUE_DEPTH = {"view": 1, "value_range": 1, "hide_range": 1, "base_color": 1, "wire_color": 1,
                "clip_planes": 2}
-IMAGE_METRICS = ("diff_mean_abs", "diff_max_abs", "diff_share_differing")
-HAUSDORFF_METRICS = ("hausdorff_pct", "hausdorff", "hausdorff_upper")
+IMAGE_METRICS = ("mean_diff_255", "max_diff_255", "share_differing")
+HAUSDORFF_METRICS = ("hausdorff_pct_diag", "hausdorff_lower_mm", "hausdorff_mm")
 DEFAULT_SIZE = (400, 300)
 DEFAULT_VIEW = (30.0, 25.0)
 DEFAULT_REPEATS = 7
@@ -204,7 +204,7 @@ def load_config(path) -> SweepConfig:
 def _metric(source: str, metric, reference, simplifies: bool) -> str | None:
     """The error column plotted: the configured one if the sweep gives it, else the default."""
     if metric is None:
-        return "hausdorff_pct" if simplifies else ("diff_mean_abs" if reference else None)
+        return "hausdorff_pct_diag" if simplifies else ("mean_diff_255" if reference else None)
     if metric in IMAGE_METRICS and reference is None:
         raise ValueError(f"{source}: metric {metric!r} needs a reference path")
     if metric in HAUSDORFF_METRICS and not simplifies:

@@ -25,12 +25,12 @@ def _axis_label(column: str, reference: str | None) -> str:
     return {
         "wall_ms": "wall time per draw (ms, median)",
         "point_ms": "wall time of the whole untimed point (ms)",
-        "diff_mean_abs": f"mean absolute difference{against} (1/255)",
-        "diff_max_abs": f"largest absolute difference{against} (1/255)",
-        "diff_share_differing": f"share of pixels differing{against} (0–1)",
-        "hausdorff_pct": "Hausdorff original → simplified (% of diagonal)",
-        "hausdorff": "Hausdorff original → simplified (model units)",
-        "hausdorff_upper": "Hausdorff original → simplified (model units)",
+        "mean_diff_255": f"mean absolute difference{against} (1/255)",
+        "max_diff_255": f"largest absolute difference{against} (1/255)",
+        "share_differing": f"share of pixels differing{against} (0–1)",
+        "hausdorff_pct_diag": "Hausdorff original → simplified (% of diagonal)",
+        "hausdorff_lower_mm": "Hausdorff original → simplified, lower bound (model units)",
+        "hausdorff_mm": "Hausdorff original → simplified, certified (model units)",
     }.get(column, column)
 
 

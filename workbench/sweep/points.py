@@ -132,8 +132,8 @@ def simplified_scene(mesh, point: Point):
     The reference simplifiers aim at the triangle count ours reaches at that tolerance. The
     columns: ``triangles_before``, ``triangles_after``, ``target_triangles`` (references),
     ``simplify_s`` (wall seconds of the simplifier's own call), and the certified one-sided
-    Hausdorff distance original → simplified: ``hausdorff`` (the attained lower end of the
-    bracket, model units), ``hausdorff_upper`` (its certified upper end), ``hausdorff_pct``
+    Hausdorff distance original → simplified: ``hausdorff_lower_mm`` (the attained lower end of
+    the bracket, model units), ``hausdorff_mm`` (its certified upper end), ``hausdorff_pct_diag``
     (the upper end in % of the bounding-box diagonal) and ``hausdorff_s``. A simplifier that
     fails or returns nothing raises RuntimeError; a scene that is no FE mesh, ValueError.
     """
@@ -146,7 +146,7 @@ def simplified_scene(mesh, point: Point):
     if point.simplifier == NO_SIMPLIFIER:  # drawn as it is, quads included
         triangles = mesh.n_elements + mesh.n_quads
         return mesh, dict(triangles_before=triangles, triangles_after=triangles, simplify_s=0.0,
-                          hausdorff=0.0, hausdorff_upper=0.0, hausdorff_pct=0.0, hausdorff_s=0.0)
+                          hausdorff_lower_mm=0.0, hausdorff_mm=0.0, hausdorff_pct_diag=0.0, hausdorff_s=0.0)
     tri = mesh.triangulation
     v, f = mesh.nodes, tri.triangles.astype(np.int64)
     used = v[np.unique(f)]
@@ -164,8 +164,8 @@ def simplified_scene(mesh, point: Point):
         u, g, seconds, shares = out.vertices, out.triangles, out.seconds, out.shares_vertices
         columns["target_triangles"] = target
     h = hausdorff(v, f, u, g, tol=HAUSDORFF_BRACKET * diagonal)
-    columns.update(triangles_after=len(g), simplify_s=seconds, hausdorff=h.max,
-                   hausdorff_upper=h.upper, hausdorff_pct=100.0 * h.upper / diagonal,
+    columns.update(triangles_after=len(g), simplify_s=seconds, hausdorff_lower_mm=h.max,
+                   hausdorff_mm=h.upper, hausdorff_pct_diag=100.0 * h.upper / diagonal,
                    hausdorff_s=h.seconds)
     simplified = FEMesh(nodes=u, elements=g, parts=parts,
                         steps=mesh.steps if shares else None,
@@ -193,7 +193,7 @@ def _reference_image(ctx, point: Point, scene, camera, measured):
 def measured_columns(point: Point, ctx) -> dict:
     """The columns of a point drawn on ``ctx``: :func:`measure`'s row (its ``scene`` renamed
     ``scene_name``; ``lock_wait_ms`` is how long the timed draw waited for the host's draw
-    lock), the simplification columns, and ``diff_*`` (:meth:`ImageDiff.as_row`: max and mean
+    lock), the simplification columns, and the image differences (:meth:`ImageDiff.as_row`: max and mean
     absolute difference in 1/255, share of pixels differing, PSNR in dB, SSIM) against the
     reference image."""
     from ..experiment.cluster import draw_lock
@@ -232,7 +232,7 @@ def measured_columns(point: Point, ctx) -> dict:
     row.update(columns)
     if point.reference is not None:
         reference = _reference_image(ctx, point, original, camera, measured)
-        row.update(compare_images(reference, measured.image).as_row("diff_"))
+        row.update(compare_images(reference, measured.image).as_row())
     return row
 
 
