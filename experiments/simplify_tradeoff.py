@@ -60,7 +60,7 @@ from workbench.scene.mesh import FEMesh
 from ._simplify_figures import save_equal_error_figure, save_tradeoff_figure
 
 TOLERANCES_PCT = (0.1, 0.25, 0.5, 1.0, 2.0)
-QUICK_TOLERANCES_PCT = (0.5, 2.0)
+QUICK_TOLERANCES_PCT = (0.5,)
 TINY_TOLERANCES_PCT = (2.0,)
 BRACKET_REL = 1e-6  # bracket width of the table's distances, share of the bounding-box diagonal
 TINY_PANELS = 400  # the fewest quads the stamped panels come in (two parts of 200)
@@ -94,18 +94,18 @@ def smooth_closed_mesh() -> Model | None:
 
 def models(exp: ExperimentContext, car: FEMesh | None) -> Iterator[Model]:
     """The meshes of the trade-off table: the car deck ``car`` (None where it is absent) per
-    part and refined k×k with a smooth displacement (k = 4, quick 2), the stamped panels
-    (26 284 quads, quick 2 215), the d3plot model, the semicylinders (n = 64, quick 16) and the
-    bunny (the d3plot and the bunny at full size only); tiny: the smallest panels alone."""
+    part and refined 4×4 with a smooth displacement, the stamped panels (26 284 quads, quick
+    2 215), the d3plot model, the semicylinders (n = 64, quick 16) and the bunny (the displaced
+    car, the d3plot and the bunny at full size only); tiny: the smallest panels alone."""
     if exp.tiny:
         yield _from_mesh("stamped panels", generators.stamped_panels(TINY_PANELS))
         return
     if car is not None:
         yield _from_mesh("car (per part)", car)
-        k = exp.pick(4, 2)
-        yield _from_mesh(f"car {k}x{k} displaced",
-                         generators.displaced(generators.refine(car, k), amplitude=10.0,
-                                              wavelength=1200.0))
+        if not exp.quick:
+            yield _from_mesh("car 4x4 displaced",
+                             generators.displaced(generators.refine(car, 4), amplitude=10.0,
+                                                  wavelength=1200.0))
     yield _from_mesh("stamped panels", generators.stamped_panels(exp.pick(26_284, 2_215)))
     d3plot = None if exp.quick else exp.builtin("d3plot")
     if d3plot is not None:
@@ -283,6 +283,7 @@ def tradeoff_rows(exp: ExperimentContext, model: Model) -> list[dict]:
 SWEEP_PCT = (0.05, 0.1, 0.25, 0.5, 1.0, 2.0)
 QUICK_SWEEP_PCT = (0.5,)
 SEARCH_STEP = 0.02   # the count search stops when its bracket is within 2 % of the count
+TINY_SEARCH_STEP = 0.25
 SEARCH_BRACKET = 1e-3  # metric bracket width for the search's decisions, share of the error
 SEARCH_FLOOR_REL = 1e-6  # smallest error searched for, share of the bounding-box diagonal
 
@@ -290,16 +291,12 @@ SEARCH_FLOOR_REL = 1e-6  # smallest error searched for, share of the bounding-bo
 def sweep_models(exp: ExperimentContext, car: FEMesh | None) -> Iterator[Model]:
     """The meshes of the equal-error sweep: the car deck ``car`` (None where it is absent) and
     the small generated meshes (a search runs a peer and the exact metric some ten times per
-    point); quick: the car deck, or the panels without it; tiny: the smallest panels."""
-    if exp.tiny:
-        yield _from_mesh("stamped panels", generators.stamped_panels(TINY_PANELS))
-        return
-    if car is not None:
+    point); quick: the panels alone; tiny: the smallest panels."""
+    if car is not None and not exp.quick:
         yield _from_mesh("car (per part)", car)
-    elif exp.quick:
-        yield _from_mesh("stamped panels", generators.stamped_panels(2_215))
+    yield _from_mesh("stamped panels", generators.stamped_panels(exp.pick(2_215, 2_215,
+                                                                          TINY_PANELS)))
     if not exp.quick:
-        yield _from_mesh("stamped panels", generators.stamped_panels(2_215))
         yield _from_mesh("semicylinders", generators.semicylinders(n=16))
 
 
@@ -315,11 +312,13 @@ def peer_runner(model: Model, method: str, scope: str, shares: dict):
     return per_part
 
 
-def fewest_triangles_within(model: Model, run, error: float) -> dict:
-    """Search the target count (bisection on its logarithm) for the fewest triangles whose
-    certified one-sided distance (upper bound of the exact metric) is ≤ ``error``. Returns the
-    count reached, its distance, the number of tool runs, and ``failure`` when even the input
-    count does not get within ``error``."""
+def fewest_triangles_within(model: Model, run, error: float,
+                            step: float = SEARCH_STEP) -> dict:
+    """Search the target count (bisection on its logarithm, until its bracket is within
+    ``step`` of the count) for the fewest triangles whose certified one-sided distance (upper
+    bound of the exact metric) is ≤ ``error``. Returns the count reached, its distance, the
+    number of tool runs, and ``failure`` when even the input count does not get within
+    ``error``."""
     k = len(model.triangles)
     calls = 0
 
@@ -338,7 +337,7 @@ def fewest_triangles_within(model: Model, run, error: float) -> dict:
         return dict(triangles=len(best.triangles), hausdorff_mm=best_h, calls=calls,
                     failure=best.failure or "not within the error even at the input count")
     lo, hi = 1, k
-    while hi - lo > max(1, SEARCH_STEP * hi):
+    while hi - lo > max(1, step * hi):
         mid = max(lo + 1, min(hi - 1, int(round(np.sqrt(lo * hi)))))
         ok, out, h = within(mid)
         if ok:
@@ -354,9 +353,11 @@ def equal_error_rows(exp: ExperimentContext, model: Model) -> list[dict]:
     """At each tolerance (0.05 % to 2 %; quick and tiny 0.5 %) our triangles and certified
     distance E (exact metric, original → simplified, whole mesh; at least 1e-6 of the
     diagonal), then for every peer (whole mesh, and per part with each part's share of the
-    count as ours) the fewest triangles it needs for a distance ≤ E."""
+    count as ours) the fewest triangles it needs for a distance ≤ E (searched to 2 % of the
+    count; tiny 25 %)."""
     rows = []
     diag = _diagonal(model.vertices, model.triangles)
+    step = exp.pick(SEARCH_STEP, SEARCH_STEP, TINY_SEARCH_STEP)
     for pct in exp.pick(SWEEP_PCT, QUICK_SWEEP_PCT):
         ours = hausdorff_decimate(model.vertices, model.triangles, pct / 100.0, relative=True,
                                   parts=model.parts)
@@ -378,7 +379,8 @@ def equal_error_rows(exp: ExperimentContext, model: Model) -> list[dict]:
         shares = {p: n / max(len(ours.triangles), 1) for p, n in part_targets(model, ours).items()}
         # and meshoptimizer searched to that distance, its like for like
         at_free = fewest_triangles_within(
-            model, peer_runner(model, "meshoptimizer simplify", "whole mesh", shares), h_free)
+            model, peer_runner(model, "meshoptimizer simplify", "whole mesh", shares), h_free,
+            step)
         rows.append(dict(scene=model.label, tol_pct=pct, method=OURS_NO_FEATURES, scope=scope,
                          borders=border_rule, vertices=kept, error=h_free,
                          error_pct_diag=100 * h_free / diag, triangles=len(free.triangles),
@@ -388,7 +390,8 @@ def equal_error_rows(exp: ExperimentContext, model: Model) -> list[dict]:
         peers = ([(m, "whole mesh") for m in SIMPLIFIERS]
                  + [(m, "per part") for m in PART_SIMPLIFIERS])
         for method, scope in peers:
-            found = fewest_triangles_within(model, peer_runner(model, method, scope, shares), error)
+            found = fewest_triangles_within(model, peer_runner(model, method, scope, shares),
+                                            error, step)
             borders = "free" if scope == "whole mesh" else PART_SIMPLIFIERS[method][1]
             vertices = ("kept" if method.startswith("meshoptimizer") or "vertices kept" in method
                         else "moved")
@@ -406,14 +409,14 @@ def equal_error_rows(exp: ExperimentContext, model: Model) -> list[dict]:
 
 
 def metric_rows(exp: ExperimentContext, car: FEMesh | None) -> list[dict]:
-    """Our bracket against the reference distance tools on the car deck ``car`` refined k×k
-    (k = 4, quick 2, tiny 1) and simplified to 1/8 by pymeshlab: ours at bracket widths from
-    1 % to 1e-6 % of the diagonal (quick 1 % and 0.1 %, tiny 1 %), pymeshlab sampled at 10 k,
-    100 k and 1 M points (quick the first two, tiny 1 k), libigl and open3d. Distances in mm;
-    no rows without the car."""
+    """Our bracket against the reference distance tools on the car deck ``car`` (refined 4×4
+    at full size) simplified to 1/8 by pymeshlab: ours at bracket widths from 1 % to 1e-6 % of
+    the diagonal (quick 1 % and 0.1 %, tiny 1 %), pymeshlab sampled at 10 k, 100 k and 1 M
+    points (quick the first two, tiny 1 k), libigl and open3d. Distances in mm; no rows
+    without the car."""
     if car is None:
         return []
-    mesh = generators.refine(car, exp.pick(4, 2, 1))
+    mesh = generators.refine(car, exp.pick(4, 1))
     v, f = mesh.nodes, mesh.triangles.astype(np.int64)
     simplified = simplify_with("pymeshlab quadric", v, f, len(f) // 8)
     u, g = simplified.vertices, simplified.triangles
