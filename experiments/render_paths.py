@@ -21,52 +21,47 @@ Run: ``workbench run render_paths [--quick]``.
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
-from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.compare import compare_drawn, difference_image
-from workbench.experiment.figures import save_field_figure, save_image_grid
-from workbench.experiment.measure import measure
-from workbench.experiment.reference import PyrenderReference
 from workbench.experiment.context import ExperimentContext
+from workbench.experiment.figures import save_field_figure, save_image_grid
+from workbench.experiment.reference import PyrenderReference
 from workbench.experiment.registry import experiment
-from workbench.experiment.tables import write_table
 from workbench.experiment.timing import time_call
-from workbench.gl import Camera, create_context, renderer
+from workbench.gl import Camera
 from workbench.paths import Style, make_path
 from workbench.paths.colormap import scale_for
 from workbench.scene import generators
-from workbench.scene.builtin import builtin_scene
 from workbench.scene.needs import MESH_ITEMS, derivation_cost
 
 BANDS = 10
 
 
-def scenes(quick: bool, say):
+def scenes(exp: ExperimentContext):
     """(label, mesh, step shown, field, element field or None, units, camera kwargs, image size).
 
     The car is put through a synthetic frontal crush (its rigid pole held still) so that it has
-    time steps and a displacement field; its last step is shown (skipped, with a message, when
-    the shared data is absent). The semicylinders are the es2008 benchmark.
+    time steps (12, quick 4, tiny 2) and a displacement field; its last step is shown at
+    1000×625 (quick 640×400, tiny 80×50), skipped, with a message, when the shared data is
+    absent. The semicylinders are the es2008 benchmark, n = 250 at 1000×1000 (quick 64 at
+    500×500, tiny 4 at 64×64).
     """
-    if shared_file(CAR_DECK) is None:
-        say(f"car skipped: {CAR_DECK} not found (set WORKBENCH_DATA to the shared data folder)")
-    else:
-        car = builtin_scene("car")
+    car = exp.builtin("car")
+    if car is not None:
         rigid = [part for part, title in car.part_names.items() if "rigid" in title.lower()]
-        car = generators.crash_sequence(car, steps=4 if quick else 12, still_parts=rigid)
+        car = generators.crash_sequence(car, steps=exp.pick(12, 4, 2), still_parts=rigid)
         yield ("car", car, car.n_steps - 1, "displacement", "thickness", "mm",
                {"azimuth": -35.0, "elevation": 20.0, "up": "z"},
-               (640, 400) if quick else (1000, 625))
-    n = 64 if quick else 250
+               exp.pick((1000, 625), (640, 400), (80, 50)))
+    n = exp.pick(250, 64, 4)
     yield (f"semicylinders n={n}", generators.semicylinders(n=n), 0, "distance", None, "mm",
-           {"azimuth": 25.0, "elevation": 15.0}, (500, 500) if quick else (1000, 1000))
+           {"azimuth": 25.0, "elevation": 15.0}, exp.pick((1000, 1000), (500, 500), (64, 64)))
 
 
 def path_configs(step: int, field: str, element_field: str | None, value_range, clip_plane):
-    """(row label, path name, style, MSAA samples, reference label or None); references come first."""
+    """(case, path name, style, MSAA samples, reference case or None); references come first."""
     plain = Style(step=step)
     smooth = replace(plain, field=field, value_range=value_range)
     banded = replace(smooth, bands=BANDS)
@@ -91,91 +86,118 @@ def path_configs(step: int, field: str, element_field: str | None, value_range, 
     yield "pixel bands, 4x MSAA", "pixel_color", banded, 4, None
 
 
+def path_rows(exp: ExperimentContext, label: str, mesh, configs, camera: Camera,
+              size) -> tuple[list[dict], dict]:
+    """One row per path configuration of :func:`path_configs` on ``mesh`` at ``size`` (W, H):
+    the measurement, what the path's needs saved, and the colour error against its reference
+    configuration where it has one. Returns the rows and the images by configuration."""
+    rows, images = [], {}
+    costs: dict[float, dict] = {}
+    for case, name, style, samples, reference in configs:
+        path = make_path(name, style)
+        probe = set_step_time(exp.repeats) if mesh.n_steps > 1 else None
+        m = exp.measure(mesh, path, camera=camera, size=size, samples=samples, probe=probe)
+        images[case] = image = m.image
+        row = dict(renderer=exp.renderer, scene=label, case=case, path=name,
+                   style=style.summary(), size=f"{size[0]}x{size[1]}", samples=samples,
+                   triangles=path.triangles, vertices=path.vertices,
+                   bytes_uploaded=path.bytes_uploaded, bytes_per_step=path.bytes_per_step,
+                   **m.timing.as_row(), mtri_per_s=path.triangles / m.timing.wall_ms / 1e3)
+        if probe is not None:
+            row["set_step_ms"] = m.row["set_step_ms"]
+        row.update(needs_saving(mesh, path.needs, style, costs))
+        if reference is not None:
+            diff = compare_drawn(image, images[reference])
+            row.update(reference=reference, max_diff_255=diff.max_abs,
+                       share_differing=diff.share_differing, psnr_db=diff.psnr, ssim=diff.ssim)
+        rows.append(row)
+        exp.say(f"  {case}: gpu {m.timing.gpu_ms:.2f} ms, wall {m.timing.wall_ms:.2f} ms, "
+                f"needs skipped {row['skipped_bytes'] / 2**20:.1f} MiB")
+    return rows, images
+
+
+def pyrender_row(exp: ExperimentContext, label: str, mesh, step: int, camera: Camera, size,
+                 ours: np.ndarray):
+    """pyrender (EGL, always 4× MSAA) drawing the crease-split Gouraud triangles of step
+    ``step`` at ``size``, timed with read-back and compared with our 4× MSAA Gouraud image
+    ``ours``. Returns its row, its image and the crease split."""
+    split = mesh.gouraud(Style().crease_deg)
+    coords = mesh.coordinates(step)
+    ref = PyrenderReference(coords[split.vertex_node], split.triangles, split.normals(coords),
+                            camera=camera, size=size, base_color=Style().base_color)
+    ref_image = ref.render()
+    ref_timing = ref.time(warmup=2, repeat=exp.repeats)
+    ref.release()
+    diff = compare_drawn(ref_image, ours)
+    row = dict(renderer=exp.renderer, scene=label, case="pyrender (EGL)", path="pyrender",
+               size=f"{size[0]}x{size[1]}", samples=4, triangles=len(split.triangles),
+               vertices=split.n_vertices, **ref_timing.as_row(),
+               mtri_per_s=len(split.triangles) / ref_timing.wall_ms / 1e3,
+               reference="gouraud, 4x MSAA", max_diff_255=diff.max_abs,
+               share_differing=diff.share_differing, psnr_db=diff.psnr, ssim=diff.ssim)
+    exp.say(f"  pyrender: wall {ref_timing.wall_ms:.2f} ms, SSIM vs gouraud 4x MSAA "
+            f"{diff.ssim:.3f}")
+    return row, ref_image, split
+
+
+def target_row(exp: ExperimentContext, label: str, mesh, size, rows: list[dict],
+               reference: dict, split) -> dict:
+    """The targets of one scene: the contour path against the position-only draw and against
+    pyrender (its ``reference`` row), and what a time step uploads against preparation."""
+    by_case = {r["case"]: r for r in rows}
+    contour, contour_msaa = by_case["pixel bands"], by_case["pixel bands, 4x MSAA"]
+    return {
+        "renderer": exp.renderer, "scene": label, "size": f"{size[0]}x{size[1]}",
+        "triangles": contour["triangles"], "contour_wall_ms": contour["wall_ms"],
+        "position_only_wall_ms": by_case["position"]["wall_ms"],
+        "contour_over_position_only": contour["wall_ms"] / by_case["position"]["wall_ms"],
+        "contour_msaa_incl_readback_ms": contour_msaa["wall_ms"] + contour_msaa["readback_ms"],
+        "pyrender_incl_readback_ms": reference["wall_ms"],
+        "contour_msaa_over_pyrender":
+            (contour_msaa["wall_ms"] + contour_msaa["readback_ms"]) / reference["wall_ms"],
+        "pyrender_ssim": reference["ssim"],
+        "nodes": len(mesh.used_nodes()), "crease_vertices_added": split.added,
+        "bytes_per_step": contour["bytes_per_step"],
+        "bytes_at_prepare": contour["bytes_uploaded"],
+    }
+
+
+def save_figures(exp: ExperimentContext, label: str, images: dict, ref_image: np.ndarray,
+                 ssim: float, value_range, field: str, units: str) -> None:
+    """The scene's per-pixel bands with the wire frame, per-vertex against per-pixel colour,
+    and ours beside pyrender (``ref_image``, ``ssim`` against ours)."""
+    stem = label.split()[0]
+    save_field_figure(exp.file(f"{stem}_bands_wire.png"), images["pixel bands + wire"],
+                      value_range=value_range, colormap=Style().colormap, label=field, units=units,
+                      title=f"{label}: per-pixel bands + element wire frame", bands=BANDS)
+    save_image_grid(exp.file(f"{stem}_vertex_vs_pixel.png"),
+                    [images["vertex smooth"], images["pixel smooth"],
+                     difference_image(images["vertex smooth"], images["pixel smooth"])],
+                    ["colour per vertex", "colour per pixel (reference)", "|difference| x8"])
+    save_image_grid(exp.file(f"{stem}_pyrender.png"), [images["gouraud, 4x MSAA"], ref_image],
+                    ["workbench gouraud, 4x MSAA", f"pyrender (SSIM {ssim:.3f})"])
+
+
 @experiment("render_paths", "first render paths on the car and the es2008 semicylinders: time against "
                             "error, pyrender and a bare draw beside them")
 def run(exp: ExperimentContext) -> list[dict]:
-    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
-    ctx = create_context()
-    gl_renderer = renderer(ctx)
-    repeat = 5 if quick else 9
     rows: list[dict] = []
     targets: list[dict] = []
-    for label, mesh, step, field, element_field, units, view, size in scenes(quick, say):
-        say(f"{label}: {mesh.n_elements} elements, {size[0]}x{size[1]}")
+    for label, mesh, step, field, element_field, units, view, size in scenes(exp):
+        exp.say(f"{label}: {mesh.n_elements} elements, {size[0]}x{size[1]}")
         lo, hi = mesh.bounds(all_steps=True)
         center = (lo + hi) / 2.0
         camera = Camera.fit_box(lo, hi, aspect=size[0] / size[1], **view)
         value_range = scale_for(mesh, field).value_range
         clip_plane = (*(-camera.view_matrix()[0, :3]), float(camera.view_matrix()[0, :3] @ center))
-        images: dict[str, np.ndarray] = {}
-        costs: dict[float, dict] = {}
-        for row_label, name, style, samples, reference in path_configs(step, field, element_field,
-                                                                       value_range, clip_plane):
-            path = make_path(name, style)
-            probe = set_step_time(repeat) if mesh.n_steps > 1 else None
-            m = measure(ctx, mesh, path, camera=camera, size=size, repeats=repeat,
-                        samples=samples, probe=probe)
-            images[row_label] = image = m.image
-            row = dict(renderer=gl_renderer, scene=label, path=row_label, path_name=name,
-                       parameters=style.summary(), width=size[0], height=size[1], msaa=samples,
-                       triangles=path.triangles, vertices=path.vertices,
-                       bytes_uploaded=path.bytes_uploaded, bytes_per_step=path.bytes_per_step,
-                       **m.timing.as_row(), mtri_per_s=path.triangles / m.timing.wall_ms / 1e3)
-            if probe is not None:
-                row["set_step_ms"] = m.row["set_step_ms"]
-            row.update(needs_saving(mesh, path.needs, style, costs))
-            if reference is not None:
-                diff = compare_drawn(image, images[reference])
-                row.update(reference=reference, max_err_255=diff.max_abs, share_differing=diff.share_differing,
-                           psnr_db=diff.psnr, ssim=diff.ssim)
-            rows.append(row)
-            say(f"  {row_label}: gpu {m.timing.gpu_ms:.2f} ms, wall {m.timing.wall_ms:.2f} ms, "
-                f"needs skipped {row['skipped_bytes'] / 2**20:.1f} MiB")
-
-        split = mesh.gouraud(Style().crease_deg)
-        coords = mesh.coordinates(step)
-        ref = PyrenderReference(coords[split.vertex_node], split.triangles, split.normals(coords),
-                                camera=camera, size=size, base_color=Style().base_color)
-        ref_image = ref.render()
-        ref_timing = ref.time(warmup=2, repeat=repeat)
-        ref.release()
-        diff = compare_drawn(ref_image, images["gouraud, 4x MSAA"])
-        rows.append(dict(renderer=gl_renderer, scene=label, path="pyrender (EGL)", path_name="pyrender",
-                         width=size[0], height=size[1], msaa=4, triangles=len(split.triangles),
-                         vertices=split.n_vertices, **ref_timing.as_row(),
-                         mtri_per_s=len(split.triangles) / ref_timing.wall_ms / 1e3,
-                         reference="gouraud, 4x MSAA", max_err_255=diff.max_abs, share_differing=diff.share_differing,
-                         psnr_db=diff.psnr, ssim=diff.ssim))
-        say(f"  pyrender: wall {ref_timing.wall_ms:.2f} ms, SSIM vs gouraud 4x MSAA {diff.ssim:.3f}")
-
-        by_path = {r["path"]: r for r in rows if r["scene"] == label}
-        contour, contour_msaa = by_path["pixel bands"], by_path["pixel bands, 4x MSAA"]
-        targets.append({
-            "renderer": gl_renderer, "scene": label, "size": f"{size[0]}x{size[1]}",
-            "triangles": contour["triangles"], "contour_wall_ms": contour["wall_ms"],
-            "position_only_wall_ms": by_path["position"]["wall_ms"],
-            "contour_over_position_only": contour["wall_ms"] / by_path["position"]["wall_ms"],
-            "contour_msaa_incl_readback_ms": contour_msaa["wall_ms"] + contour_msaa["readback_ms"],
-            "pyrender_incl_readback_ms": ref_timing.wall_ms,
-            "contour_msaa_over_pyrender":
-                (contour_msaa["wall_ms"] + contour_msaa["readback_ms"]) / ref_timing.wall_ms,
-            "pyrender_ssim": diff.ssim,
-            "nodes": len(mesh.used_nodes()), "crease_vertices_added": split.added,
-            "bytes_per_step": contour["bytes_per_step"],
-            "bytes_at_prepare": contour["bytes_uploaded"],
-        })
-
-        stem = label.split()[0]
-        save_field_figure(out_dir / f"{stem}_bands_wire.png", images["pixel bands + wire"],
-                          value_range=value_range, colormap=Style().colormap, label=field, units=units,
-                          title=f"{label}: per-pixel bands + element wire frame", bands=BANDS)
-        save_image_grid(out_dir / f"{stem}_vertex_vs_pixel.png",
-                        [images["vertex smooth"], images["pixel smooth"],
-                         difference_image(images["vertex smooth"], images["pixel smooth"])],
-                        ["colour per vertex", "colour per pixel (reference)", "|difference| x8"])
-        save_image_grid(out_dir / f"{stem}_pyrender.png", [images["gouraud, 4x MSAA"], ref_image],
-                        ["workbench gouraud, 4x MSAA", f"pyrender (SSIM {diff.ssim:.3f})"])
-    write_table(targets, out_dir, name="targets", title="Targets: contour path against pyrender and a bare draw")
+        configs = path_configs(step, field, element_field, value_range, clip_plane)
+        scene_rows, images = path_rows(exp, label, mesh, configs, camera, size)
+        reference, ref_image, split = pyrender_row(exp, label, mesh, step, camera, size,
+                                                   images["gouraud, 4x MSAA"])
+        rows += scene_rows + [reference]
+        targets.append(target_row(exp, label, mesh, size, scene_rows, reference, split))
+        save_figures(exp, label, images, ref_image, reference["ssim"], value_range, field, units)
+    exp.table(targets, "targets", "Targets: contour path against pyrender and a bare draw")
     return rows
 
 

@@ -40,29 +40,30 @@ Run: ``workbench run simplify_tradeoff [--quick]``.
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from workbench.algo.bvh import TriangleBVH
 from workbench.algo.hausdorff import hausdorff
 from workbench.algo.simplify import hausdorff_decimate
-from workbench.data import CAR_DECK, D3PLOT, shared_file
 from workbench.experiment.context import ExperimentContext
 from workbench.experiment.registry import experiment
 from workbench.experiment.simplifiers import (PART_SIMPLIFIERS, SIMPLIFIERS, igl_hausdorff,
                                               open3d_distances, part_border_vertices,
                                               pymeshlab_hausdorff, simplify_per_part,
                                               simplify_with)
-from workbench.experiment.tables import atomic_open, write_table
 from workbench.scene import generators
-from workbench.scene.builtin import builtin_scene
 from workbench.scene.mesh import FEMesh
 
+from ._simplify_figures import save_equal_error_figure, save_tradeoff_figure
+
 TOLERANCES_PCT = (0.1, 0.25, 0.5, 1.0, 2.0)
-QUICK_TOLERANCES_PCT = (0.5, 2.0)
+QUICK_TOLERANCES_PCT = (0.5,)
+TINY_TOLERANCES_PCT = (2.0,)
 BRACKET_REL = 1e-6  # bracket width of the table's distances, share of the bounding-box diagonal
+TINY_PANELS = 400  # the fewest quads the stamped panels come in (two parts of 200)
 
 
 @dataclass
@@ -91,26 +92,31 @@ def smooth_closed_mesh() -> Model | None:
     return Model("bunny (closed)", np.asarray(m.vertices, np.float64), f, np.zeros(len(f), np.int32))
 
 
-def models(quick: bool, say):
-    if shared_file(CAR_DECK) is None:
-        say(f"car skipped: {CAR_DECK} not found (set WORKBENCH_DATA to the shared data folder)")
-    else:
-        car = builtin_scene("car")
+def models(exp: ExperimentContext, car: FEMesh | None) -> Iterator[Model]:
+    """The meshes of the trade-off table: the car deck ``car`` (None where it is absent) per
+    part and refined 4×4 with a smooth displacement, the stamped panels (26 284 quads, quick
+    2 215), the d3plot model, the semicylinders (n = 64, quick 16) and the bunny (the displaced
+    car, the d3plot and the bunny at full size only); tiny: the smallest panels alone."""
+    if exp.tiny:
+        yield _from_mesh("stamped panels", generators.stamped_panels(TINY_PANELS))
+        return
+    if car is not None:
         yield _from_mesh("car (per part)", car)
-        refined = generators.refine(car, 2 if quick else 4)
-        yield _from_mesh(f"car {2 if quick else 4}x{2 if quick else 4} displaced",
-                         generators.displaced(refined, amplitude=10.0, wavelength=1200.0))
-    yield _from_mesh("stamped panels", generators.stamped_panels(2_215 if quick else 26_284))
-    if shared_file(D3PLOT) is None:
-        say(f"d3plot skipped: {D3PLOT} not found")
-    elif not quick:
-        yield _from_mesh("d3plot", builtin_scene("d3plot"))
-    yield _from_mesh("semicylinders", generators.semicylinders(n=16 if quick else 64))
-    bunny = smooth_closed_mesh()
-    if bunny is None:
-        say("bunny skipped: pymeshlab's sample meshes are not installed")
-    elif not quick:
-        yield bunny
+        if not exp.quick:
+            yield _from_mesh("car 4x4 displaced",
+                             generators.displaced(generators.refine(car, 4), amplitude=10.0,
+                                                  wavelength=1200.0))
+    yield _from_mesh("stamped panels", generators.stamped_panels(exp.pick(26_284, 2_215)))
+    d3plot = None if exp.quick else exp.builtin("d3plot")
+    if d3plot is not None:
+        yield _from_mesh("d3plot", d3plot)
+    yield _from_mesh("semicylinders", generators.semicylinders(n=exp.pick(64, 16)))
+    if not exp.quick:
+        bunny = smooth_closed_mesh()
+        if bunny is None:
+            exp.say("bunny skipped: pymeshlab's sample meshes are not installed")
+        else:
+            yield bunny
 
 
 def _diagonal(v: np.ndarray, f: np.ndarray) -> float:
@@ -127,21 +133,26 @@ def float32_slack(*vertex_arrays) -> float:
     return 1e-5 * max(float(np.abs(v).max()) for v in vertex_arrays)
 
 
-def measure(model: Model, v: np.ndarray, f: np.ndarray, samples: int, bracket: float) -> dict:
-    """One-sided (original → simplified) and symmetric certified distances, pymeshlab beside."""
+def distance_columns(model: Model, v: np.ndarray, f: np.ndarray, sample_points: int,
+                     bracket: float) -> dict:
+    """One-sided (original → simplified) and symmetric certified distances in model units
+    (brackets ``bracket`` wide), pymeshlab's value from ``sample_points`` beside them; no
+    columns for an empty result."""
     if not len(f):
         return {}
     one = hausdorff(model.vertices, model.triangles, v, f, tol=bracket)
     back = hausdorff(v, f, model.vertices, model.triangles, tol=bracket)
     diag = _diagonal(model.vertices, model.triangles)
-    sampled = pymeshlab_hausdorff(model.vertices, model.triangles, v, f, samples)
-    return dict(h_lower=one.lower, h_upper=one.upper, h_pct_diag=100 * one.upper / diag,
-                h_bracket_reached=one.tol_reached,
-                h_mean=one.mean, metric_s=one.seconds,
-                sym_lower=max(one.lower, back.lower), sym_upper=max(one.upper, back.upper),
-                pymeshlab_sampled=sampled["max"], pymeshlab_samples=samples,
-                pymeshlab_outside=bool(sampled["max"] > one.upper
-                                       + float32_slack(model.vertices, v)))
+    sampled = pymeshlab_hausdorff(model.vertices, model.triangles, v, f, sample_points)
+    return dict(hausdorff_lower_mm=one.lower, hausdorff_mm=one.upper,
+                hausdorff_pct_diag=100 * one.upper / diag,
+                hausdorff_bracket_reached=one.tol_reached,
+                hausdorff_mean_mm=one.mean, metric_s=one.seconds,
+                symmetric_hausdorff_lower_mm=max(one.lower, back.lower),
+                symmetric_hausdorff_mm=max(one.upper, back.upper),
+                pymeshlab_hausdorff_mm=sampled["max"], sample_points=sample_points,
+                pymeshlab_outside_bracket=bool(sampled["max"] > one.upper
+                                               + float32_slack(model.vertices, v)))
 
 
 def per_part_check(model: Model, decimation) -> float:
@@ -192,13 +203,13 @@ def part_targets(model: Model, decimation) -> dict:
     return {int(p): int((decimation.parts == p).sum()) for p in np.unique(model.parts)}
 
 
-def ours_row(model: Model, method: str, pct: float, samples: int, bracket: float,
+def ours_row(model: Model, method: str, pct: float, sample_points: int, bracket: float,
              borders: np.ndarray):
     """Our decimation at ``pct`` % and its row (constraints, count, distances, per-part check)."""
     ours = hausdorff_decimate(model.vertices, model.triangles, pct / 100.0, relative=True,
                               parts=model.parts, slide_shared=(method == OURS))
     scope, border_rule, kept = OURS_CONSTRAINTS[method]
-    row = dict(mesh=model.label, method=method, scope=scope, borders=border_rule, vertices=kept,
+    row = dict(scene=model.label, method=method, scope=scope, borders=border_rule, vertices=kept,
                tol_pct=pct, input_triangles=len(model.triangles),
                triangles=len(ours.triangles), seconds=ours.seconds,
                certified_max=ours.certified_max,
@@ -206,15 +217,16 @@ def ours_row(model: Model, method: str, pct: float, samples: int, bracket: float
                border_vertices_kept=present_share(model.vertices, borders, model.vertices,
                                                   ours.triangles),
                bytes_saved_by_sharing=ours.bytes_saved,
-               **measure(model, model.vertices, ours.triangles, samples, bracket))
+               **distance_columns(model, model.vertices, ours.triangles, sample_points,
+                                  bracket))
     return ours, row
 
 
-def peer_row(model: Model, out, target: int, pct: float, samples: int, bracket: float,
+def peer_row(model: Model, out, target: int, pct: float, sample_points: int, bracket: float,
              borders: np.ndarray) -> dict:
     """A reference simplifier's row at our count ``target``: its constraints, the count it
     reached (``stopped_at`` when it could not reach ours), distances."""
-    row = dict(mesh=model.label, method=out.method, scope=out.scope, borders=out.borders,
+    row = dict(scene=model.label, method=out.method, scope=out.scope, borders=out.borders,
                vertices=out.vertices_kept, tol_pct=pct, input_triangles=len(model.triangles),
                target_triangles=target, triangles=len(out.triangles),
                stopped_at=(None if out.failure or reached(target, len(out.triangles))
@@ -223,28 +235,30 @@ def peer_row(model: Model, out, target: int, pct: float, samples: int, bracket: 
                border_vertices_kept=(present_share(model.vertices, borders, out.vertices,
                                                    out.triangles) if not out.failure else None),
                bytes_saved_by_sharing=(out.vertices.nbytes if out.shares_vertices else 0))
-    row.update(measure(model, out.vertices, out.triangles, samples, bracket))
+    row.update(distance_columns(model, out.vertices, out.triangles, sample_points, bracket))
     return row
 
 
-def tradeoff_rows(model: Model, tolerances, samples: int, say) -> list[dict]:
-    """At each tolerance: ours (shared borders sliding, and locked for reference), then every
-    peer at our triangle count on the whole mesh (part borders free) and per part (each part
-    asked for our count of that part, under the tool's border constraint)."""
+def tradeoff_rows(exp: ExperimentContext, model: Model) -> list[dict]:
+    """At each tolerance (% of each part's bounding-sphere diameter): ours (shared borders
+    sliding, and locked for reference), then every peer at our triangle count on the whole mesh
+    (part borders free) and per part (each part asked for our count of that part, under the
+    tool's border constraint); pymeshlab samples 100 k points (quick 10 k, tiny 1 k)."""
     rows = []
     diag = _diagonal(model.vertices, model.triangles)
     bracket = BRACKET_REL * diag
     borders = part_border_vertices(model.triangles, model.parts)
-    for pct in tolerances:
+    samples = exp.pick(100_000, 10_000, 1_000)
+    for pct in exp.pick(TOLERANCES_PCT, QUICK_TOLERANCES_PCT, TINY_TOLERANCES_PCT):
         ours, row = ours_row(model, OURS, pct, samples, bracket, borders)
         target = len(ours.triangles)
         rows.append(row)
-        say(f"  {model.label} ours {pct} %: {target} triangles in {ours.seconds:.2f} s, "
-            f"H ≤ {row['h_upper']:.4g}")
+        exp.say(f"  {model.label} ours {pct} %: {target} triangles in {ours.seconds:.2f} s, "
+                f"H ≤ {row['hausdorff_mm']:.4g}")
         _, row = ours_row(model, OURS_LOCKED, pct, samples, bracket, borders)
         rows.append(row)
-        say(f"  {model.label} ours locked {pct} %: {row['triangles']} triangles, "
-            f"H ≤ {row['h_upper']:.4g}")
+        exp.say(f"  {model.label} ours locked {pct} %: {row['triangles']} triangles, "
+                f"H ≤ {row['hausdorff_mm']:.4g}")
         targets = part_targets(model, ours)
         runs = [simplify_with(method, model.vertices, model.triangles, target)
                 for method in SIMPLIFIERS]
@@ -253,14 +267,14 @@ def tradeoff_rows(model: Model, tolerances, samples: int, say) -> list[dict]:
         for out in runs:
             row = peer_row(model, out, target, pct, samples, bracket, borders)
             rows.append(row)
-            say(f"  {model.label} {out.method} ({out.scope}): {len(out.triangles)} triangles in "
-                f"{out.seconds:.2f} s" + (f" ({out.failure})" if out.failure
-                                           else f", H ≤ {row.get('h_upper', 0):.4g}"))
+            exp.say(f"  {model.label} {out.method} ({out.scope}): {len(out.triangles)} triangles "
+                    f"in {out.seconds:.2f} s" + (f" ({out.failure})" if out.failure else
+                                                 f", H ≤ {row.get('hausdorff_mm', 0):.4g}"))
     ours_rows = {r["tol_pct"]: r for r in rows if r["method"] == OURS}
     for r in rows:
         mine = ours_rows[r["tol_pct"]]
-        if r["method"] != OURS and r.get("h_upper"):
-            r["h_over_ours"] = r["h_lower"] / mine["h_upper"]
+        if r["method"] != OURS and r.get("hausdorff_mm"):
+            r["hausdorff_over_ours"] = r["hausdorff_lower_mm"] / mine["hausdorff_mm"]
             r["time_over_ours"] = r["seconds"] / mine["seconds"]
     return rows
 
@@ -269,22 +283,20 @@ def tradeoff_rows(model: Model, tolerances, samples: int, say) -> list[dict]:
 SWEEP_PCT = (0.05, 0.1, 0.25, 0.5, 1.0, 2.0)
 QUICK_SWEEP_PCT = (0.5,)
 SEARCH_STEP = 0.02   # the count search stops when its bracket is within 2 % of the count
+TINY_SEARCH_STEP = 0.25
 SEARCH_BRACKET = 1e-3  # metric bracket width for the search's decisions, share of the error
 SEARCH_FLOOR_REL = 1e-6  # smallest error searched for, share of the bounding-box diagonal
 
 
-def sweep_models(quick: bool, say):
-    """The meshes of the equal-error sweep: the car deck and the small generated meshes (a
-    search runs a peer and the exact metric some ten times per point); quick: the car deck,
-    or the panels without it."""
-    if shared_file(CAR_DECK) is not None:
-        yield _from_mesh("car (per part)", builtin_scene("car"))
-    else:
-        say(f"car skipped in the sweep: {CAR_DECK} not found")
-        if quick:
-            yield _from_mesh("stamped panels", generators.stamped_panels(2_215))
-    if not quick:
-        yield _from_mesh("stamped panels", generators.stamped_panels(2_215))
+def sweep_models(exp: ExperimentContext, car: FEMesh | None) -> Iterator[Model]:
+    """The meshes of the equal-error sweep: the car deck ``car`` (None where it is absent) and
+    the small generated meshes (a search runs a peer and the exact metric some ten times per
+    point); quick: the panels alone; tiny: the smallest panels."""
+    if car is not None and not exp.quick:
+        yield _from_mesh("car (per part)", car)
+    yield _from_mesh("stamped panels", generators.stamped_panels(exp.pick(2_215, 2_215,
+                                                                          TINY_PANELS)))
+    if not exp.quick:
         yield _from_mesh("semicylinders", generators.semicylinders(n=16))
 
 
@@ -300,11 +312,13 @@ def peer_runner(model: Model, method: str, scope: str, shares: dict):
     return per_part
 
 
-def fewest_triangles_within(model: Model, run, error: float) -> dict:
-    """Search the target count (bisection on its logarithm) for the fewest triangles whose
-    certified one-sided distance (upper bound of the exact metric) is ≤ ``error``. Returns the
-    count reached, its distance, the number of tool runs, and ``failure`` when even the input
-    count does not get within ``error``."""
+def fewest_triangles_within(model: Model, run, error: float,
+                            step: float = SEARCH_STEP) -> dict:
+    """Search the target count (bisection on its logarithm, until its bracket is within
+    ``step`` of the count) for the fewest triangles whose certified one-sided distance (upper
+    bound of the exact metric) is ≤ ``error``. Returns the count reached, its distance, the
+    number of tool runs, and ``failure`` when even the input count does not get within
+    ``error``."""
     k = len(model.triangles)
     calls = 0
 
@@ -320,28 +334,31 @@ def fewest_triangles_within(model: Model, run, error: float) -> dict:
 
     ok, best, best_h = within(k)
     if not ok:
-        return dict(triangles=len(best.triangles), h_upper=best_h, calls=calls,
+        return dict(triangles=len(best.triangles), hausdorff_mm=best_h, calls=calls,
                     failure=best.failure or "not within the error even at the input count")
     lo, hi = 1, k
-    while hi - lo > max(1, SEARCH_STEP * hi):
+    while hi - lo > max(1, step * hi):
         mid = max(lo + 1, min(hi - 1, int(round(np.sqrt(lo * hi)))))
         ok, out, h = within(mid)
         if ok:
             hi, best, best_h = mid, out, h
         else:
             lo = mid
-    return dict(triangles=len(best.triangles), h_upper=best_h, calls=calls, failure=None,
+    return dict(triangles=len(best.triangles), hausdorff_mm=best_h, calls=calls, failure=None,
                 seconds=best.seconds, scope=best.scope, borders=best.borders,
                 vertices=best.vertices_kept)
 
 
-def equal_error_rows(model: Model, tolerances, say) -> list[dict]:
-    """At each tolerance our triangles and certified distance E (exact metric, original →
-    simplified, whole mesh; at least 1e-6 of the diagonal), then for every peer (whole mesh, and per part with each part's
-    share of the count as ours) the fewest triangles it needs for a distance ≤ E."""
+def equal_error_rows(exp: ExperimentContext, model: Model) -> list[dict]:
+    """At each tolerance (0.05 % to 2 %; quick and tiny 0.5 %) our triangles and certified
+    distance E (exact metric, original → simplified, whole mesh; at least 1e-6 of the
+    diagonal), then for every peer (whole mesh, and per part with each part's share of the
+    count as ours) the fewest triangles it needs for a distance ≤ E (searched to 2 % of the
+    count; tiny 25 %)."""
     rows = []
     diag = _diagonal(model.vertices, model.triangles)
-    for pct in tolerances:
+    step = exp.pick(SEARCH_STEP, SEARCH_STEP, TINY_SEARCH_STEP)
+    for pct in exp.pick(SWEEP_PCT, QUICK_SWEEP_PCT):
         ours = hausdorff_decimate(model.vertices, model.triangles, pct / 100.0, relative=True,
                                   parts=model.parts)
         h = hausdorff(model.vertices, model.triangles, model.vertices, ours.triangles,
@@ -349,7 +366,7 @@ def equal_error_rows(model: Model, tolerances, say) -> list[dict]:
         # below 1e-6 of the diagonal a float32 tool cannot resolve a distance: search to that
         error = max(h.upper, SEARCH_FLOOR_REL * diag)
         scope, border_rule, kept = OURS_CONSTRAINTS[OURS]
-        rows.append(dict(mesh=model.label, tol_pct=pct, method=OURS, scope=scope,
+        rows.append(dict(scene=model.label, tol_pct=pct, method=OURS, scope=scope,
                          borders=border_rule, vertices=kept, error=error,
                          error_pct_diag=100 * error / diag, triangles=len(ours.triangles),
                          over_ours=1.0, seconds=ours.seconds, calls=1))
@@ -362,8 +379,9 @@ def equal_error_rows(model: Model, tolerances, say) -> list[dict]:
         shares = {p: n / max(len(ours.triangles), 1) for p, n in part_targets(model, ours).items()}
         # and meshoptimizer searched to that distance, its like for like
         at_free = fewest_triangles_within(
-            model, peer_runner(model, "meshoptimizer simplify", "whole mesh", shares), h_free)
-        rows.append(dict(mesh=model.label, tol_pct=pct, method=OURS_NO_FEATURES, scope=scope,
+            model, peer_runner(model, "meshoptimizer simplify", "whole mesh", shares), h_free,
+            step)
+        rows.append(dict(scene=model.label, tol_pct=pct, method=OURS_NO_FEATURES, scope=scope,
                          borders=border_rule, vertices=kept, error=h_free,
                          error_pct_diag=100 * h_free / diag, triangles=len(free.triangles),
                          over_ours=len(free.triangles) / max(len(ours.triangles), 1),
@@ -372,167 +390,91 @@ def equal_error_rows(model: Model, tolerances, say) -> list[dict]:
         peers = ([(m, "whole mesh") for m in SIMPLIFIERS]
                  + [(m, "per part") for m in PART_SIMPLIFIERS])
         for method, scope in peers:
-            found = fewest_triangles_within(model, peer_runner(model, method, scope, shares), error)
+            found = fewest_triangles_within(model, peer_runner(model, method, scope, shares),
+                                            error, step)
             borders = "free" if scope == "whole mesh" else PART_SIMPLIFIERS[method][1]
             vertices = ("kept" if method.startswith("meshoptimizer") or "vertices kept" in method
                         else "moved")
-            row = dict(mesh=model.label, tol_pct=pct, method=method, scope=scope,
-                       borders=borders, vertices=vertices, error=error,
-                       error_pct_diag=100 * error / diag, triangles=found["triangles"],
-                       h_upper=found["h_upper"],
-                       over_ours=found["triangles"] / max(len(ours.triangles), 1),
-                       seconds=found.get("seconds"), calls=found["calls"],
-                       failure=found["failure"])
-            rows.append(row)
-            say(f"  equal error {model.label} {pct} %: {method} ({scope}) "
-                + (f"fails ({found['failure']})" if found["failure"]
-                   else f"{found['triangles']} triangles vs ours {len(ours.triangles)}"))
+            rows.append(dict(scene=model.label, tol_pct=pct, method=method, scope=scope,
+                             borders=borders, vertices=vertices, error=error,
+                             error_pct_diag=100 * error / diag, triangles=found["triangles"],
+                             hausdorff_mm=found["hausdorff_mm"],
+                             over_ours=found["triangles"] / max(len(ours.triangles), 1),
+                             seconds=found.get("seconds"), calls=found["calls"],
+                             failure=found["failure"]))
+            exp.say(f"  equal error {model.label} {pct} %: {method} ({scope}) "
+                    + (f"fails ({found['failure']})" if found["failure"]
+                       else f"{found['triangles']} triangles vs ours {len(ours.triangles)}"))
     return rows
 
 
-def save_equal_error_figure(path: Path, rows: list[dict]) -> None:
-    """Triangles against the certified one-sided distance, one panel per mesh, one line per
-    method and scope (log axes)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    meshes = list(dict.fromkeys(r["mesh"] for r in rows))
-    series = list(dict.fromkeys((r["method"], r["scope"]) for r in rows))
-    colours = plt.get_cmap("tab20")
-    fig, axes = plt.subplots(1, len(meshes), figsize=(5.5 * len(meshes) + 3, 4.6), dpi=100,
-                             squeeze=False)
-    handles = {}
-    for ax, mesh in zip(axes[0], meshes):
-        mine = [r for r in rows if r["mesh"] == mesh]
-        for i, (method, scope) in enumerate(series):
-            sel = sorted((r for r in mine if r["method"] == method and r["scope"] == scope
-                          and not r.get("failure")), key=lambda r: r["error"])
-            if not sel:
-                continue
-            style = "o-" if method.startswith("ours") else ("x--" if scope == "whole mesh"
-                                                            else "s:")
-            line, = ax.plot([r["error"] for r in sel], [r["triangles"] for r in sel], style,
-                            color=colours(i % 20), label=f"{method} ({scope})", markersize=4)
-            handles.setdefault(line.get_label(), line)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("certified one-sided Hausdorff distance, original → simplified\n"
-                      "(model units: mm for the car and the panels)")
-        ax.set_ylabel("triangles reached")
-        ax.set_title(mesh)
-        ax.grid(True, which="both", alpha=0.3)
-    fig.legend(list(handles.values()), list(handles), fontsize=7, loc="center right")
-    fig.tight_layout(rect=(0, 0, 1 - 3 / (5.5 * len(meshes) + 3), 1))
-    with atomic_open(path, "wb") as fh:
-        fig.savefig(fh, format="png")
-    plt.close(fig)
-
-
-def metric_rows(quick: bool, say) -> list[dict]:
-    """Our bracket against the reference distance tools on the car refined and simplified."""
-    if shared_file(CAR_DECK) is None:
+def metric_rows(exp: ExperimentContext, car: FEMesh | None) -> list[dict]:
+    """Our bracket against the reference distance tools on the car deck ``car`` (refined 4×4
+    at full size) simplified to 1/8 by pymeshlab: ours at bracket widths from 1 % to 1e-6 % of
+    the diagonal (quick 1 % and 0.1 %, tiny 1 %), pymeshlab sampled at 10 k, 100 k and 1 M
+    points (quick the first two, tiny 1 k), libigl and open3d. Distances in mm; no rows
+    without the car."""
+    if car is None:
         return []
-    car = builtin_scene("car")
-    mesh = generators.refine(car, 2 if quick else 4)
+    mesh = generators.refine(car, exp.pick(4, 1))
     v, f = mesh.nodes, mesh.triangles.astype(np.int64)
     simplified = simplify_with("pymeshlab quadric", v, f, len(f) // 8)
     u, g = simplified.vertices, simplified.triangles
     diag = _diagonal(v, f)
     rows = []
     brackets = {}
-    for width_pct in ((1.0, 0.1) if quick else (1.0, 0.1, 0.01, 1e-6)):
+    for width_pct in exp.pick((1.0, 0.1, 0.01, 1e-6), (1.0, 0.1), (1.0,)):
         h = hausdorff(v, f, u, g, tol=width_pct / 100 * diag)
         brackets[width_pct] = h
-        rows.append(dict(pair=f"car {len(f)} → pymeshlab {len(g)} triangles",
+        rows.append(dict(scene=f"car {len(f)} → pymeshlab {len(g)} triangles",
                          tool=f"ours, bracket width {width_pct} % of diagonal", value=h.max,
-                         lower=h.lower, upper=h.upper, width_reached=h.tol_reached,
-                         seconds=h.seconds, samples=h.samples))
-        say(f"  metric: ours {width_pct} %: [{h.lower:.6g}, {h.upper:.6g}] in {h.seconds:.2f} s")
+                         hausdorff_lower_mm=h.lower, hausdorff_mm=h.upper,
+                         width_reached=h.tol_reached, seconds=h.seconds, sample_points=h.samples))
+        exp.say(f"  metric: ours {width_pct} %: [{h.lower:.6g}, {h.upper:.6g}] in "
+                f"{h.seconds:.2f} s")
     tight = brackets[min(brackets)]
     slack = float32_slack(v, u)
-    for samples in ((10_000, 100_000) if quick else (10_000, 100_000, 1_000_000)):
+    for samples in exp.pick((10_000, 100_000, 1_000_000), (10_000, 100_000), (1_000,)):
         s = pymeshlab_hausdorff(v, f, u, g, samples)
         rows.append(dict(tool=f"pymeshlab sampled, {samples} samples", value=s["max"],
-                         seconds=s["seconds"], samples=samples,
+                         seconds=s["seconds"], sample_points=samples,
                          outside_bracket=bool(s["max"] > tight.upper + slack)))
     ig = igl_hausdorff(v, f, u, g)
     back = hausdorff(u, g, v, f, tol=min(brackets) / 100 * diag)
     sym_upper, sym_lower = max(tight.upper, back.upper), max(tight.lower, back.lower)
     rows.append(dict(tool="libigl hausdorff (symmetric)", value=ig["value"], seconds=ig["seconds"],
-                     lower=sym_lower, upper=sym_upper,
-                     outside_bracket=bool(not sym_lower * (1 - 1e-9) <= ig["value"] <= sym_upper * (1 + 1e-9))))
+                     hausdorff_lower_mm=sym_lower, hausdorff_mm=sym_upper,
+                     outside_bracket=bool(not sym_lower * (1 - 1e-9) <= ig["value"]
+                                          <= sym_upper * (1 + 1e-9))))
     points = v[np.unique(f)]
     o3 = open3d_distances(points, u, g)
     exact, _, _ = TriangleBVH(u, g).nearest(points)
     rows.append(dict(tool="open3d RaycastingScene (float32), at the vertices", value=o3["max"],
-                     seconds=o3["seconds"], samples=len(points),
+                     seconds=o3["seconds"], sample_points=len(points),
                      outside_bracket=bool(o3["max"] > tight.upper + slack),
                      worst_point_error=float(np.abs(o3["distances"] - exact).max()),
                      exact_at_worst_point=float(exact[np.argmax(np.abs(o3["distances"] - exact))])))
     for r in rows:
-        r.setdefault("pair", rows[0]["pair"])
+        r.setdefault("scene", rows[0]["scene"])
     return rows
-
-
-def save_tradeoff_figure(path: Path, rows: list[dict], title: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, (ax_n, ax_t) = plt.subplots(1, 2, figsize=(14, 4.6), dpi=100, sharey=True)
-    for ax in (ax_n, ax_t):  # more methods than the default ten colours
-        ax.set_prop_cycle(color=plt.cm.tab20.colors)
-    for method, scope in dict.fromkeys((r["method"], r["scope"]) for r in rows):
-        sel = sorted((r for r in rows if r["method"] == method and r["scope"] == scope
-                      and r.get("h_upper")), key=lambda r: r["triangles"])
-        if not sel:
-            continue
-        style = "o-" if method.startswith("ours") else ("x--" if scope == "whole mesh" else "s:")
-        error = [max(r["h_upper"], 1e-12) for r in sel]
-        label = f"{method} ({scope})"
-        ax_n.plot([r["triangles"] for r in sel], error, style, label=label, markersize=4)
-        ax_t.plot([r["seconds"] for r in sel], error, style, label=label, markersize=4)
-    ax_n.set_xlabel("triangles")
-    ax_t.set_xlabel("simplification time (s)")
-    for ax in (ax_n, ax_t):
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.grid(True, which="both", alpha=0.3)
-    ax_n.set_ylabel("one-sided Hausdorff, original → simplified\n"
-                    "(upper bound; model units, mm for the car and panels)")
-    ax_t.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.02, 0.5))
-    fig.suptitle(title)
-    fig.tight_layout()
-    with atomic_open(path, "wb") as fh:
-        fig.savefig(fh, format="png")
-    plt.close(fig)
 
 
 @experiment("simplify_tradeoff", "crash2000 §3.2: Hausdorff-bounded decimation against pymeshlab, "
                                  "libigl, open3d and meshoptimizer, with a certified metric")
 def run(exp: ExperimentContext) -> list[dict]:
-    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
-    tolerances = QUICK_TOLERANCES_PCT if quick else TOLERANCES_PCT
-    samples = 10_000 if quick else 100_000
+    car = exp.builtin("car")
     rows = []
-    for model in models(quick, say):
-        say(f"{model.label}: {len(model.triangles)} triangles, "
-            f"{len(np.unique(model.parts))} parts")
-        mesh_rows = tradeoff_rows(model, tolerances, samples, say)
+    for model in models(exp, car):
+        exp.say(f"{model.label}: {len(model.triangles)} triangles, "
+                f"{len(np.unique(model.parts))} parts")
+        mesh_rows = tradeoff_rows(exp, model)
         rows += mesh_rows
         stem = model.label.split(" (")[0].replace(" ", "_")
-        save_tradeoff_figure(out_dir / f"{stem}_tradeoff.png", mesh_rows,
+        save_tradeoff_figure(exp.file(f"{stem}_tradeoff.png"), mesh_rows,
                              f"{model.label}: error against triangles and time")
-    write_table(metric_rows(quick, say), out_dir, "metric",
-                title="The certified metric beside pymeshlab, libigl and open3d")
-    sweep = []
-    for model in sweep_models(quick, say):
-        sweep += equal_error_rows(model, QUICK_SWEEP_PCT if quick else SWEEP_PCT, say)
-    write_table(sweep, out_dir, "equal_error",
-                title="Triangles reached at equal certified one-sided distance")
-    save_equal_error_figure(out_dir / "equal_error.png", sweep)
+    exp.table(metric_rows(exp, car), "metric",
+              "The certified metric beside pymeshlab, libigl and open3d")
+    sweep = [r for model in sweep_models(exp, car) for r in equal_error_rows(exp, model)]
+    exp.table(sweep, "equal_error", "Triangles reached at equal certified one-sided distance")
+    save_equal_error_figure(exp.file("equal_error.png"), sweep)
     return rows
-

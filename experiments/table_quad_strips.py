@@ -23,22 +23,20 @@ Run: ``workbench run table_quad_strips [--quick]``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Iterator
+from itertools import islice
 from pathlib import Path
 
 from workbench.algo.strips import quad_strips, tri_strips
-from workbench.data import CAR_DECK, D3PLOT, shared_file
 from workbench.experiment.compare import difference_map, wire_agreement
+from workbench.experiment.context import Case, ExperimentContext
 from workbench.experiment.figures import save_image_grid
-from workbench.experiment.measure import measure
-from workbench.experiment.context import ExperimentContext
 from workbench.experiment.registry import experiment
-from workbench.experiment.tables import atomic_open, write_table
+from workbench.experiment.tables import atomic_open
 from workbench.experiment.timing import time_call
-from workbench.gl import Camera, VertexShaderInvocations, create_context, renderer
+from workbench.gl import Camera, VertexShaderInvocations
 from workbench.paths import Style
 from workbench.scene import generators
-from workbench.scene.builtin import builtin_scene
 
 PAPER_SIZES = (2_215, 26_284, 51_473, 104_749, 255_641)
 # crash2000 Table 1 as printed: #quads, #verts, opTriStripper (#strips, #verts, length),
@@ -53,44 +51,38 @@ PAPER_TABLE_1 = (
 CUTOFFS = (1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64)
 
 
-@dataclass
-class Model:
-    label: str
-    kind: str  # "paper size", "car", "car part", "car refined", "d3plot"
-    mesh: object
+def models(exp: ExperimentContext) -> Iterator[Case]:
+    """The stripping suite as cases of each ``kind`` ("paper size", "car", "car part", "car
+    refined", "d3plot"), smallest first within each kind: the same in quick runs (stripping is
+    fast; quick runs draw and sweep smaller meshes); tiny: the smallest of each kind (the
+    panels of the paper's first size, the car, its first part, its 2×2 refinement, the d3plot).
+    The car and the d3plot are skipped, said, where the shared data is absent."""
+    for n in exp.pick(PAPER_SIZES, PAPER_SIZES, PAPER_SIZES[:1]):
+        yield Case(f"panels {n}", generators.stamped_panels(n), "paper size")
+    car = exp.builtin("car")
+    if car is not None:
+        yield Case("car", car, "car")
+        parts = (Case(f"car part {part}", car.part(part), "car part")
+                 for part in sorted(car.part_names))
+        yield from islice((c for c in parts if c.scene.n_elements), exp.pick(None, None, 1))
+        for k in exp.pick((2, 4, 8), (2, 4, 8), (2,)):
+            yield Case(f"car {k}x{k}", generators.refine(car, k), "car refined")
+    d3plot = exp.builtin("d3plot")
+    if d3plot is not None:
+        yield Case("d3plot", d3plot, "d3plot")
 
 
-def models(say):
-    """The stripping suite, smallest first within each kind (the same in quick runs: stripping
-    is fast; quick runs draw and sweep smaller meshes)."""
-    for n in PAPER_SIZES:
-        yield Model(f"panels {n}", "paper size", generators.stamped_panels(n))
-    if shared_file(CAR_DECK) is None:
-        say(f"car skipped: {CAR_DECK} not found (set WORKBENCH_DATA to the shared data folder)")
-    else:
-        car = builtin_scene("car")
-        yield Model("car", "car", car)
-        for part in sorted(car.part_names):
-            sub = car.part(part)
-            if sub.n_elements:
-                yield Model(f"car part {part}", "car part", sub)
-        for k in (2, 4, 8):
-            yield Model(f"car {k}x{k}", "car refined", generators.refine(car, k))
-    if shared_file(D3PLOT) is None:
-        say(f"d3plot skipped: {D3PLOT} not found")
-    else:
-        yield Model("d3plot", "d3plot", builtin_scene("d3plot"))
-
-
-def stripping_row(model: Model, repeat: int) -> dict:
-    mesh = model.mesh
+def stripping_row(exp: ExperimentContext, case: Case) -> dict:
+    """Our quad strips and meshoptimizer's triangle strips of ``case``: counts, vertices sent
+    (and % of 4n), triangles per strip, and the median stripping wall ms of ``exp.repeats``."""
+    mesh = case.scene
     four_n = 4 * mesh.n_elements
     quads = quad_strips(mesh.elements)
     tri = tri_strips(mesh.triangles, mesh.n_nodes)
-    t_quad = time_call(lambda: quad_strips(mesh.elements), repeat=repeat)
-    t_tri = time_call(lambda: tri_strips(mesh.triangles, mesh.n_nodes), repeat=repeat)
+    t_quad = time_call(lambda: quad_strips(mesh.elements), repeat=exp.repeats)
+    t_tri = time_call(lambda: tri_strips(mesh.triangles, mesh.n_nodes), repeat=exp.repeats)
     return {
-        "mesh": model.label, "kind": model.kind, "elements": mesh.n_elements, "quads": mesh.n_quads,
+        "scene": case.label, "kind": case.kind, "elements": mesh.n_elements, "quads": mesh.n_quads,
         "triangle_elements": len(quads.triangles), "degenerate": len(quads.degenerate),
         "verts_4n": four_n,
         "tri_strips": tri.n_strips, "tri_verts": tri.n_vertices,
@@ -106,7 +98,7 @@ def stripping_row(model: Model, repeat: int) -> dict:
 
 def paper_rows(rows: list[dict]) -> list[dict]:
     """The paper's Table 1 beside the measured rows of the same sizes."""
-    measured = {r["mesh"]: r for r in rows if r["kind"] == "paper size"}
+    measured = {r["scene"]: r for r in rows if r["kind"] == "paper size"}
     out = []
     for quads, verts, t_strips, t_verts, t_len, q_strips, q_verts, q_len in PAPER_TABLE_1:
         r = measured.get(f"panels {quads}")
@@ -126,15 +118,16 @@ def paper_rows(rows: list[dict]) -> list[dict]:
     return out
 
 
-def cutoff_rows(model: Model, cutoffs) -> list[dict]:
-    mesh = model.mesh
+def cutoff_rows(case: Case, cutoffs) -> list[dict]:
+    """Our quad strips of ``case`` at each bandification cutoff beside meshoptimizer's share."""
+    mesh = case.scene
     four_n = 4 * mesh.n_elements
     tri = tri_strips(mesh.triangles, mesh.n_nodes)
     rows = []
     for cutoff in cutoffs:
         quads = quad_strips(mesh.elements, cutoff)
         t = time_call(lambda c=cutoff: quad_strips(mesh.elements, c), warmup=0, repeat=5)
-        rows.append({"mesh": model.label, "cutoff": cutoff, "strips": quads.n_strips,
+        rows.append({"scene": case.label, "cutoff": cutoff, "strips": quads.n_strips,
                      "leftover_quads": len(quads.leftover), "verts": quads.vertex_count,
                      "verts_pct": 100 * quads.vertex_count / four_n,
                      "length": quads.mean_triangles_per_strip, "passes": quads.passes,
@@ -149,8 +142,8 @@ def save_cutoff_figure(path: Path, rows: list[dict]) -> None:
     import matplotlib.pyplot as plt
 
     fig, (ax_v, ax_s) = plt.subplots(1, 2, figsize=(10, 4), dpi=100)
-    for label in dict.fromkeys(r["mesh"] for r in rows):
-        sel = [r for r in rows if r["mesh"] == label]
+    for label in dict.fromkeys(r["scene"] for r in rows):
+        sel = [r for r in rows if r["scene"] == label]
         cut = [r["cutoff"] for r in sel]
         line, = ax_v.plot(cut, [r["verts_pct"] for r in sel], "o-", label=f"{label}: quad strips")
         ax_v.axhline(sel[0]["meshopt_verts_pct"], color=line.get_color(), ls="--",
@@ -174,7 +167,7 @@ def save_cutoff_figure(path: Path, rows: list[dict]) -> None:
 
 
 DRAW_CONFIGS = (
-    # row label, path, style keywords, baseline row for the pixel comparison
+    # case, path, style keywords, the case whose image this one is compared with
     ("list, shorter diagonal", "gouraud", {}, None),
     ("list, strip diagonal", "gouraud", {"quad_diagonal": "strip"}, None),
     ("meshopt triangle strips", "gouraud", {"strips": "triangle", "quad_diagonal": "strip"},
@@ -201,77 +194,75 @@ def vertex_shader_invocations(ctx):
     return probe
 
 
-def draw_rows(ctx, model: Model, size, repeat: int, say) -> tuple[list[dict], dict]:
-    mesh = model.mesh
+def draw_rows(exp: ExperimentContext, case: Case, size) -> tuple[list[dict], dict]:
+    """Every draw configuration on ``case`` at ``size`` (W, H): the measurement, vertices sent
+    and vertex-shader invocations, the pixels differing from the reference image, and the
+    single-pass wire frame's agreement with the line overdraw's. Returns rows and images."""
+    mesh = case.scene
     lo, hi = mesh.bounds()
     view = {"azimuth": -35.0, "elevation": 25.0, "up": "z"}
     camera = Camera.fit_box(lo, hi, aspect=size[0] / size[1], **view)
-    gl_renderer = renderer(ctx)
+    gl_renderer = exp.renderer
     rows, images = [], {}
-    for label, name, kw, baseline in DRAW_CONFIGS:
+    for label, name, kw, reference in DRAW_CONFIGS:
         style = Style(**kw)
-        m = measure(ctx, mesh, name, style, camera=camera, size=size, repeats=repeat,
-                    probe=vertex_shader_invocations(ctx))
+        m = exp.measure(mesh, name, style, camera=camera, size=size,
+                        probe=vertex_shader_invocations(exp.gl))
         images[label] = image = m.image
-        row = dict(renderer=gl_renderer, mesh=model.label, size=f"{size[0]}x{size[1]}", path=label,
-                   path_name=name, parameters=style.summary(), triangles=m.row["triangles"],
+        row = dict(renderer=gl_renderer, scene=case.label, size=f"{size[0]}x{size[1]}",
+                   case=label, path=name, style=style.summary(), triangles=m.row["triangles"],
                    vertices=m.row["vertices"], vertices_sent=m.row["vertices_sent"],
                    strips=m.row["strips"], vs_invocations=m.row["vs_invocations"],
                    bytes_per_step=m.row["bytes_per_step"], **m.timing.as_row())
-        if baseline is not None:
-            diff = difference_map(image, images[baseline])
-            row.update(baseline=baseline, pixels_differing=int((diff > 0).sum()),
+        if reference is not None:
+            diff = difference_map(image, images[reference])
+            row.update(reference=reference, differing_px=int((diff > 0).sum()),
                        max_diff_255=int(diff.max()))
         rows.append(row)
-        say(f"  {model.label} {size[0]}x{size[1]} {label}: wall {m.timing.wall_ms:.1f} ms, "
-            f"{m.row['vertices_sent']} vertices sent")
-    by = {r["path"]: r for r in rows}
+        exp.say(f"  {case.label} {size[0]}x{size[1]} {label}: wall {m.timing.wall_ms:.1f} ms, "
+                f"{m.row['vertices_sent']} vertices sent")
+    by = {r["case"]: r for r in rows}
     base = by["list, strip diagonal"]
     for r in rows:
         r["wall_over_list"] = r["wall_ms"] / base["wall_ms"]
     single, overdraw = images["quad_wire (single pass)"], images["list + line-overdraw wire"]
     wire = wire_agreement(single, overdraw, Style().wire_color)
-    by["quad_wire (single pass)"].update(baseline="list + line-overdraw wire", **wire)
+    by["quad_wire (single pass)"].update(reference="list + line-overdraw wire", **wire)
     return rows, images
 
 
 @experiment("table_quad_strips", "crash2000 Table 1: quad strips by bandification against "
                                  "meshoptimizer triangle strips, drawn stripped and unstripped")
 def run(exp: ExperimentContext) -> list[dict]:
-    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
-    repeat = 5 if quick else 9
-    suite = list(models(say))
+    suite = list(models(exp))
     rows = []
-    for model in suite:
-        rows.append(stripping_row(model, repeat))
+    for case in suite:
+        rows.append(stripping_row(exp, case))
         r = rows[-1]
-        say(f"{model.label}: quad strips {r['quad_verts_pct']:.1f} % of 4n "
-            f"({r['quad_strip_ms']:.0f} ms), meshoptimizer {r['tri_verts_pct']:.1f} % "
-            f"({r['tri_strip_ms']:.0f} ms)")
-    write_table(paper_rows(rows), out_dir, "paper",
-                title="crash2000 Table 1 beside the measured stamped panels of the same sizes")
+        exp.say(f"{case.label}: quad strips {r['quad_verts_pct']:.1f} % of 4n "
+                f"({r['quad_strip_ms']:.0f} ms), meshoptimizer {r['tri_verts_pct']:.1f} % "
+                f"({r['tri_strip_ms']:.0f} ms)")
+    exp.table(paper_rows(rows), "paper",
+              "crash2000 Table 1 beside the measured stamped panels of the same sizes")
 
-    by_label = {m.label: m for m in suite}
-    sweep_models = [by_label[k] for k in ("panels 51473" if quick else "panels 255641", "car 8x8")
-                    if k in by_label]
-    sweep = [r for m in sweep_models for r in cutoff_rows(m, CUTOFFS[:6] if quick else CUTOFFS)]
-    write_table(sweep, out_dir, "cutoff", title="Bandification cutoff sweep")
-    save_cutoff_figure(out_dir / "cutoff.png", sweep)
+    by_label = {c.label: c for c in suite}
+    largest = exp.pick("panels 255641", "panels 51473", "panels 2215")
+    sweep_cases = [by_label[k] for k in (largest, exp.pick("car 8x8", "car 8x8", "car"))
+                   if k in by_label]
+    sweep = [r for c in sweep_cases for r in cutoff_rows(c, exp.pick(CUTOFFS, CUTOFFS[:6]))]
+    exp.table(sweep, "cutoff", "Bandification cutoff sweep")
+    save_cutoff_figure(exp.file("cutoff.png"), sweep)
 
-    ctx = create_context()
-    sizes = [(500, 375)] if quick else [(1000, 750), (250, 188)]
-    draw_models = [by_label[k] for k in ("panels 51473" if quick else "panels 255641",
-                                         "car 2x2" if quick else "car 8x8") if k in by_label]
+    draw_cases = [by_label[k] for k in (largest, exp.pick("car 8x8", "car 2x2", "car"))
+                  if k in by_label]
     draws = []
-    for model in draw_models:
-        for size in sizes:
-            model_rows, images = draw_rows(ctx, model, size, repeat, say)
-            draws += model_rows
-        stem = model.label.replace(" ", "_")
-        save_image_grid(out_dir / f"{stem}_wire.png",
+    for case in draw_cases:
+        for size in exp.pick([(1000, 750), (250, 188)], [(500, 375)], [(160, 120)]):
+            case_rows, images = draw_rows(exp, case, size)
+            draws += case_rows
+        stem = case.label.replace(" ", "_")
+        save_image_grid(exp.file(f"{stem}_wire.png"),
                         [images["list + line-overdraw wire"], images["quad_wire (single pass)"]],
                         ["Gouraud + line-overdraw wire frame", "quad_wire: one pass from quad strips"])
-    write_table(draws, out_dir, "draw", title="Drawing the largest meshes stripped and unstripped "
-                                              "(Gouraud shading)")
+    exp.table(draws, "draw", "Drawing the largest meshes stripped and unstripped (Gouraud shading)")
     return rows
-

@@ -1,58 +1,88 @@
-"""The render_paths experiment end to end in its quick form: tables, figures and what they must show."""
+"""The render_paths experiment end to end: tables, figures and what they must show.
+
+Every test on ``result`` runs at the tiny size (seconds) and, marked slow, on the quick run
+(minutes); the tiny run must write every table and column the quick run writes. What holds only
+at the quick sizes is tested on the quick run alone.
+"""
 
 import pytest
 
-from workbench.data import CAR_DECK, shared_file
+import workbench.data
 from workbench.experiment.registry import discover, run_experiment
 from workbench.experiment.tables import read_table
 
+SEMICYLINDERS = {"tiny": "semicylinders n=4", "quick": "semicylinders n=64"}
+
 
 @pytest.fixture(scope="module")
-def result(tmp_path_factory):
-    if shared_file(CAR_DECK) is None:
-        pytest.skip("shared car deck not found (set WORKBENCH_DATA)")
-    discover()
-    root = tmp_path_factory.mktemp("figures")
-    rows, out_dir = run_experiment("render_paths", figures_root=root, quick=True)
-    return rows, out_dir
+def runs(car_deck, tmp_path_factory):
+    """size → (size, rows, out_dir), each size run once per module."""
+    done = {}
+
+    def run(size):
+        if size not in done:
+            discover()
+            root = tmp_path_factory.mktemp(f"figures_{size}")
+            done[size] = (size, *run_experiment("render_paths", figures_root=root, size=size))
+        return done[size]
+
+    return run
+
+
+@pytest.fixture(scope="module", params=["tiny", pytest.param("quick", marks=pytest.mark.slow)])
+def result(request, runs):
+    return runs(request.param)
+
+
+@pytest.fixture
+def quick(runs):
+    return runs("quick")
 
 
 def test_every_path_is_measured_on_both_scenes(result):
-    rows, _ = result
+    _, rows, _ = result
     scenes = {r["scene"] for r in rows}
     assert len(scenes) == 2
     for scene in scenes:
-        paths = {r["path"] for r in rows if r["scene"] == scene}
+        cases = {r["case"] for r in rows if r["scene"] == scene}
         assert {"position", "flat", "gouraud", "gouraud + wire", "pixel smooth", "vertex smooth",
                 "pixel bands", "vertex bands", "pixel bands + clip", "pixel bands, 4x MSAA",
-                "pyrender (EGL)"} <= paths
+                "pyrender (EGL)"} <= cases
     for r in rows:
         assert r["renderer"] and r["wall_ms"] > 0 and r["triangles"] > 0
 
 
 def test_per_vertex_colour_is_compared_with_per_pixel(result):
-    rows, _ = result
-    for r in (r for r in rows if r["path"].startswith("vertex")):
+    _, rows, _ = result
+    for r in (r for r in rows if r["case"].startswith("vertex")):
+        assert r["reference"].startswith("pixel")
+        assert 0 < r["share_differing"] < 1
+
+
+@pytest.mark.slow
+def test_per_vertex_colour_is_close_to_per_pixel(quick):
+    _, rows, _ = quick
+    for r in (r for r in rows if r["case"].startswith("vertex")):
         assert r["reference"].startswith("pixel")
         assert 0 < r["share_differing"] < 1 and r["ssim"] > 0.9
 
 
 def test_pyrender_draws_a_like_for_like_image(result):
-    rows, _ = result
-    for r in (r for r in rows if r["path"] == "pyrender (EGL)"):
+    _, rows, _ = result
+    for r in (r for r in rows if r["case"] == "pyrender (EGL)"):
         assert r["reference"] == "gouraud, 4x MSAA" and r["ssim"] >= 0.9
 
 
 def test_time_steps_upload_coordinates_not_topology(result):
-    rows, _ = result
-    car = [r for r in rows if r["scene"] == "car" and r["path"] == "pixel bands"][0]
+    _, rows, _ = result
+    car = next(r for r in rows if r["scene"] == "car" and r["case"] == "pixel bands")
     # per step: float32 positions and normals of every drawn vertex, plus the field values
     assert car["bytes_per_step"] == car["vertices"] * (12 + 12 + 4)
     assert car["bytes_per_step"] < car["bytes_uploaded"]
 
 
 def test_tables_and_figures_are_written(result):
-    rows, out_dir = result
+    _, rows, out_dir = result
     assert len(read_table(out_dir / "table.csv")) == len(rows)
     assert (out_dir / "table.md").read_text().count("\n| ") >= len(rows)
     assert len(read_table(out_dir / "targets.csv")) == 2
@@ -60,14 +90,41 @@ def test_tables_and_figures_are_written(result):
         assert (out_dir / name).stat().st_size > 1000
 
 
-def test_without_the_shared_data_the_car_is_skipped_with_a_message(tmp_path, monkeypatch):
-    import workbench.experiments.render_paths as render_paths
+# the tables of a quick run and their columns
+COLUMNS = {
+    "table": ["renderer", "scene", "case", "path", "style", "size", "samples", "triangles",
+              "vertices", "bytes_uploaded", "bytes_per_step", "gpu_ms", "gpu_ms_min",
+              "gpu_ms_max", "wall_ms", "wall_ms_min", "wall_ms_max", "readback_ms", "repeats",
+              "mtri_per_s", "set_step_ms", "derive_ms", "derive_bytes", "skipped_ms",
+              "skipped_bytes", "reference", "max_diff_255", "share_differing", "psnr_db",
+              "ssim"],
+    "targets": ["renderer", "scene", "size", "triangles", "contour_wall_ms",
+                "position_only_wall_ms", "contour_over_position_only",
+                "contour_msaa_incl_readback_ms", "pyrender_incl_readback_ms",
+                "contour_msaa_over_pyrender", "pyrender_ssim", "nodes", "crease_vertices_added",
+                "bytes_per_step", "bytes_at_prepare"],
+}
+CASES = {"position", "flat", "gouraud", "gouraud + wire", "pixel smooth", "vertex smooth",
+         "pixel bands", "vertex bands", "pixel bands + wire", "pixel transfer (hide low 30 %)",
+         "pixel bands + clip", "element flat", "pixel bands, deformation x3",
+         "gouraud, 4x MSAA", "pixel bands, 4x MSAA", "pyrender (EGL)"}
 
+
+def test_every_table_with_every_column_and_kind_of_row(result):
+    _, rows, out_dir = result
+    assert sorted(p.stem for p in out_dir.glob("*.csv")) == sorted(COLUMNS)
+    for name, columns in COLUMNS.items():
+        assert list(read_table(out_dir / f"{name}.csv")[0]) == columns, name
+    assert {r["case"] for r in rows} == CASES
+
+
+@pytest.mark.parametrize("size", ["tiny", pytest.param("quick", marks=pytest.mark.slow)])
+def test_without_the_shared_data_the_car_is_skipped_with_a_message(size, tmp_path, monkeypatch):
     discover()
-    monkeypatch.setattr(render_paths, "shared_file", lambda relative: None)
+    monkeypatch.setattr(workbench.data, "shared_data_dir", lambda: None)
     messages = []
-    rows, out_dir = run_experiment("render_paths", figures_root=tmp_path, quick=True,
+    rows, out_dir = run_experiment("render_paths", figures_root=tmp_path, size=size,
                                    progress=messages.append)
-    assert {r["scene"] for r in rows} == {"semicylinders n=64"}
+    assert {r["scene"] for r in rows} == {SEMICYLINDERS[size]}
     assert any("car skipped" in m for m in messages)
     assert len(read_table(out_dir / "targets.csv")) == 1
