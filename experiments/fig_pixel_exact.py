@@ -9,11 +9,11 @@ velocity magnitude; lighting is Phong with the height field's exact normal.
 
 Outputs in ``figures/fig_pixel_exact/``:
 
-* ``table.md`` — per slice size (10³ … 10⁶ polygons; 10³ … 10⁵ with ``--quick``): tetrahedra,
-  polygons, per-frame slicing time, then for each path (per vertex, per pixel) without edge
-  overdraw, with the paper's line overdraw ("over"), with lines behind the fill ("behind") and
-  with lines and skirts behind it ("skirts"), element records in a buffer texture, and once
-  more without overdraw from the paper's 2-D texture rectangle ("texture"): the time to upload
+* ``table.md`` — per slice size (10³ … 10⁶ polygons; 10³ … 10⁵ with ``--quick``):
+  tetrahedra, polygons, per-frame slicing time, then for each path (per vertex, per pixel)
+  without edge overdraw, with the paper's line overdraw ("over"), with lines behind the fill
+  ("behind") and with lines and skirts behind it ("skirts"), element records in a buffer
+  texture, and once more without overdraw from the paper's 2-D texture rectangle ("texture"): the time to upload
   the slice (``prepare_ms``, program linking included), GPU and wall ms per frame, max and
   mean colour error against the exact image (1/255), the share of covered pixels over 1/255 —
   all of them, and those whose centre is more than 0.01 px from an element edge (closer, the
@@ -34,13 +34,15 @@ Outputs in ``figures/fig_pixel_exact/``:
   polygons: raw polygons, lines over and behind the fill, lines with quadrisection, skirts) and
   ``fig8_height.png`` (the height field, per vertex against per pixel).
 
+The tiny size (the tests' check of every table's shape) draws slices of 10³ polygons 160 px
+wide, with a sweep of two thresholds and two resolutions and a coarser stability mesh.
+
 Run: ``workbench run fig_pixel_exact [--quick]``.
 """
 
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -49,19 +51,18 @@ from workbench.algo.spacetime.fields import BAR, STEEL, RadialPulse
 from workbench.algo.spacetime.mesh import front_refined, rect_triangulation
 from workbench.algo.spacetime.poly import evaluate, evaluate_float32_global, evaluate_float32_local
 from workbench.algo.spacetime.raster import PixelGrid
+from workbench.algo.spacetime.scene import (DOMAIN, PULSE, T_SLICE, Solution, SpacetimeScene,
+                                            bar_scene, plate_solution, slice_scene, window)
 from workbench.algo.spacetime.slicing import TimeSlicer, polygon_areas, quadrisect, slice_at
 from workbench.experiment.compare import crack_pixels
-from workbench.experiment.figures import save_field_figure, save_image_grid
-from workbench.experiment.measure import measure
 from workbench.experiment.context import ExperimentContext
+from workbench.experiment.figures import save_field_figure, save_image_grid
 from workbench.experiment.registry import experiment
-from workbench.experiment.tables import atomic_open, write_table
+from workbench.experiment.tables import atomic_open
 from workbench.experiment.timing import time_call
-from workbench.gl import Camera, create_context, renderer
+from workbench.gl import Camera
 from workbench.paths.colormap import colormap_lut
 from workbench.paths.spacetime import OVERDRAWS, SpacetimeStyle, spacetime_path, top_camera
-from workbench.algo.spacetime.scene import (DOMAIN, PULSE, T_SLICE, Solution, SpacetimeScene, bar_scene,
-                                       plate_solution, slice_scene, window)
 
 U_MAX = 100.0  # kJ/m³, top of the log colour scale
 HEIGHT_SCALE = 800.0  # mm of height per mm/µs (peak speeds ~1e-2 mm/µs)
@@ -74,39 +75,40 @@ EDGE_PX = 0.01  # pixel centres this close to an element edge may go to either e
 RESOLUTIONS = {1_000: 7, 10_000: 28, 100_000: 115, 1_000_000: 390}
 
 
-class Renderer:
-    """One GL context; measures spacetime scenes in the top view (against the exact image) and
-    in an oblique perspective view (cracks), each through
-    :func:`~workbench.experiment.measure.measure`."""
+def spacetime_style(shading, overdraw="none", lighting=True, store="buffer") -> SpacetimeStyle:
+    """The experiment's style: its colour scale and height scale, with ``shading``
+    ("per_vertex", "per_pixel"), edge ``overdraw``, ``lighting`` and element ``store``."""
+    return SpacetimeStyle(shading=shading, edge_overdraw=overdraw, lighting=lighting,
+                          height_scale=HEIGHT_SCALE, U_max=U_MAX, colormap=COLORMAP,
+                          element_store=store)
 
-    def __init__(self, width: int, repeat: int) -> None:
-        self.ctx = create_context()
-        self.name = renderer(self.ctx)
-        self.width, self.repeat = width, repeat
+
+def top_height(scene: SpacetimeScene) -> float:
+    """The largest vertex height of the scene (mm)."""
+    if scene.is_bar:
+        return 1.0
+    c = scene.corners.reshape(-1, 2)
+    speed = evaluate(scene.coeffs, scene.centre, scene.extent, np.repeat(scene.element, 4),
+                     c[:, 0], c[:, 1], scene.t)["speed"]
+    return float(HEIGHT_SCALE * speed.max()) + 1e-3
+
+
+class Views:
+    """Spacetime scenes ``width`` pixels wide in the top view (against the exact image) and in
+    an oblique perspective view (cracks), each measured through the run's context."""
+
+    def __init__(self, exp: ExperimentContext, width: int) -> None:
+        self.exp, self.width = exp, width
         self.table = colormap_lut(COLORMAP)
-
-    def style(self, shading, overdraw="none", lighting=True, store="buffer") -> SpacetimeStyle:
-        return SpacetimeStyle(shading=shading, edge_overdraw=overdraw, lighting=lighting,
-                              height_scale=HEIGHT_SCALE, U_max=U_MAX, colormap=COLORMAP,
-                              element_store=store)
 
     def grid(self, scene: SpacetimeScene) -> PixelGrid:
         return PixelGrid.fit(*scene.bounds(), self.width)
-
-    def heights(self, scene: SpacetimeScene) -> float:
-        """The largest vertex height of the scene (mm)."""
-        if scene.is_bar:
-            return 1.0
-        c = scene.corners.reshape(-1, 2)
-        speed = evaluate(scene.coeffs, scene.centre, scene.extent, np.repeat(scene.element, 4),
-                         c[:, 0], c[:, 1], scene.t)["speed"]
-        return float(HEIGHT_SCALE * speed.max()) + 1e-3
 
     def top(self, scene, style, *, time_it=False, origin=None):
         """(measurement, grid) of the top view, timed with ``time_it``; ``origin`` (3,) is the
         float64 upload origin (default the grid centre)."""
         grid = self.grid(scene)
-        camera = top_camera(grid, (-1.0, self.heights(scene) + 1.0), origin=origin)
+        camera = top_camera(grid, (-1.0, top_height(scene) + 1.0), origin=origin)
         return self._measure(scene, style, camera, (grid.width, grid.height), BACKGROUND,
                              time_it), grid
 
@@ -114,7 +116,7 @@ class Renderer:
         """(H, W, 4) uint8 image of a perspective view from 35° above the plate, on
         CRACK_BACKGROUND."""
         lo, hi = scene.bounds()
-        top = self.heights(scene)
+        top = top_height(scene)
         camera = Camera.fit_box(np.r_[lo, 0.0], np.r_[hi, top], azimuth=25, elevation=35,
                                 projection="perspective", up="z", margin=0.9,
                                 aspect=4 / 3, origin=np.r_[(lo + hi) / 2, 0.0])
@@ -122,19 +124,16 @@ class Renderer:
         return self._measure(scene, style, camera, size, CRACK_BACKGROUND, False).image
 
     def _measure(self, scene, style, camera, size, background, time_it):
-        return measure(self.ctx, scene, spacetime_path(style), camera=camera, size=size,
-                       repeats=self.repeat, background=background, timed=time_it)
+        return self.exp.measure(scene, spacetime_path(style), camera=camera, size=size,
+                                background=background, timed=time_it)
 
     def exact(self, scene: SpacetimeScene, material, grid: PixelGrid, lighting=True):
         return exact_image(scene.corners, scene.element, scene.coeffs, scene.centre, scene.extent,
                            material, grid, t=scene.t, U_max=U_MAX, table=self.table,
                            height_scale=HEIGHT_SCALE, lighting=lighting and not scene.is_bar)
 
-    def release(self) -> None:
-        self.ctx.release()
 
-
-def error_columns(image, exact, corners, grid: PixelGrid, prefix="") -> dict:
+def error_columns(image, exact, corners, grid: PixelGrid) -> dict:
     """Colour error against the exact image (1/255): max, mean and the share of covered pixels
     over 1/255, then the same share and the max error once pixels whose centre lies within
     EDGE_PX of its element's edge are set aside — there the rasteriser's finite sub-pixel
@@ -149,11 +148,11 @@ def error_columns(image, exact, corners, grid: PixelGrid, prefix="") -> dict:
     good = exact.covered & (err <= 1.0)
     worst = max(float(err[good].max()) if good.any() else 0.0,
                 float(err[off[:, 0], off[:, 1]].max()) if len(off) else 0.0)
-    return {prefix + "err_max": stats["max"], prefix + "err_mean": stats["mean"],
-            prefix + "share_over_1": stats["share_over_1"],
-            prefix + "share_over_1_off_edges": len(off) / stats["covered"],
-            prefix + "err_max_off_edges": worst,
-            prefix + "uncovered": stats["uncovered"]}
+    return {"max_diff_255": stats["max"], "mean_diff_255": stats["mean"],
+            "share_over_1": stats["share_over_1"],
+            "share_over_1_off_edges": len(off) / stats["covered"],
+            "max_diff_255_off_edges": worst,
+            "uncovered": stats["uncovered"]}
 
 
 def error_map(image, exact) -> np.ndarray:
@@ -161,75 +160,97 @@ def error_map(image, exact) -> np.ndarray:
     return np.where(exact.covered, err, 0.0)
 
 
+def detail_target(exp: ExperimentContext) -> int:
+    """The slice size of the sweep and of ``fig5``: 10⁴ polygons (tiny 10³)."""
+    return exp.pick(10_000, 10_000, 1_000)
+
+
 # ---------------------------------------------------------------------------- the main table
-def size_rows(r: Renderer, quick: bool, say) -> tuple[list[dict], dict]:
+def timed_slices(slicer: TimeSlicer, frames) -> tuple[object, list[float]]:
+    """(the last slice, ms per frame) of slicing ``frames`` (µs) one after the other."""
+    slice_ms = []
+    for t in frames:
+        start = time.perf_counter()
+        s = slicer.slice(float(t))
+        slice_ms.append(1e3 * (time.perf_counter() - start))
+    return s, slice_ms
+
+
+def size_rows(exp: ExperimentContext, views: Views) -> tuple[list[dict], dict]:
+    """The main table: per slice size (10³ … 10⁶ polygons; quick up to 10⁵, tiny 10³) every
+    path, overdraw and store; and per size up to 10⁵ (solution, scene, slice) for the rest."""
     rows, keep = [], {}
-    targets = [t for t in RESOLUTIONS if not quick or t <= 100_000]
+    targets = [t for t in RESOLUTIONS if t <= exp.pick(1_000_000, 100_000, 1_000)]
     for target in targets:
         n = RESOLUTIONS[target]
         t_lo, t_hi = window(n)
         sol = plate_solution(n, t_lo, t_hi)
-        slicer = TimeSlicer(sol.mesh, outer=True)
         frames = np.linspace(t_lo + 0.05 * (t_hi - t_lo), T_SLICE, 9)
-        slice_ms = []
-        for t in frames:
-            start = time.perf_counter()
-            s = slicer.slice(float(t))
-            slice_ms.append(1e3 * (time.perf_counter() - start))
+        s, slice_ms = timed_slices(TimeSlicer(sol.mesh, outer=True), frames)
         scene = slice_scene(sol, s)
-        say(f"  {target:>9} target: {sol.mesh.n_simplices} tets, {s.n_polygons} polygons, "
-            f"mesh {sol.mesh_s:.1f} s, fit {sol.fit_s:.1f} s, slice {np.median(slice_ms[1:]):.1f} ms")
-        exact = None
-        # every overdraw with the element records in a buffer texture, and the paper's 2-D
-        # texture rectangle for comparison
-        variants = [(overdraw, "buffer") for overdraw in OVERDRAWS] + [("none", "texture")]
-        for shading in ("per_vertex", "per_pixel"):
-            for overdraw, store in variants:
-                style = r.style(shading, overdraw, store=store)
-                m, grid = r.top(scene, style, time_it=True)
-                if exact is None:
-                    exact = r.exact(scene, sol.material, grid)
-                oblique = r.oblique(scene, style)
-                row = dict(target_polygons=target, cells=f"{n}x{n}", tets=sol.mesh.n_simplices,
-                           polygons=s.n_polygons, quads=int(s.is_quad.sum()),
-                           slice_ms=float(np.median(slice_ms[1:])), path=shading,
-                           edge_overdraw=overdraw, element_store=store, **m.timing.as_row(),
-                           prepare_ms=m.row["prepare_ms"], upload_bytes=m.row["bytes_uploaded"],
-                           **error_columns(m.image, exact, scene.corners, grid),
-                           crack_pixels=int(crack_pixels(oblique, CRACK_BACKGROUND).sum()),
-                           renderer=r.name, image=f"{grid.width}x{grid.height}")
-                rows.append(row)
-                say(f"    {shading:10} overdraw {overdraw:6} {store:7} wall {row['wall_ms']:.1f} ms, "
-                    f"err max {row['err_max']:.1f} mean {row['err_mean']:.2f}, "
-                    f">1/255 {100 * row['share_over_1']:.4f} % (off edges "
-                    f"{100 * row['share_over_1_off_edges']:.4f} %, max "
-                    f"{row['err_max_off_edges']:.2f}), cracks {row['crack_pixels']}")
+        exp.say(f"  {target:>9} target: {sol.mesh.n_simplices} tets, {s.n_polygons} polygons, "
+                f"mesh {sol.mesh_s:.1f} s, fit {sol.fit_s:.1f} s, slice "
+                f"{np.median(slice_ms[1:]):.1f} ms")
+        common = dict(target_polygons=target, cells=f"{n}x{n}", tets=sol.mesh.n_simplices,
+                      polygons=s.n_polygons, quads=int(s.is_quad.sum()),
+                      slice_ms=float(np.median(slice_ms[1:])))
+        rows += path_rows(exp, views, sol, scene, common)
         if target <= 100_000:
             keep[target] = (sol, scene, s)
     # cost against the per-vertex path with the same overdraw and store (wall time)
     by = {(row["target_polygons"], row["path"], row["edge_overdraw"], row["element_store"]): row
           for row in rows}
     for row in rows:
-        base = by[(row["target_polygons"], "per_vertex", row["edge_overdraw"], row["element_store"])]
+        base = by[(row["target_polygons"], "per_vertex", row["edge_overdraw"],
+                   row["element_store"])]
         row["wall_vs_per_vertex"] = row["wall_ms"] / base["wall_ms"]
     return rows, keep
 
 
+def path_rows(exp: ExperimentContext, views: Views, sol: Solution, scene, common: dict):
+    """The rows of one slice: both shadings with every overdraw, element records in a buffer
+    texture, and once without overdraw from the paper's 2-D texture rectangle; ``common`` the
+    slice's columns."""
+    rows, exact = [], None
+    variants = [(overdraw, "buffer") for overdraw in OVERDRAWS] + [("none", "texture")]
+    for shading in ("per_vertex", "per_pixel"):
+        for overdraw, store in variants:
+            style = spacetime_style(shading, overdraw, store=store)
+            m, grid = views.top(scene, style, time_it=True)
+            if exact is None:
+                exact = views.exact(scene, sol.material, grid)
+            oblique = views.oblique(scene, style)
+            row = dict(**common, path=shading, edge_overdraw=overdraw, element_store=store,
+                       **m.timing.as_row(), prepare_ms=m.row["prepare_ms"],
+                       bytes_uploaded=m.row["bytes_uploaded"],
+                       **error_columns(m.image, exact, scene.corners, grid),
+                       crack_pixels=int(crack_pixels(oblique, CRACK_BACKGROUND).sum()),
+                       renderer=exp.renderer, size=f"{grid.width}x{grid.height}")
+            rows.append(row)
+            exp.say(f"    {shading:10} overdraw {overdraw:6} {store:7} wall "
+                    f"{row['wall_ms']:.1f} ms, err max {row['max_diff_255']:.1f} mean "
+                    f"{row['mean_diff_255']:.2f}, >1/255 {100 * row['share_over_1']:.4f} % (off "
+                    f"edges {100 * row['share_over_1_off_edges']:.4f} %, max "
+                    f"{row['max_diff_255_off_edges']:.2f}), cracks {row['crack_pixels']}")
+    return rows
+
+
 # ---------------------------------------------------------------------------------- slicing
-def slicing_rows(quick: bool, say) -> list[dict]:
-    """Incremental slicing while t advances through a mesh of ~10⁶ (10⁵ quick) tetrahedra."""
-    n, t_end = (25, 6.0) if quick else (35, 10.0)
+def slicing_rows(exp: ExperimentContext) -> list[dict]:
+    """Incremental slicing while t advances through a mesh of ~10⁶ (quick 10⁵, tiny ~10⁴)
+    tetrahedra, with and without the domain-boundary edges, against slicing from scratch."""
+    n, t_end = exp.pick((35, 10.0), (25, 6.0), (8, 3.0))
     field = RadialPulse(**PULSE)
     start = time.perf_counter()
     pts, tris = rect_triangulation(n, n, size=(DOMAIN, DOMAIN), jitter=0.25, seed=2)
     mesh = front_refined(pts, tris, t_end, STEEL.p_wave_speed, bands=4,
                          front_distance=field.front_distance, width=1.5 * DOMAIN / n)
     build_s = time.perf_counter() - start
-    say(f"slicing: {mesh.n_simplices} tets built in {build_s:.1f} s")
+    exp.say(f"slicing: {mesh.n_simplices} tets built in {build_s:.1f} s")
     start = time.perf_counter()
     slicer = TimeSlicer(mesh)
     sort_s = time.perf_counter() - start
-    times = np.linspace(0.05 * t_end, 0.95 * t_end, 10 if quick else 40)
+    times = np.linspace(0.05 * t_end, 0.95 * t_end, exp.pick(40, 10, 5))
     inc, polys = [], []
     for t in times:
         start = time.perf_counter()
@@ -240,12 +261,7 @@ def slicing_rows(quick: bool, say) -> list[dict]:
     start = time.perf_counter()
     mesh.shared_facets  # derived once per mesh
     facets_s = time.perf_counter() - start
-    outer_slicer = TimeSlicer(mesh, outer=True)
-    inc_outer = []
-    for t in times:
-        start = time.perf_counter()
-        outer_slicer.slice(float(t))
-        inc_outer.append(1e3 * (time.perf_counter() - start))
+    _, inc_outer = timed_slices(TimeSlicer(mesh, outer=True), times)
     brute = [time_call(lambda t=t: slice_at(mesh, float(t)), warmup=0, repeat=5).wall_ms
              for t in times[:: max(1, len(times) // 5)]]
     area = float(polygon_areas(s).sum())
@@ -258,30 +274,32 @@ def slicing_rows(quick: bool, say) -> list[dict]:
            "brute_force_ms_median": float(np.median(brute)),
            "speedup": float(np.median(brute) / np.median(inc[1:])),
            "last_slice_area_error": abs(area - DOMAIN * DOMAIN) / (DOMAIN * DOMAIN)}
-    say(f"  incremental {row['incremental_ms_median']:.1f} ms/frame (max {row['incremental_ms_max']:.1f}, "
-        f"{row['with_outer_ms_median']:.1f} with boundary edges), "
-        f"brute force {row['brute_force_ms_median']:.1f} ms, {row['polygons_median']} polygons")
+    exp.say(f"  incremental {row['incremental_ms_median']:.1f} ms/frame (max "
+            f"{row['incremental_ms_max']:.1f}, {row['with_outer_ms_median']:.1f} with boundary "
+            f"edges), brute force {row['brute_force_ms_median']:.1f} ms, "
+            f"{row['polygons_median']} polygons")
     return [row]
 
 
 # ------------------------------------------------------------------------------------ sweep
-def sweep_rows(r: Renderer, quick: bool, keep: dict, say) -> list[dict]:
+def quadrisection_rows(exp: ExperimentContext, views: Views, keep: dict) -> list[dict]:
+    """Error, time and cracks of the detail slice quadrisected down to a share of its mean
+    polygon area (none, 2 … 1/8; quick 1 … 1/4, tiny 1)."""
     rows = []
-    sol, _, s = keep[10_000]
-    area = polygon_areas(s)
-    mean_area = float(area.mean())
-    factors = (None, 1.0, 0.5, 0.25) if quick else (None, 2.0, 1.0, 0.5, 0.25, 0.125)
+    sol, _, s = keep[detail_target(exp)]
+    mean_area = float(polygon_areas(s).mean())
+    factors = exp.pick((None, 2.0, 1.0, 0.5, 0.25, 0.125), (None, 1.0, 0.5, 0.25), (None, 1.0))
     exact = None
     for factor in factors:
         threshold = np.inf if factor is None else factor * mean_area
         q = s if factor is None else quadrisect(s, threshold)
         qs = slice_scene(sol, q)
         for shading in ("per_vertex", "per_pixel"):
-            m, grid = r.top(qs, r.style(shading, "behind"), time_it=True)
+            m, grid = views.top(qs, spacetime_style(shading, "behind"), time_it=True)
             if exact is None:  # children show their parent's element: one exact image for all
-                exact = r.exact(slice_scene(sol, s), sol.material, grid)
-            oblique = r.oblique(qs, r.style(shading, "behind"))
-            skirted = r.oblique(qs, r.style(shading, "skirts"))
+                exact = views.exact(slice_scene(sol, s), sol.material, grid)
+            oblique = views.oblique(qs, spacetime_style(shading, "behind"))
+            skirted = views.oblique(qs, spacetime_style(shading, "skirts"))
             rows.append(dict(sweep="quadrisection", cells=sol.label,
                              threshold_mm2=None if factor is None else threshold,
                              threshold_vs_mean_area=factor, polygons=q.n_polygons, path=shading,
@@ -289,27 +307,34 @@ def sweep_rows(r: Renderer, quick: bool, keep: dict, say) -> list[dict]:
                              **error_columns(m.image, exact, s.corners, grid),
                              crack_pixels=int(crack_pixels(oblique, CRACK_BACKGROUND).sum()),
                              crack_pixels_skirts=int(crack_pixels(skirted, CRACK_BACKGROUND).sum()),
-                             renderer=r.name))
-        say(f"  quadrisection {factor}: {q.n_polygons} polygons, {rows[-1]['crack_pixels']} crack "
-            f"pixels with lines behind, {rows[-1]['crack_pixels_skirts']} with skirts")
-    for n in ((12, 24, 48) if quick else (12, 24, 48, 96, 192)):
+                             renderer=exp.renderer))
+        exp.say(f"  quadrisection {factor}: {q.n_polygons} polygons, {rows[-1]['crack_pixels']} "
+                f"crack pixels with lines behind, {rows[-1]['crack_pixels_skirts']} with skirts")
+    return rows
+
+
+def resolution_rows(exp: ExperimentContext, views: Views) -> list[dict]:
+    """Error and time against the space-mesh resolution (12² … 192² cells; quick up to 48²,
+    tiny 6² and 8²), with the fitted solution's own error against the closed form."""
+    rows = []
+    for n in exp.pick((12, 24, 48, 96, 192), (12, 24, 48), (6, 8)):
         t_lo, t_hi = window(n)
         sol_n = plate_solution(n, t_lo, t_hi)
         sn = slice_at(sol_n.mesh, T_SLICE)
         scene_n = slice_scene(sol_n, sn)
         ex = None
         for shading in ("per_vertex", "per_pixel"):
-            m, grid = r.top(scene_n, r.style(shading, "behind"), time_it=True)
+            m, grid = views.top(scene_n, spacetime_style(shading, "behind"), time_it=True)
             if ex is None:
-                ex = r.exact(scene_n, sol_n.material, grid)
+                ex = views.exact(scene_n, sol_n.material, grid)
                 closed = closed_form_error(sol_n, grid, ex)
             rows.append(dict(sweep="resolution", cells=f"{n}x{n}", polygons=sn.n_polygons,
                              path=shading, wall_ms=m.timing.wall_ms, gpu_ms=m.timing.gpu_ms,
                              **error_columns(m.image, ex, scene_n.corners, grid),
                              fit_U_err_max=closed,
-                             renderer=r.name))
-        say(f"  resolution {n}x{n}: {sn.n_polygons} polygons, fitted U off the closed form by "
-            f"{closed:.3g} kJ/m³")
+                             renderer=exp.renderer))
+        exp.say(f"  resolution {n}x{n}: {sn.n_polygons} polygons, fitted U off the closed form "
+                f"by {closed:.3g} kJ/m³")
     return rows
 
 
@@ -323,7 +348,7 @@ def closed_form_error(sol: Solution, grid: PixelGrid, exact) -> float:
     return float(np.abs(exact.U[cov] - U).max())
 
 
-def plot_sweep(rows: list[dict], path: Path) -> None:
+def plot_sweep(rows: list[dict], path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -332,7 +357,7 @@ def plot_sweep(rows: list[dict], path: Path) -> None:
     for ax, sweep, label in zip(axes, ("quadrisection", "resolution"),
                                 ("quadrisection threshold", "mesh resolution")):
         for shading, marker in (("per_vertex", "o"), ("per_pixel", "s")):
-            pts = [(row["wall_ms"], row["err_mean"]) for row in rows
+            pts = [(row["wall_ms"], row["mean_diff_255"]) for row in rows
                    if row["sweep"] == sweep and row["path"] == shading]
             if pts:
                 x, y = zip(*pts)
@@ -350,22 +375,38 @@ def plot_sweep(rows: list[dict], path: Path) -> None:
 
 
 # ------------------------------------------------------------------------------- stability
-def stability_rows(r: Renderer, quick: bool, say) -> list[dict]:
-    rows = []
-    n = 24
+def stability_rows(exp: ExperimentContext, views: Views) -> list[dict]:
+    """Far from the origin, degenerate slices and zero fields, per pixel, against the exact
+    image (on a space mesh of 24² cells; tiny 8²)."""
+    n = exp.pick(24, 24, 8)
     t_lo, t_hi = window(n)
-    h = DOMAIN / n
     near = plate_solution(n, t_lo, t_hi)
-    far_offset = (1e4 * h, -1e4 * h)
-    far = plate_solution(n, t_lo, t_hi, offset=far_offset)
+    rows = (far_rows(exp, views, near, n, t_lo, t_hi)
+            + degenerate_rows(exp, views, near, t_lo, t_hi) + zero_field_rows(exp, views, n))
+    for row in rows:
+        exp.say(f"  {row['case']}: err max {row['max_diff_255']:.2f}, >1/255 off edges "
+                f"{100 * row['share_over_1_off_edges']:.4f} %, max off edges "
+                f"{row['max_diff_255_off_edges']:.2f}")
+    return rows
+
+
+def nan_pixels(exact) -> int:
+    return int((~np.isfinite(exact.rgb)).any(axis=2).sum())
+
+
+def far_rows(exp, views: Views, near: Solution, n: int, t_lo: float, t_hi: float) -> list[dict]:
+    """The domain at the origin and 10⁴ element sizes away (relative upload, and global float32
+    coordinates), on the GPU and in a float32 emulation of the evaluation."""
+    h = DOMAIN / n
+    far = plate_solution(n, t_lo, t_hi, offset=(1e4 * h, -1e4 * h))
+    rows = []
     for label, sol, origin in (("at the origin", near, None),
                                ("10^4 element sizes away, relative upload", far, None),
                                ("10^4 element sizes away, global float32", far, np.zeros(3))):
         s = slice_at(sol.mesh, T_SLICE)
         scene = slice_scene(sol, s)
-        m, grid = r.top(scene, r.style("per_pixel"), origin=origin)
-        image = m.image
-        exact = r.exact(scene, sol.material, grid)
+        m, grid = views.top(scene, spacetime_style("per_pixel"), origin=origin)
+        exact = views.exact(scene, sol.material, grid)
         # float32 emulation of the same evaluation at the pixel centres
         xs, ys = grid.centres()
         X, Y = np.meshgrid(xs, ys)
@@ -377,89 +418,104 @@ def stability_rows(r: Renderer, quick: bool, say) -> list[dict]:
         loc = evaluate_float32_local(*args)["U"].astype(np.float64)
         scale = max(float(np.abs(ref).max()), 1e-30)
         rows.append(dict(case=label, offset_mm=float(np.hypot(*np.asarray(sol.field.origin))),
-                         polygons=s.n_polygons, **error_columns(image, exact, scene.corners, grid),
+                         polygons=s.n_polygons,
+                         **error_columns(m.image, exact, scene.corners, grid),
                          f32_global_U_err_rel=float(np.abs(glob - ref).max() / scale),
                          f32_local_U_err_rel=float(np.abs(loc - ref).max() / scale),
-                         nan_pixels=int((~np.isfinite(exact.rgb)).any(axis=2).sum()),
-                         renderer=r.name))
-    # degenerate slices: the flat front between the two bands, and a vertex's time
+                         nan_pixels=nan_pixels(exact), renderer=exp.renderer))
+    return rows
+
+
+def degenerate_rows(exp, views: Views, near: Solution, t_lo: float, t_hi: float) -> list[dict]:
+    """Slices through the flat front between the two bands and through a vertex's time."""
     mid = 0.5 * (t_lo + t_hi)
     vertex_t = float(near.mesh.points[near.mesh.simplices[len(near.mesh.simplices) // 2], 2].max())
+    rows = []
     for label, t in (("slice through the flat front between bands", mid),
                      ("slice through a vertex", vertex_t)):
         s = slice_at(near.mesh, t)
         scene = slice_scene(near, s)
-        m, grid = r.top(scene, r.style("per_pixel"))
-        image = m.image
-        exact = r.exact(scene, near.material, grid)
+        m, grid = views.top(scene, spacetime_style("per_pixel"))
+        exact = views.exact(scene, near.material, grid)
         areas = polygon_areas(s)
         rows.append(dict(case=label, t_us=t, polygons=s.n_polygons,
                          zero_area_polygons=int((areas <= 1e-12 * DOMAIN ** 2).sum()),
                          nan_corners=int((~np.isfinite(s.corners)).sum()),
                          area_error=abs(float(areas.sum()) - DOMAIN ** 2) / DOMAIN ** 2,
-                         **error_columns(image, exact, scene.corners, grid),
-                         nan_pixels=int((~np.isfinite(exact.rgb)).any(axis=2).sum()),
-                         renderer=r.name))
-    # zero strain and zero velocity: before the pulse reaches the far corner, U and |v| vanish
+                         **error_columns(m.image, exact, scene.corners, grid),
+                         nan_pixels=nan_pixels(exact), renderer=exp.renderer))
+    return rows
+
+
+def zero_field_rows(exp, views: Views, n: int) -> list[dict]:
+    """Zero strain and zero velocity: before the pulse reaches the far corner, U and |v|
+    vanish."""
     early = plate_solution(n, 0.0, 1.0, bands=1)
     s = slice_at(early.mesh, 0.5)
     scene = slice_scene(early, s)
+    rows = []
     for shading in ("per_vertex", "per_pixel"):
-        m, grid = r.top(scene, r.style(shading))
-        image = m.image
-        exact = r.exact(scene, early.material, grid)
+        m, grid = views.top(scene, spacetime_style(shading))
+        exact = views.exact(scene, early.material, grid)
         zero = exact.covered & (exact.U < 1e-9)
         rows.append(dict(case=f"U ≈ 0 and |v| ≈ 0 regions ({shading})", polygons=s.n_polygons,
-                         zero_U_pixels=int(zero.sum()), **error_columns(image, exact, scene.corners, grid),
-                         nan_pixels=int((~np.isfinite(exact.rgb)).any(axis=2).sum()),
-                         renderer=r.name))
-    for row in rows:
-        say(f"  {row['case']}: err max {row['err_max']:.2f}, >1/255 off edges "
-            f"{100 * row['share_over_1_off_edges']:.4f} %, max off edges "
-            f"{row['err_max_off_edges']:.2f}")
+                         zero_U_pixels=int(zero.sum()),
+                         **error_columns(m.image, exact, scene.corners, grid),
+                         nan_pixels=nan_pixels(exact), renderer=exp.renderer))
     return rows
 
 
 # --------------------------------------------------------------------------------- figures
-def figures(r: Renderer, out_dir: Path, keep: dict, say) -> None:
+def save_bar_figure(exp: ExperimentContext, views: Views) -> None:
+    """``fig3_bar.png``: the 1-D bar's whole (x, t) spacetime, per vertex, per pixel, exact."""
     bar, _ = bar_scene()
-    images, errors = {}, {}
+    images = {}
     for shading in ("per_vertex", "per_pixel"):
-        m, grid = r.top(bar, r.style(shading, lighting=False))
+        m, grid = views.top(bar, spacetime_style(shading, lighting=False))
         images[shading] = m.image
-    exact = r.exact(bar, BAR, grid, lighting=False)
-    for shading in images:
-        errors[shading] = error_map(images[shading], exact)
-    save_image_grid(out_dir / "fig3_bar.png",
+    exact = views.exact(bar, BAR, grid, lighting=False)
+    errors = {shading: error_map(image, exact) for shading, image in images.items()}
+    save_image_grid(exp.file("fig3_bar.png"),
                     [images["per_vertex"], images["per_pixel"], exact.rgba8(),
                      errors["per_vertex"], errors["per_pixel"]],
                     ["(a) per vertex", "(b) per pixel", "(c) exact", "|a − c|", "|b − c|"],
                     columns=3)
-    say(f"  fig3: bar, {len(bar.corners)} spacetime triangles, per-vertex error max "
-        f"{errors['per_vertex'].max():.0f}, per-pixel {errors['per_pixel'].max():.1f} (1/255)")
+    exp.say(f"  fig3: bar, {len(bar.corners)} spacetime triangles, per-vertex error max "
+            f"{errors['per_vertex'].max():.0f}, per-pixel {errors['per_pixel'].max():.1f} (1/255)")
 
-    sol, scene, _ = keep[10_000]
+
+def save_slice_figures(exp: ExperimentContext, views: Views, keep: dict) -> None:
+    """``fig5_slice.png``, ``fig5_crop.png`` and ``fig5_colorbar.png`` of the detail slice."""
+    sol, scene, _ = keep[detail_target(exp)]
     images = {}
     for shading in ("per_vertex", "per_pixel"):
-        m, grid = r.top(scene, r.style(shading))
+        m, grid = views.top(scene, spacetime_style(shading))
         images[shading] = m.image
-    exact = r.exact(scene, sol.material, grid)
+    exact = views.exact(scene, sol.material, grid)
     panels = [images["per_vertex"], images["per_pixel"], exact.rgba8(),
               error_map(images["per_vertex"], exact), error_map(images["per_pixel"], exact)]
     titles = ["(a) per vertex", "(b) per pixel", "(c) exact", "|a − c|", "|b − c|"]
-    save_image_grid(out_dir / "fig5_slice.png", panels, titles, columns=3)
+    save_image_grid(exp.file("fig5_slice.png"), panels, titles, columns=3)
     # a quarter of the image around the ring's upper right part, for a closer look
     h, w = grid.height, grid.width
     box = (slice(h // 4, h // 2), slice(w // 2, w // 2 + w // 4))
-    save_image_grid(out_dir / "fig5_crop.png", [p[box] for p in panels], titles, columns=5)
-    unlit = r.top(scene, r.style("per_pixel", lighting=False))[0].image
-    save_field_figure(out_dir / "fig5_colorbar.png", unlit,
+    save_image_grid(exp.file("fig5_crop.png"), [p[box] for p in panels], titles, columns=5)
+    unlit = views.top(scene, spacetime_style("per_pixel", lighting=False))[0].image
+    save_field_figure(exp.file("fig5_colorbar.png"), unlit,
                       value_range=(0.0, float(np.log1p(U_MAX))), colormap=COLORMAP,
                       label="ln(1 + U / (1 kJ/m³)), clamped at U_max", units="",
                       title=f"strain energy density at t = {scene.t:.2f} µs, per pixel, unlit")
+    panels = [views.oblique(scene, spacetime_style(sh, "skirts"))
+              for sh in ("per_vertex", "per_pixel")]
+    save_image_grid(exp.file("fig8_height.png"), panels,
+                    ["(a) per-vertex colour", "(b) per-pixel colour"])
 
+
+def save_crack_figure(exp: ExperimentContext, views: Views, keep: dict) -> None:
+    """``fig4_cracks.png``: oblique views of every kept slice size (10³, 10⁴, 10⁵ polygons;
+    tiny 10³) raw, with lines over and behind, with quadrisection, and with skirts."""
     panels, titles = [], []
-    for target in (1_000, 10_000, 100_000):
+    for target in sorted(keep):
         sol_k, scene_k, s_k = keep[target]
         quads = slice_scene(sol_k, quadrisect(s_k, 0.25 * float(polygon_areas(s_k).mean())))
         row = []
@@ -467,14 +523,12 @@ def figures(r: Renderer, out_dir: Path, keep: dict, say) -> None:
                                     ("lines behind", scene_k, "behind"),
                                     ("behind + quadrisection", quads, "behind"),
                                     ("skirts", scene_k, "skirts")):
-            image = r.oblique(sc, r.style("per_pixel", overdraw))
+            image = views.oblique(sc, spacetime_style("per_pixel", overdraw))
             row.append(image)
             titles.append(f"{s_k.n_polygons} polygons, {label}: "
                           f"{int(crack_pixels(image, CRACK_BACKGROUND).sum())} crack px")
         panels += crop_to_cracks(row)
-    save_image_grid(out_dir / "fig4_cracks.png", panels, titles, columns=5)
-    panels = [r.oblique(scene, r.style(sh, "skirts")) for sh in ("per_vertex", "per_pixel")]
-    save_image_grid(out_dir / "fig8_height.png", panels, ["(a) per-vertex colour", "(b) per-pixel colour"])
+    save_image_grid(exp.file("fig4_cracks.png"), panels, titles, columns=5)
 
 
 def crop_to_cracks(images: list) -> list:
@@ -490,25 +544,19 @@ def crop_to_cracks(images: list) -> list:
 @experiment("fig_pixel_exact", "st2005: pixel-exact rendering of spacetime FE solutions, "
                                "per vertex against per pixel, with exact images")
 def run(exp: ExperimentContext) -> list[dict]:
-    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
-    r = Renderer(width=400 if quick else 1000, repeat=5 if quick else 9)
-    try:
-        say(f"slice sizes on {r.name}")
-        rows, keep = size_rows(r, quick, say)
-        write_table(slicing_rows(quick, say), out_dir, "slicing",
-                    title="st2005 time slicing as t advances (ms per frame)")
-        say("sweep")
-        sweep = sweep_rows(r, quick, keep, say)
-        write_table(sweep, out_dir, "sweep", title="st2005 error and time against quadrisection "
-                                                   "and mesh resolution")
-        plot_sweep(sweep, out_dir / "sweep.png")
-        say("stability")
-        write_table(stability_rows(r, quick, say), out_dir, "stability",
-                    title="st2005 numerical stability: far from the origin, zero fields, "
-                          "degenerate slices")
-        say("figures")
-        figures(r, out_dir, keep, say)
-    finally:
-        r.release()
+    views = Views(exp, width=exp.pick(1000, 400, 160))
+    exp.say(f"slice sizes on {exp.renderer}")
+    rows, keep = size_rows(exp, views)
+    exp.table(slicing_rows(exp), "slicing", "st2005 time slicing as t advances (ms per frame)")
+    exp.say("sweep")
+    sweep = quadrisection_rows(exp, views, keep) + resolution_rows(exp, views)
+    exp.table(sweep, "sweep", "st2005 error and time against quadrisection and mesh resolution")
+    plot_sweep(sweep, exp.file("sweep.png"))
+    exp.say("stability")
+    exp.table(stability_rows(exp, views), "stability",
+              "st2005 numerical stability: far from the origin, zero fields, degenerate slices")
+    exp.say("figures")
+    save_bar_figure(exp, views)
+    save_slice_figures(exp, views, keep)
+    save_crack_figure(exp, views, keep)
     return rows
-

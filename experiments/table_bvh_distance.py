@@ -3,7 +3,9 @@ today's distance queries beside them, connectivity of parts, flanges and force t
 
 **Hierarchies** (``table.md``): for every node, the exact float64 distance to the nearest
 element of another part within 1.5 mm (the paper's distance of interest), on the car deck and
-its 4 × 4 and 8 × 8 refinements (quick: the car and its 2 × 2 and 4 × 4), with AABB and OBB
+its 4 × 4 and 8 × 8 refinements (quick: the car and its 2 × 2 and 4 × 4; tiny: the car and
+its 2 × 2, brute force on samples, the references on the car alone, small images, 2 crush
+steps), with AABB and OBB
 hierarchies of 1 and up to 10 elements per leaf: the paper's columns (#BVs, point/BV tests,
 point/element tests, build + query seconds), the point-to-plane skips, node queries per
 second (build apart; median of 3 runs), and the check against brute force (every node of the
@@ -35,7 +37,6 @@ from __future__ import annotations
 
 import statistics
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -43,24 +44,22 @@ from workbench.algo.forcetube import (BRUTE_FORCE, force_tube, prismatic_tube, s
                                       stress_tensor, tube_mesh, with_tube)
 from workbench.algo.membrane import with_membrane_stress
 from workbench.algo.part_distance import brute_force_part_distances, connectivity, part_distances
-from workbench.data import CAR_DECK, shared_file
+from workbench.experiment.context import ExperimentContext
 from workbench.experiment.distance_refs import (TOOLS, compare_with_exact,
                                                 reference_part_distances)
 from workbench.experiment.figures import save_field_figure, save_image_grid
-from workbench.experiment.measure import default_camera, measure
-from workbench.experiment.context import ExperimentContext
+from workbench.experiment.measure import default_camera
 from workbench.experiment.registry import experiment
-from workbench.experiment.tables import atomic_open, write_table
-from workbench.gl import create_context
+from workbench.experiment.tables import atomic_open
 from workbench.paths import Style
 from workbench.paths.flange import FlangeStyle
 from workbench.scene import generators
-from workbench.scene.builtin import builtin_scene
 
 CUTOFF = 1.5  # mm, crash2000 §4.1
 FLANGE_MM = 2.0
 MAP_MM = 50.0
 YIELD_MPA = 300.0
+BASES = ("car", "panels")  # the labels of the unrefined model
 # crash2000 Table 2: kind, elements per leaf, #BVs, point/BV, point/element, build s, query s
 PAPER_TABLE_2 = (("aabb", 1, 419_049, 17_152_432, 25_483, 6.3, 13.93),
                  ("obb", 1, None, 14_270_338, 5_386, 11.0, 35.64),
@@ -68,18 +67,22 @@ PAPER_TABLE_2 = (("aabb", 1, 419_049, 17_152_432, 25_483, 6.3, 13.93),
                  ("obb", 10, None, 13_603_798, 2_140_013, 4.9, 32.58))
 
 
-def base_model(say):
-    """The car deck, or generated stamped panels (several parts) without the shared data."""
-    if shared_file(CAR_DECK) is not None:
-        return "car", builtin_scene("car")
-    say(f"car deck not found ({CAR_DECK}; set WORKBENCH_DATA): generated panels stand in")
+def base_model(exp: ExperimentContext):
+    """(label, mesh): the car deck, or generated stamped panels (several parts) without the
+    shared data."""
+    car = exp.builtin("car", "car deck")
+    if car is not None:
+        return "car", car
+    exp.say("generated stamped panels stand in for the car deck")
     return "panels", generators.stamped_panels(4366, seed=3)
 
 
-def models(quick: bool, say):
-    label, base = base_model(say)
+def models(exp: ExperimentContext):
+    """(label, mesh) of the base model and its refinements (4 × 4 and 8 × 8; quick 2 × 2 and
+    4 × 4; tiny 2 × 2)."""
+    label, base = base_model(exp)
     yield label, base
-    for k in ((2, 4) if quick else (4, 8)):
+    for k in exp.pick((4, 8), (2, 4), (2,)):
         yield f"{label} {k}x{k}", generators.refine(base, k)
 
 
@@ -134,100 +137,136 @@ def _brute_force_sample(mesh, nodes: np.ndarray) -> np.ndarray:
     return out
 
 
-def hierarchy_rows(quick: bool, say) -> tuple[list[dict], dict]:
+def hierarchy_row(label: str, mesh, kind: str, leaf: int) -> tuple[dict, object, float]:
+    """(row, the last run's result, median query seconds) of one hierarchy on one model:
+    the paper's columns, the point-to-plane skips and node queries per second (build apart;
+    medians of 3 runs)."""
+    runs = [part_distances(mesh, CUTOFF, kind=kind, leaf_size=leaf) for _ in range(3)]
+    result = runs[-1]
+    query_s = statistics.median(r.query_s for r in runs)
+    build_s = statistics.median(r.build_s for r in runs)
+    row = dict(scene=label, nodes=mesh.n_nodes, elements=mesh.n_elements,
+               parts=len(np.unique(mesh.parts)), kind=kind,
+               elements_per_leaf="1" if leaf == 1 else f"<= {leaf}", n_bvs=result.n_bvs,
+               point_bv_tests=result.bv_tests, point_element_tests=result.element_tests,
+               plane_skips=result.plane_skips,
+               plane_skip_pct=100.0 * result.plane_skips / max(result.leaf_elements, 1),
+               build_s=build_s, query_s=query_s,
+               queries_per_s=result.nodes_queried / query_s,
+               nodes_within=int(np.isfinite(result.distance).sum()))
+    return row, result, query_s
+
+
+def checked_columns(exp: ExperimentContext, label: str, mesh, result) -> dict:
+    """The check against brute force (every node of the base model, a sample of 2000 nodes of
+    a refinement; quick 300; tiny a sample of 50 nodes of each) and, on the base model, the
+    largest change of a distance with the model translated by 10⁶ mm."""
+    base = label in BASES
+    columns = exact_check(mesh, result, exp.pick(None, None, 50) if base
+                          else exp.pick(2000, 300, 50))
+    if base:
+        moved = part_distances(mesh.translated((1e6, 1e6, 1e6)), CUTOFF)
+        both = np.isfinite(result.distance)
+        columns["max_change_translated_1e6_mm"] = float(np.abs(
+            moved.distance[both] - result.distance[both]).max(initial=0.0))
+    return columns
+
+
+def paper_rows() -> list[dict]:
+    """The paper's Table 2 (627 parts, SGI Octane R12K 300 MHz) in the table's columns."""
+    return [dict(scene="paper: 627 parts (SGI Octane R12K 300 MHz)", nodes=197_861,
+                 elements=209_838, parts=627, kind=kind,
+                 elements_per_leaf="1" if leaf == 1 else "<= 10",
+                 n_bvs=bvs if bvs is not None else (419_049 if leaf == 1 else 57_443),
+                 point_bv_tests=bv_tests, point_element_tests=el_tests,
+                 build_s=build, query_s=query, queries_per_s=197_861 / query)
+            for kind, leaf, bvs, bv_tests, el_tests, build, query in PAPER_TABLE_2]
+
+
+def hierarchy_rows(exp: ExperimentContext) -> tuple[list[dict], dict]:
+    """The main table's rows, and per model label (mesh, AABB result with one element per
+    leaf, its median query seconds) for the other tables."""
     rows, ours = [], {}
-    for label, mesh in models(quick, say):
+    for label, mesh in models(exp):
         for kind in ("aabb", "obb"):
             for leaf in (1, 10):
-                runs = [part_distances(mesh, CUTOFF, kind=kind, leaf_size=leaf)
-                        for _ in range(3)]
-                result = runs[-1]
-                query_s = statistics.median(r.query_s for r in runs)
-                build_s = statistics.median(r.build_s for r in runs)
-                row = dict(model=label, nodes=mesh.n_nodes, elements=mesh.n_elements,
-                           parts=len(np.unique(mesh.parts)), kind=kind, elements_per_leaf=
-                           "1" if leaf == 1 else f"<= {leaf}", n_bvs=result.n_bvs,
-                           point_bv_tests=result.bv_tests,
-                           point_element_tests=result.element_tests,
-                           plane_skips=result.plane_skips,
-                           plane_skip_pct=100.0 * result.plane_skips / max(
-                               result.leaf_elements, 1),
-                           build_s=build_s, query_s=query_s,
-                           queries_per_s=result.nodes_queried / query_s,
-                           nodes_within=int(np.isfinite(result.distance).sum()))
+                row, result, query_s = hierarchy_row(label, mesh, kind, leaf)
                 if kind == "aabb" and leaf == 1:
                     ours[label] = (mesh, result, query_s)
-                    row.update(exact_check(mesh, result, None if label in ("car", "panels")
-                                           else (300 if quick else 2000)))
-                    if label in ("car", "panels"):
-                        moved = part_distances(mesh.translated((1e6, 1e6, 1e6)), CUTOFF)
-                        both = np.isfinite(result.distance)
-                        row["max_change_translated_1e6_mm"] = float(np.abs(
-                            moved.distance[both] - result.distance[both]).max(initial=0.0))
+                    row.update(checked_columns(exp, label, mesh, result))
                 rows.append(row)
-                say(f"{label} {kind} leaf {leaf}: {row['queries_per_s'] / 1e6:.2f} M queries/s, "
-                    f"{result.n_bvs} BVs, {result.bv_tests} point/BV, "
-                    f"{result.element_tests} point/element tests")
-    for kind, leaf, bvs, bv_tests, el_tests, build, query in PAPER_TABLE_2:
-        rows.append(dict(model="paper: 627 parts (SGI Octane R12K 300 MHz)", nodes=197_861,
-                         elements=209_838, parts=627, kind=kind,
-                         elements_per_leaf="1" if leaf == 1 else "<= 10",
-                         n_bvs=bvs if bvs is not None else (419_049 if leaf == 1 else 57_443),
-                         point_bv_tests=bv_tests, point_element_tests=el_tests,
-                         build_s=build, query_s=query, queries_per_s=197_861 / query))
-    return rows, ours
+                exp.say(f"{label} {kind} leaf {leaf}: {row['queries_per_s'] / 1e6:.2f} M "
+                        f"queries/s, {result.n_bvs} BVs, {result.bv_tests} point/BV, "
+                        f"{result.element_tests} point/element tests")
+    return rows + paper_rows(), ours
 
 
-def reference_rows(ours: dict, quick: bool, say) -> list[dict]:
+def ours_reference_row(label: str, result, query_s: float) -> dict:
+    return dict(scene=label, tool="ours (AABB, 1 element per leaf)",
+                queries=result.nodes_queried, build_s=result.build_s, query_s=query_s,
+                queries_per_s=result.nodes_queried / query_s, speed_vs_ours=1.0,
+                max_abs_error_mm=0.0, nodes_flagged=0, constraints="float64, exact, per node all "
+                "other parts (a node's own parts: every part of an element using it), numba, "
+                "2 threads")
+
+
+def tool_runs(exp: ExperimentContext, label: str):
+    """(tool, local origin, sample) of the reference runs on model ``label``: every tool; open3d
+    also on the raw coordinates of the base model; trimesh (its exact query a Python loop) on a
+    sample of 2000 nodes of the base model at full size, 300 otherwise (tiny 30), and not on
+    the refinements of a small run."""
+    base = label in BASES
+    for tool in TOOLS:
+        if exp.quick and tool == "trimesh" and not base:
+            continue
+        for local in ((True, False) if tool == "open3d" and base else (True,)):
+            sample = None
+            if tool == "trimesh":
+                sample = exp.pick(2000 if base else 300, 300, 30)
+            yield tool, local, sample
+
+
+def reference_rows(exp: ExperimentContext, ours: dict) -> list[dict]:
+    """Today's tools on the same queries, per model (tiny: the base model only), against our
+    exact distances."""
     rows = []
-    for label, (mesh, result, query_s) in ours.items():
-        exact = result.distance
+    measured = list(ours.items())
+    for label, (mesh, result, query_s) in measured[:1] if exp.tiny else measured:
         ours_qps = result.nodes_queried / query_s
-        rows.append(dict(model=label, tool="ours (AABB, 1 element per leaf)",
-                         queries=result.nodes_queried, build_s=result.build_s, query_s=query_s,
-                         queries_per_s=ours_qps, speed_vs_ours=1.0, max_abs_error_mm=0.0,
-                         nodes_flagged=0, constraints="float64, exact, per node all other "
-                         "parts (a node's own parts: every part of an element using it), "
-                         "numba, 2 threads"))
-        for tool in TOOLS:
-            if quick and tool == "trimesh" and label not in ("car", "panels"):
+        rows.append(ours_reference_row(label, result, query_s))
+        for tool, local, sample in tool_runs(exp, label):
+            ref = reference_part_distances(tool, mesh, CUTOFF, local_origin=local,
+                                           sample=sample)
+            name = tool + ("" if local else ", raw coordinates")
+            if not ref.available:
+                rows.append(dict(scene=label, tool=name, constraints=ref.reason))
+                exp.say(f"{label} {name}: not available ({ref.reason})")
                 continue
-            for local in ((True, False) if tool == "open3d" and label in ("car", "panels")
-                          else (True,)):
-                sample = None
-                if tool == "trimesh":  # its exact query is a Python loop: a sample
-                    sample = 300 if quick or label not in ("car", "panels") else 2000
-                ref = reference_part_distances(tool, mesh, CUTOFF, local_origin=local,
-                                               sample=sample)
-                name = tool + ("" if local else ", raw coordinates")
-                if not ref.available:
-                    rows.append(dict(model=label, tool=name, constraints=ref.reason))
-                    say(f"{label} {name}: not available ({ref.reason})")
-                    continue
-                check = compare_with_exact(exact, ref)
-                qps = ref.queries_per_second
-                rows.append(dict(model=label, tool=name, queries=ref.queries,
-                                 build_s=ref.seconds_build, query_s=ref.seconds_query,
-                                 queries_per_s=qps, speed_vs_ours=qps / ours_qps,
-                                 max_abs_error_mm=check["max_abs_error"],
-                                 nodes_flagged=check["n_flagged"],
-                                 cutoff_disagreements=check["cutoff_disagreements"],
-                                 constraints=ref.constraints))
-                say(f"{label} {name}: {qps / 1e3:.0f} k queries/s ({qps / ours_qps:.3f} of "
+            check = compare_with_exact(result.distance, ref)
+            qps = ref.queries_per_second
+            rows.append(dict(scene=label, tool=name, queries=ref.queries,
+                             build_s=ref.seconds_build, query_s=ref.seconds_query,
+                             queries_per_s=qps, speed_vs_ours=qps / ours_qps,
+                             max_abs_error_mm=check["max_abs_error"],
+                             nodes_flagged=check["n_flagged"],
+                             cutoff_disagreements=check["cutoff_disagreements"],
+                             constraints=ref.constraints))
+            exp.say(f"{label} {name}: {qps / 1e3:.0f} k queries/s ({qps / ours_qps:.3f} of "
                     f"ours), max error {check['max_abs_error']:.3g} mm, "
                     f"{check['n_flagged']} nodes flagged")
     return rows
 
 
-def connectivity_rows(mesh, out_dir: Path) -> list[dict]:
+def connectivity_rows(exp: ExperimentContext, mesh) -> list[dict]:
+    """The pairs of parts closer than the cut-off (``connectivity.png`` beside)."""
     conn = connectivity(mesh, CUTOFF)
     rows = [dict(part_a=r["part_a"], part_b=r["part_b"], min_distance_mm=r["min_distance"],
                  nodes_within=r["nodes_within"]) for r in conn.rows()]
-    plot_connectivity(out_dir / "connectivity.png", conn)
+    plot_connectivity(exp.file("connectivity.png"), conn)
     return rows
 
 
-def plot_connectivity(path: Path, conn) -> None:
+def plot_connectivity(path, conn) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -254,8 +293,10 @@ def plot_connectivity(path: Path, conn) -> None:
     plt.close(fig)
 
 
-def flange_rows(ctx, mesh, label: str, out_dir: Path, quick: bool) -> list[dict]:
-    size = (800, 500) if quick else (1200, 750)
+def flange_rows(exp: ExperimentContext, mesh, label: str) -> list[dict]:
+    """The distance map and the flange view drawn by the flange path, timed, with their
+    figures (1200 × 750; quick 800 × 500, tiny 240 × 150)."""
+    size = exp.pick((1200, 750), (800, 500), (240, 150))
     camera = default_camera(mesh, size, view=(-35.0, 25.0))
     rows = []
     for name, style, units_label in (
@@ -263,45 +304,51 @@ def flange_rows(ctx, mesh, label: str, out_dir: Path, quick: bool) -> list[dict]
              f"distance to another part, up to {MAP_MM:g} mm"),
             ("fig9_flanges", FlangeStyle(threshold=FLANGE_MM, cutoff=MAP_MM),
              f"potential flanges: within {FLANGE_MM:g} mm of another part")):
-        m = measure(ctx, mesh, "flange", style, camera=camera, size=size,
-                    repeats=5 if quick else 7)
+        m = exp.measure(mesh, "flange", style, camera=camera, size=size)
         scale = m.path.scale
-        save_field_figure(out_dir / f"{name}.png", m.image, value_range=scale.value_range,
+        save_field_figure(exp.file(f"{name}.png"), m.image, value_range=scale.value_range,
                           colormap=style.colormap, label="distance", units="mm",
                           title=f"{label}: {units_label}")
-        rows.append(dict(model=label, view=name, wall_ms=m.row["wall_ms"],
+        rows.append(dict(scene=label, view=name, wall_ms=m.row["wall_ms"],
                          gpu_ms=m.row["gpu_ms"], derive_ms=m.row["derive_ms"],
                          covered_px=m.row["covered_px"], renderer=m.row["renderer"]))
     return rows
 
 
-def forcetube_rows(ctx, mesh, label: str, out_dir: Path, quick: bool, say) -> list[dict]:
-    rows = []
-    # the closed form: a prismatic tube, straight and oblique planes, every step
-    tube_mesh_, exact = prismatic_tube(sides=12, length=400.0, radius=40.0, thickness=1.5,
-                                       stress=[100.0, 250.0, -80.0], segments=20, steps=3,
-                                       stretch=0.01)
+def closed_form_row(exp: ExperimentContext) -> dict:
+    """The section force through a prismatic tube against its closed form: straight and
+    oblique planes, every step; the largest relative error."""
+    tube, exact = prismatic_tube(sides=12, length=400.0, radius=40.0, thickness=1.5,
+                                 stress=[100.0, 250.0, -80.0], segments=20, steps=3,
+                                 stretch=0.01)
     worst = 0.0
-    for step in range(tube_mesh_.n_steps):
-        coords = tube_mesh_.coordinates(step)
-        thickness = tube_mesh_.element_field("thickness", step)
-        stress = stress_tensor(tube_mesh_, step)
+    for step in range(tube.n_steps):
+        coords = tube.coordinates(step)
+        thickness = tube.element_field("thickness", step)
+        stress = stress_tensor(tube, step)
         for x, tilt in ((100.0, 0.0), (200.0, 0.3), (300.0, -0.5)):
             normal = np.array([1.0, tilt, 0.5 * tilt])
             normal /= np.linalg.norm(normal)
-            f = section_force(coords, tube_mesh_.elements, thickness, stress,
+            f = section_force(coords, tube.elements, thickness, stress,
                               np.array([x * (1 + 0.01 * step), 0.0, 0.0]), normal)
             worst = max(worst, abs(f[0] - exact[step]) / abs(exact[step]),
                         float(np.abs(f[1:]).max()) / abs(exact[step]))
-    rows.append(dict(case="prismatic tube, 12 sides, 3 steps, straight and oblique planes",
-                     max_rel_error_vs_closed_form=worst))
-    say(f"force tube on the prismatic tube: largest relative error {worst:.2e}")
+    exp.say(f"force tube on the prismatic tube: largest relative error {worst:.2e}")
+    return dict(case="prismatic tube, 12 sides, 3 steps, straight and oblique planes",
+                max_rel_error_vs_closed_form=worst)
+
+
+def forcetube_rows(exp: ExperimentContext, mesh, label: str) -> list[dict]:
+    """The closed form; on the car, the rails under a synthetic front crush (8 steps; quick 6,
+    tiny 2): rings along the rail per step, the elements each plane cuts found through the
+    hierarchy and checked against brute force (``force_tubes.png`` beside)."""
+    rows = [closed_form_row(exp)]
     if label != "car":
         return rows
     from workbench.scene.car_views import car_barrier_parts, car_trace_line
 
-    steps = 6 if quick else 8
-    crash = generators.crash_sequence(mesh, steps=steps, still_parts=car_barrier_parts(mesh))
+    crash = generators.crash_sequence(mesh, steps=exp.pick(8, 6, 2),
+                                      still_parts=car_barrier_parts(mesh))
     loaded = with_membrane_stress(crash, yield_stress=YIELD_MPA)
     points, parts = car_trace_line(mesh)
     start = time.perf_counter()
@@ -318,49 +365,48 @@ def forcetube_rows(ctx, mesh, label: str, out_dir: Path, quick: bool, say) -> li
                          elements_cut=int(tube.crossed[k].sum())))
     rows.append(dict(case="car rails: planes through the hierarchy against brute force",
                      equal_forces=same, hierarchy_s=tree_s, brute_force_s=brute_s))
-    say(f"force tubes on the car: {len(tube.steps)} steps, hierarchy {tree_s:.2f} s, brute "
-        f"force {brute_s:.2f} s, equal {same}")
+    exp.say(f"force tubes on the car: {len(tube.steps)} steps, hierarchy {tree_s:.2f} s, brute "
+            f"force {brute_s:.2f} s, equal {same}")
     shown = np.isin(loaded.parts, list(parts) + list(car_barrier_parts(mesh)))
-    save_tube_frames(ctx, loaded.subset(shown), tube, out_dir / "force_tubes.png", quick)
+    save_tube_frames(exp, loaded.subset(shown), tube)
     return rows
 
 
-def save_tube_frames(ctx, model, tube, path: Path, quick: bool) -> None:
-    """One frame per step: the rails (the rest of the body would hide them) and the tube,
-    coloured and sized by the axial force."""
+def save_tube_frames(exp: ExperimentContext, model, tube) -> None:
+    """``force_tubes.png``: one frame per step, the rails (the rest of the body would hide
+    them) and the tube, coloured and sized by the axial force (720 × 450 each; quick
+    480 × 300, tiny 160 × 100)."""
     lo, hi = model.bounds(all_steps=True)
     radius = 0.03 * float(np.max(hi - lo))
     animated = with_tube(model, tube_mesh(tube, None, radius_range=(0.25 * radius, radius)))
     force = animated.node_fields["section_force"]
     bound = float(np.nanmax(np.abs(force))) or 1.0
-    size = (480, 300) if quick else (720, 450)
+    size = exp.pick((720, 450), (480, 300), (160, 100))
     camera = default_camera(animated, size, view=(-30.0, 35.0))
     frames, titles = [], []
     for step in range(animated.n_steps):
         style = Style(field="section_force", step=step, colormap="coolwarm",
                       value_range=(-bound, bound))
-        frames.append(measure(ctx, animated, "pixel_color", style, camera=camera, size=size,
-                              timed=False).image)
+        frames.append(exp.measure(animated, "pixel_color", style, camera=camera, size=size,
+                                  timed=False).image)
         titles.append(f"step {step}: axial force (blue compression, red tension), "
                       f"|F| up to {bound / 1e3:.0f} kN")
-    save_image_grid(path, frames, titles, columns=2 if len(frames) > 3 else len(frames))
+    save_image_grid(exp.file("force_tubes.png"), frames, titles,
+                    columns=2 if len(frames) > 3 else len(frames))
 
 
 @experiment("table_bvh_distance", "crash2000 Table 2: part distances through AABB/OBB "
             "hierarchies against libigl/open3d/trimesh/coal; flanges; force tubes")
 def run(exp: ExperimentContext) -> list[dict]:
-    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
-    rows, ours = hierarchy_rows(quick, say)
-    write_table(reference_rows(ours, quick, say), out_dir, "references",
-                title=f"Distances to other parts within {CUTOFF} mm: today's tools on the same "
-                      f"queries (per excluded part set)")
+    rows, ours = hierarchy_rows(exp)
+    exp.table(reference_rows(exp, ours), "references",
+              f"Distances to other parts within {CUTOFF} mm: today's tools on the same "
+              f"queries (per excluded part set)")
     label, (mesh, _, _) = next(iter(ours.items()))
-    write_table(connectivity_rows(mesh, out_dir), out_dir, "connectivity",
-                title=f"{label}: pairs of parts closer than {CUTOFF} mm")
-    ctx = create_context()
-    write_table(flange_rows(ctx, mesh, label, out_dir, quick), out_dir, "flange",
-                title="Flange path: distance map and flanges (drawn on the GL context)")
-    write_table(forcetube_rows(ctx, mesh, label, out_dir, quick, say), out_dir, "forcetube",
-                title="Force tubes: the closed form, and the car's rails under a crush")
+    exp.table(connectivity_rows(exp, mesh), "connectivity",
+              f"{label}: pairs of parts closer than {CUTOFF} mm")
+    exp.table(flange_rows(exp, mesh, label), "flange",
+              "Flange path: distance map and flanges (drawn on the GL context)")
+    exp.table(forcetube_rows(exp, mesh, label), "forcetube",
+              "Force tubes: the closed form, and the car's rails under a crush")
     return rows
-

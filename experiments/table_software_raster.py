@@ -11,8 +11,9 @@ rejection), with 0 sub-pixel bits, and with the span table for S = 10, 15, 20. P
 time (median of the timed draws, through :func:`~workbench.experiment.measure.measure`),
 triangles/s, the speed against llvmpipe's position-only draw and against llvmpipe's draw of the
 same shading in this run, fragments, table-fit share, and the image against the EGL image of
-the same shading (share of differing pixels, largest difference). Quick runs: 125 × 125 quads
-per sheet at 500 × 500 (the paper's triangle size) and 250 × 250 at 1000 × 1000.
+the same shading (share of differing pixels, largest difference; the EGL row named in
+``reference``). Quick runs: 125 × 125 quads per sheet at 500 × 500 (the paper's triangle size)
+and 250 × 250 at 1000 × 1000; tiny runs: 16 × 16 at 100 × 100 and 24 × 24 at 120 × 120.
 
 **Steps** (``steps.md``, ``steps.png``): the paper's Table 2 columns for the paper's pipeline
 (span table S = 10, no early depth rejection): each step vectorised or not, its time with the
@@ -26,7 +27,7 @@ cache-load time, table-fit share, and the draw against the half-space generator 
 **Compositing** (``composite.md``): the benchmark split into D = 1, 2, 4, 8 domains (by space
 and by part), rendered by the software rasterizer on a LocalCluster of 2 worker processes and
 composited by binary tree and binary swap: equality with the one-process image, bytes moved
-between workers, render and compositing seconds.
+between workers, render and compositing seconds (tiny: D = 1, 2 on a small image).
 
 Run: ``workbench run table_software_raster [--quick]``.
 """
@@ -38,19 +39,17 @@ import statistics
 import time
 import tracemalloc
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from workbench.algo.softraster import STEPS, RasterOptions
 from workbench.algo.softraster.spantable import PAPER_MB, build_span_table, forget_tables, span_table
 from workbench.experiment.compare import compare_images, difference_map
-from workbench.experiment.figures import save_image_grid
-from workbench.experiment.measure import default_camera, measure
 from workbench.experiment.context import ExperimentContext
+from workbench.experiment.figures import save_image_grid
+from workbench.experiment.measure import default_camera
 from workbench.experiment.registry import experiment
-from workbench.experiment.tables import atomic_open, write_table
-from workbench.gl import create_context, renderer
+from workbench.experiment.tables import atomic_open
 from workbench.paths import SoftwareRasterizer, Style
 from workbench.paths.software import SoftwarePath
 from workbench.scene.generators import semicylinders
@@ -72,6 +71,8 @@ PAPER_STEPS = {
 PAPER_RUNS = (("es2008 1 M", 1.0e6, 0.82), ("es2008 16.6 M (Pantheon)", 16.6e6, 16.6 / 2.33))
 BANDS = dict(field="distance", bands=10)
 TABLE_SIZES = (10, 15, 20)
+HALF_SPACE_0_BITS = "software bands, 0 sub-pixel bits"
+PAPER_PIPELINE = "software bands, span table S=10, no early depth (es2008)"
 
 
 @dataclass
@@ -82,12 +83,16 @@ class Bench:
     main: bool  # the 1 M benchmark (the figures, the span-table rows and compositing use it)
 
 
-def benches(quick: bool):
-    n = 125 if quick else 250
+def benches(exp: ExperimentContext):
+    """The benchmark (8 sheets of 250 × 250 quads at 1000 × 1000; quick 125 × 125 at 500 × 500,
+    tiny 16 × 16 at 100 × 100) and the large scene (1024 × 1024 quads at 1000 × 1000; quick
+    250 × 250, tiny 24 × 24 at 120 × 120)."""
+    n = exp.pick(250, 125, 16)
     yield Bench(f"benchmark 8x{n}x{n}", semicylinders(8, n),
-                (500, 500) if quick else (1000, 1000), True)
-    n = 250 if quick else 1024
-    yield Bench(f"large 8x{n}x{n}", semicylinders(8, n), (1000, 1000), False)
+                exp.pick((1000, 1000), (500, 500), (100, 100)), True)
+    n = exp.pick(1024, 250, 24)
+    yield Bench(f"large 8x{n}x{n}", semicylinders(8, n),
+                exp.pick((1000, 1000), (1000, 1000), (120, 120)), False)
 
 
 def software_configs(main: bool):
@@ -96,11 +101,11 @@ def software_configs(main: bool):
     yield "software bands, GL rule", "pixel_color", BANDS, RasterOptions()
     yield ("software bands, GL rule, no early depth", "pixel_color", BANDS,
            RasterOptions(early_depth=False))
-    yield "software bands, 0 sub-pixel bits", "pixel_color", BANDS, RasterOptions(subpixel_bits=0)
+    yield HALF_SPACE_0_BITS, "pixel_color", BANDS, RasterOptions(subpixel_bits=0)
     for size in TABLE_SIZES if main else (10,):
         yield (f"software bands, span table S={size}", "pixel_color", BANDS,
                RasterOptions(generator="table", table_size=size, subpixel_bits=0))
-    yield ("software bands, span table S=10, no early depth (es2008)", "pixel_color", BANDS,
+    yield (PAPER_PIPELINE, "pixel_color", BANDS,
            RasterOptions(generator="table", subpixel_bits=0, early_depth=False))
     yield ("software bands, GL rule, 1 thread", "pixel_color", BANDS, RasterOptions(threads=1))
 
@@ -136,60 +141,78 @@ def peak_memory(path) -> dict:
                 process_peak_MB=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e3)
 
 
-def bench_rows(ctx, bench: Bench, repeats: int, say) -> tuple[list[dict], dict]:
-    mesh, size = bench.mesh, bench.size
-    camera = default_camera(mesh, size, view=(0.0, 0.0), up="y")
+def egl_rows(exp: ExperimentContext, bench: Bench, camera) -> tuple[list[dict], dict, dict]:
+    """(rows, images by case, wall ms by path) of the EGL paths on the GL context:
+    position-only (the floor), flat and per-pixel bands."""
     rows, images, gl_wall = [], {}, {}
-    triangles = len(mesh.triangles)
+    triangles = len(bench.mesh.triangles)
     for label, name, options in (("EGL position-only (the floor)", "position", {}),
                                  ("EGL flat", "flat", {}), ("EGL bands", "pixel_color", BANDS)):
-        m = measure(ctx, mesh, name, Style(**options), camera=camera, size=size, repeats=repeats)
+        m = exp.measure(bench.mesh, name, Style(**options), camera=camera, size=bench.size)
         gl_wall[name] = m.row["wall_ms"]
         images[label] = m.image
-        rows.append(dict(scene=bench.label, triangles=triangles, size=f"{size[0]}x{size[1]}",
-                         renderer=m.row["renderer"], config=label, shading=name,
+        rows.append(dict(scene=bench.label, triangles=triangles, size=m.row["size"],
+                         renderer=m.row["renderer"], case=label, path=name,
                          wall_ms=m.row["wall_ms"], wall_ms_min=m.row["wall_ms_min"],
                          wall_ms_max=m.row["wall_ms_max"],
-                         Mtri_per_s=triangles / m.row["wall_ms"] / 1e3))
-        say(f"{bench.label} {label}: {m.row['wall_ms']:.1f} ms")
+                         mtri_per_s=triangles / m.row["wall_ms"] / 1e3))
+        exp.say(f"{bench.label} {label}: {m.row['wall_ms']:.1f} ms")
+    return rows, images, gl_wall
+
+
+def software_probe(exp: ExperimentContext, bench: Bench, label: str):
+    """The probe of a software row: the per-step times (over 3 more draws on the benchmark, 2
+    on the large scene; tiny 1), and on the large scene's default row its memory."""
+    steps = step_probe(exp.pick(3, 3, 1) if bench.main else exp.pick(2, 2, 1))
+    if bench.main or label != "software bands, GL rule":
+        return steps
+    return lambda path: {**steps(path), **peak_memory(path)}
+
+
+def bench_rows(exp: ExperimentContext, bench: Bench) -> tuple[list[dict], dict]:
+    """(rows, images by case) of one scene: the EGL paths, then the software rasterizer's
+    configurations against the EGL image of the same shading."""
+    mesh, size = bench.mesh, bench.size
+    camera = default_camera(mesh, size, view=(0.0, 0.0), up="y")
+    rows, images, gl_wall = egl_rows(exp, bench, camera)
+    triangles = len(mesh.triangles)
     for label, name, options, raster in software_configs(bench.main):
         path = SoftwarePath(name, Style(**options), raster)
-        probes = step_probe(3 if bench.main else 2)
-        if not bench.main and label == "software bands, GL rule":
-            def probes(p, steps=probes):  # the 16.8 M scene's memory, on one row
-                return {**steps(p), **peak_memory(p)}
-        m = measure(SoftwareRasterizer(raster), mesh, path, camera=camera, size=size, repeats=repeats, probe=probes)
+        m = exp.measure(mesh, path, camera=camera, size=size,
+                        probe=software_probe(exp, bench, label),
+                        backend=SoftwareRasterizer(raster))
         images[label] = m.image
-        same = images["EGL bands" if name == "pixel_color" else "EGL flat"]
-        diff = compare_images(same, m.image)
+        reference = "EGL bands" if name == "pixel_color" else "EGL flat"
+        diff = compare_images(images[reference], m.image)
         wall = m.row["wall_ms"]
-        row = dict(scene=bench.label, triangles=triangles, size=f"{size[0]}x{size[1]}",
-                   renderer=m.row["renderer"], config=label, shading=name, wall_ms=wall,
+        row = dict(scene=bench.label, triangles=triangles, size=m.row["size"],
+                   renderer=m.row["renderer"], case=label, path=name, wall_ms=wall,
                    wall_ms_min=m.row["wall_ms_min"], wall_ms_max=m.row["wall_ms_max"],
-                   Mtri_per_s=triangles / wall / 1e3,
+                   mtri_per_s=triangles / wall / 1e3,
                    speed_vs_llvmpipe_floor=gl_wall["position"] / wall,
                    speed_vs_llvmpipe_same=gl_wall[name] / wall,
                    fragments=m.row["fragments"], table_fit_pct=100.0 * m.row["table_fit"]
-                   / max(m.row["kept"], 1), table_MB=m.row["table_MB"],
-                   differing_pct_vs_egl=100.0 * diff.share_differing,
-                   max_diff_vs_egl=diff.max_abs, threads=m.row["threads"],
+                   / max(m.row["kept"], 1), table_MB=m.row["table_MB"], reference=reference,
+                   differing_pct=100.0 * diff.share_differing,
+                   max_diff_255=diff.max_abs, threads=m.row["threads"],
                    fragment_pool_MB=m.row["fragment_pool_MB"],
                    draw_peak_MB=m.row.get("draw_peak_MB"),
                    process_peak_MB=m.row.get("process_peak_MB"), steps_ms=m.row["steps_ms"])
-        if "0 sub-pixel bits" not in label and "span table" in label:
+        if label != HALF_SPACE_0_BITS and "span table" in label:
             row["differing_px_vs_half_space_0_bits"] = int(
-                (m.image != images["software bands, 0 sub-pixel bits"]).any(axis=-1).sum())
+                (m.image != images[HALF_SPACE_0_BITS]).any(axis=-1).sum())
         rows.append(row)
-        say(f"{bench.label} {label}: {wall:.1f} ms, {row['Mtri_per_s']:.1f} M triangles/s, "
-            f"{row['speed_vs_llvmpipe_floor']:.2f}x llvmpipe's floor, "
-            f"{row['differing_pct_vs_egl']:.3f} % pixels differ from EGL")
+        exp.say(f"{bench.label} {label}: {wall:.1f} ms, {row['mtri_per_s']:.1f} M triangles/s, "
+                f"{row['speed_vs_llvmpipe_floor']:.2f}x llvmpipe's floor, "
+                f"{row['differing_pct']:.3f} % pixels differ from EGL")
     return rows, images
 
 
-def small_case_steps(say) -> dict:
-    """Each step's seconds with the kernels interpreted and compiled, on a small case."""
-    mesh = semicylinders(8, 10)
-    size = (100, 100)
+def small_case_steps(exp: ExperimentContext) -> dict:
+    """Each step's seconds with the kernels interpreted and compiled, on a small case (8 sheets
+    of 10 × 10 quads at 100 × 100; tiny 4 × 4 at 40 × 40)."""
+    mesh = semicylinders(8, exp.pick(10, 10, 4))
+    size = exp.pick((100, 100), (100, 100), (40, 40))
     camera = default_camera(mesh, size, view=(0.0, 0.0), up="y")
     path = SoftwarePath("pixel_color", Style(**BANDS),
                         RasterOptions(generator="table", subpixel_bits=0, early_depth=False))
@@ -206,17 +229,18 @@ def small_case_steps(say) -> dict:
     path.target.clear()
     path.draw(vectorized=False)
     off = dict(path.stats.seconds)
-    say(f"small case ({len(mesh.triangles)} triangles, {path.stats.fragments} fragments): "
-        f"interpreted {sum(off.values()):.2f} s")
+    exp.say(f"small case ({len(mesh.triangles)} triangles, {path.stats.fragments} fragments): "
+            f"interpreted {sum(off.values()):.2f} s")
     return dict(triangles=len(mesh.triangles), fragments=path.stats.fragments,
                 off=off, on={k: statistics.median(v) for k, v in on.items()})
 
 
 def step_rows(rows: list[dict], small: dict) -> list[dict]:
-    paper_label = "software bands, span table S=10, no early depth (es2008)"
-    ours = {r["scene"]: r["steps_ms"] for r in rows if r.get("config") == paper_label}
+    """The per-step table: the small case interpreted and compiled, the paper's pipeline and
+    the default one on both scenes, the paper's Tables 2 and 3 beside, and a total row."""
+    ours = {r["scene"]: r["steps_ms"] for r in rows if r.get("case") == PAPER_PIPELINE}
     default = {r["scene"]: r["steps_ms"] for r in rows
-               if r.get("config") == "software bands, GL rule"}
+               if r.get("case") == "software bands, GL rule"}
     out = []
     for name, vectorised in STEPS:
         off, on = small["off"][name], small["on"][name]
@@ -245,8 +269,10 @@ def step_rows(rows: list[dict], small: dict) -> list[dict]:
 
 
 def span_table_rows(rows: list[dict]) -> list[dict]:
-    main_rows = {r["config"]: r for r in rows if r["scene"].startswith("benchmark")}
-    half = main_rows.get("software bands, 0 sub-pixel bits")
+    """Per span-table size S: memory against the paper's, build and cache-load seconds, and the
+    benchmark's draw with it against the half-space generator on the same 0-bit rule."""
+    main_rows = {r["case"]: r for r in rows if r["scene"].startswith("benchmark")}
+    half = main_rows.get(HALF_SPACE_0_BITS)
     out = []
     for size in TABLE_SIZES:
         start = time.perf_counter()
@@ -262,26 +288,30 @@ def span_table_rows(rows: list[dict]) -> list[dict]:
                         paper_MB=PAPER_MB[size], build_s=build_s, cache_load_s=load_s,
                         table_fit_pct=drawn.get("table_fit_pct"), wall_ms=drawn.get("wall_ms"),
                         half_space_0_bits_wall_ms=None if half is None else half["wall_ms"],
-                        differing_px_vs_half_space=drawn.get(
-                            "differing_px_vs_half_space_0_bits")))
+                        reference=HALF_SPACE_0_BITS,
+                        differing_px=drawn.get("differing_px_vs_half_space_0_bits")))
     return out
 
 
-def composite_rows(quick: bool, say) -> list[dict]:
+def composite_rows(exp: ExperimentContext) -> list[dict]:
+    """The benchmark (8 sheets of 250 × 250 quads at 1000 × 1000; quick 64 × 64 at 500 × 500,
+    tiny 16 × 16 at 100 × 100) split into D = 1, 2, 4, 8 domains (tiny 1, 2) by space and by
+    part, drawn on a LocalCluster of 2 worker processes and composited by binary tree and
+    binary swap, against the one-process image."""
     from workbench.experiment.cluster import sweep_cluster
     from workbench.experiment.sortlast import SoftwareDomains, render_sortlast
     from workbench.scene.domains import split_domains
 
-    spec = "semicylinders:64" if quick else "semicylinders:250"
-    size = (500, 500) if quick else (1000, 1000)
-    mesh = semicylinders(8, 64 if quick else 250)
-    camera = default_camera(mesh, size, view=(0.0, 0.0), up="y")
+    n = exp.pick(250, 64, 16)
+    spec = f"semicylinders:{n}"
+    size = exp.pick((1000, 1000), (500, 500), (100, 100))
+    camera = default_camera(semicylinders(8, n), size, view=(0.0, 0.0), up="y")
     render_domain = SoftwareDomains(spec, "pixel_color", Style(**BANDS), camera, size)
     one = render_domain(np.arange(render_domain.prepared().triangles))
     rows = []
     with sweep_cluster(workers=2) as cluster:
         for by in ("space", "part"):
-            for count in (1, 2, 4, 8):
+            for count in exp.pick((1, 2, 4, 8), (1, 2, 4, 8), (1, 2)):
                 domains = split_domains(render_domain.prepared().mesh, count, by=by)
                 for method in ("tree", "swap"):
                     frame, stats = render_sortlast(cluster.client, render_domain, domains,
@@ -296,12 +326,12 @@ def composite_rows(quick: bool, say) -> list[dict]:
                                      bytes_moved_MB=stats.bytes_moved / 1e6,
                                      schedule_MB=stats.schedule_bytes / 1e6,
                                      render_s=stats.render_s, composite_s=stats.composite_s))
-                    say(f"composite {by} D={count} {method}: equal {differing == 0}, "
-                        f"{stats.bytes_moved / 1e6:.1f} MB moved, {stats.composite_s:.3f} s")
+                    exp.say(f"composite {by} D={count} {method}: equal {differing == 0}, "
+                            f"{stats.bytes_moved / 1e6:.1f} MB moved, {stats.composite_s:.3f} s")
     return rows
 
 
-def plot_steps(path: Path, steps: list[dict]) -> None:
+def plot_steps(path, steps: list[dict]) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -330,51 +360,52 @@ def plot_steps(path: Path, steps: list[dict]) -> None:
     plt.close(fig)
 
 
-def save_images(out_dir: Path, images: dict) -> None:
+def save_images(exp: ExperimentContext, images: dict) -> None:
+    """``images.png``: the middle of the benchmark drawn by EGL, the software rasterizer with
+    the GL rule and with the span table, and their differences from EGL."""
     egl = images["EGL bands"]
     h, w = egl.shape[:2]
     window = (slice(h // 2 - h // 8, h // 2 + h // 8), slice(w // 2 - w // 8, w // 2 + w // 8))
     soft = images["software bands, GL rule"]
     table = images["software bands, span table S=10"]
-    save_image_grid(out_dir / "images.png",
+    save_image_grid(exp.file("images.png"),
                     [egl[window], soft[window], table[window],
                      difference_map(egl, soft)[window], difference_map(egl, table)[window]],
                     ["EGL (llvmpipe) bands", "software, GL rule", "software, span table S=10",
                      "|EGL - GL rule|", "|EGL - span table|"], columns=3)
 
 
+def paper_rows() -> list[dict]:
+    """The paper's runs (es2008 Tables 2 and 3) in the main table's columns."""
+    return [dict(scene=label, triangles=int(triangles), size="1000x1000",
+                 renderer="Earth Simulator, one vector processor (paper)",
+                 case="es2008 (paper)", path="flat + band texture",
+                 wall_ms=seconds * 1e3, mtri_per_s=triangles / seconds / 1e6)
+            for label, triangles, seconds in PAPER_RUNS]
+
+
 @experiment("table_software_raster", "es2008 Tables 2-3: the software rasterizer with a span "
             "look-up table against llvmpipe, per-step times, sort-last compositing on Dask")
 def run(exp: ExperimentContext) -> list[dict]:
-    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
-    repeats = 5 if quick else 7
-    ctx = create_context()
-    say(f"renderer: {renderer(ctx)}")
+    exp.say(f"renderer: {exp.renderer}")
     rows, images = [], {}
-    for bench in benches(quick):
-        bench_out, bench_images = bench_rows(ctx, bench, repeats, say)
+    for bench in benches(exp):
+        bench_out, bench_images = bench_rows(exp, bench)
         rows += bench_out
         if bench.main:
             images = bench_images
-    for label, triangles, seconds in PAPER_RUNS:
-        rows.append(dict(scene=label, triangles=int(triangles), size="1000x1000",
-                         renderer="Earth Simulator, one vector processor (paper)",
-                         config="es2008 (paper)", shading="flat + band texture",
-                         wall_ms=seconds * 1e3, Mtri_per_s=triangles / seconds / 1e6))
-    small = small_case_steps(say)
+    rows += paper_rows()
+    small = small_case_steps(exp)
     steps = step_rows(rows, small)
-    write_table(steps, out_dir, "steps",
-                title=f"Per-step times (ms; paper columns in s); small case: "
-                      f"{small['triangles']} triangles, {small['fragments']} fragments, "
-                      f"kernels interpreted (off) and compiled (on)")
-    plot_steps(out_dir / "steps.png", steps)
-    write_table(span_table_rows(rows), out_dir, "span_table",
-                title="Span look-up table: memory, build, and its draw against half-space")
-    composite = composite_rows(quick, say)
-    write_table(composite, out_dir, "composite",
-                title="Sort-last compositing on a LocalCluster of 2 worker processes")
-    save_images(out_dir, images)
+    exp.table(steps, "steps", f"Per-step times (ms; paper columns in s); small case: "
+                              f"{small['triangles']} triangles, {small['fragments']} fragments, "
+                              f"kernels interpreted (off) and compiled (on)")
+    plot_steps(exp.file("steps.png"), steps)
+    exp.table(span_table_rows(rows), "span_table",
+              "Span look-up table: memory, build, and its draw against half-space")
+    exp.table(composite_rows(exp), "composite",
+              "Sort-last compositing on a LocalCluster of 2 worker processes")
+    save_images(exp, images)
     for row in rows:
         row.pop("steps_ms", None)
     return rows
-

@@ -1,21 +1,48 @@
-"""The table_bvh_distance experiment end to end in its quick form: what its tables show."""
+"""The table_bvh_distance experiment end to end: the shape of its tables at the tiny size, and
+what its tables show in its quick form (slow)."""
 
 import pytest
 
 from workbench.experiment.registry import discover, run_experiment
 from workbench.experiment.tables import read_table
 
+NAME = "table_bvh_distance"
+# every table the quick run writes (with the car deck), with its columns
+TABLES = {
+    "table": ["scene", "nodes", "elements", "parts", "kind", "elements_per_leaf", "n_bvs",
+              "point_bv_tests", "point_element_tests", "plane_skips", "plane_skip_pct",
+              "build_s", "query_s", "queries_per_s", "nodes_within", "checked_nodes",
+              "checked_within", "max_abs_error_mm", "max_rel_error", "same_nodes_within",
+              "max_change_translated_1e6_mm"],
+    "references": ["scene", "tool", "queries", "build_s", "query_s", "queries_per_s",
+                   "speed_vs_ours", "max_abs_error_mm", "nodes_flagged", "constraints",
+                   "cutoff_disagreements"],
+    "connectivity": ["part_a", "part_b", "min_distance_mm", "nodes_within"],
+    "flange": ["scene", "view", "wall_ms", "gpu_ms", "derive_ms", "covered_px", "renderer"],
+    "forcetube": ["case", "max_rel_error_vs_closed_form", "planes", "max_compression_kN",
+                  "max_tension_kN", "elements_cut", "equal_forces", "hierarchy_s",
+                  "brute_force_s"],
+}
+FIGURES = ("fig9_distance.png", "fig9_flanges.png", "connectivity.png")
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    discover()
+    return run_experiment(NAME, figures_root=tmp_path_factory.mktemp("figures"), size="tiny")
+
 
 @pytest.fixture(scope="module")
 def result(tmp_path_factory):
     discover()
     root = tmp_path_factory.mktemp("figures")
-    return run_experiment("table_bvh_distance", figures_root=root, quick=True)
+    return run_experiment(NAME, figures_root=root, quick=True)
 
 
-def test_every_hierarchy_is_exact_and_counts_its_tests(result):
-    rows, _ = result
-    ours = [r for r in rows if not str(r["model"]).startswith("paper")]
+def check_hierarchies(rows, models: int) -> None:
+    """Every hierarchy of each of ``models`` models is exact and counts its tests; the paper's
+    rows are beside."""
+    ours = [r for r in rows if not str(r["scene"]).startswith("paper")]
     assert {(r["kind"], r["elements_per_leaf"]) for r in ours} == {
         ("aabb", "1"), ("aabb", "<= 10"), ("obb", "1"), ("obb", "<= 10")}
     for r in ours:
@@ -23,16 +50,15 @@ def test_every_hierarchy_is_exact_and_counts_its_tests(result):
         if r["elements_per_leaf"] == "1":
             assert r["plane_skips"] == 0  # one element per leaf: nothing to skip
     checked = [r for r in ours if r.get("checked_nodes")]
-    assert len(checked) == 3
+    assert len(checked) == models
     for r in checked:
         assert r["max_rel_error"] <= 1e-12 and r["same_nodes_within"] is True
     assert [r for r in ours if r.get("max_change_translated_1e6_mm") is not None][0][
         "max_change_translated_1e6_mm"] <= 1e-9
-    assert sum(str(r["model"]).startswith("paper") for r in rows) == 4
+    assert sum(str(r["scene"]).startswith("paper") for r in rows) == 4
 
 
-def test_references_are_compared_with_the_exact_distances(result):
-    _, out_dir = result
+def check_references(out_dir) -> None:
     refs = read_table(out_dir / "references.csv")
     libigl = [r for r in refs if r["tool"] == "libigl"]
     assert libigl and all(r["max_abs_error_mm"] <= 1e-9 and r["nodes_flagged"] == 0
@@ -41,8 +67,7 @@ def test_references_are_compared_with_the_exact_distances(result):
     assert all(r["constraints"] for r in refs)
 
 
-def test_force_tubes_and_flanges(result):
-    _, out_dir = result
+def check_force_tubes_and_flanges(out_dir) -> None:
     tubes = read_table(out_dir / "forcetube.csv")
     assert tubes[0]["max_rel_error_vs_closed_form"] <= 1e-9
     car = [r for r in tubes if str(r["case"]).startswith("car rails: planes")]
@@ -52,5 +77,45 @@ def test_force_tubes_and_flanges(result):
     assert {r["view"] for r in flange} == {"fig9_distance", "fig9_flanges"}
     by = {r["view"]: r for r in flange}
     assert 0 < by["fig9_flanges"]["covered_px"] < by["fig9_distance"]["covered_px"]
-    for name in ("fig9_distance.png", "fig9_flanges.png", "connectivity.png"):
+    for name in FIGURES:
         assert (out_dir / name).stat().st_size > 0
+
+
+# ------------------------------------------------------------------------------- tiny size
+def test_tiny_run_writes_every_table_with_its_columns(tiny, car_deck):
+    _, out_dir = tiny
+    for name, columns in TABLES.items():
+        assert (out_dir / f"{name}.md").is_file()
+        with open(out_dir / f"{name}.csv", encoding="utf-8") as fh:
+            assert fh.readline().rstrip("\r\n").split(",") == columns, name
+    assert (out_dir / "force_tubes.png").stat().st_size > 0
+
+
+def test_tiny_hierarchies_are_exact_and_count_their_tests(tiny):
+    rows, _ = tiny
+    check_hierarchies(rows, models=2)  # the base model and its 2 x 2 refinement
+
+
+def test_tiny_references_are_compared_with_the_exact_distances(tiny):
+    check_references(tiny[1])
+
+
+def test_tiny_force_tubes_and_flanges(tiny):
+    check_force_tubes_and_flanges(tiny[1])
+
+
+# ------------------------------------------------------------------------------ quick size
+@pytest.mark.slow
+def test_every_hierarchy_is_exact_and_counts_its_tests(result):
+    rows, _ = result
+    check_hierarchies(rows, models=3)  # the base model and its 2 x 2 and 4 x 4 refinements
+
+
+@pytest.mark.slow
+def test_references_are_compared_with_the_exact_distances(result):
+    check_references(result[1])
+
+
+@pytest.mark.slow
+def test_force_tubes_and_flanges(result):
+    check_force_tubes_and_flanges(result[1])
