@@ -304,7 +304,7 @@ def flange_rows(exp: ExperimentContext, mesh, label: str) -> list[dict]:
              f"distance to another part, up to {MAP_MM:g} mm"),
             ("fig9_flanges", FlangeStyle(threshold=FLANGE_MM, cutoff=MAP_MM),
              f"potential flanges: within {FLANGE_MM:g} mm of another part")):
-        m = exp.measure(mesh, "flange", style, camera=camera, size=size)
+        m = exp.measure(mesh, "flange", style, camera=camera, size=size, repeats=exp.pick(7, 5))
         scale = m.path.scale
         save_field_figure(exp.file(f"{name}.png"), m.image, value_range=scale.value_range,
                           colormap=style.colormap, label="distance", units="mm",

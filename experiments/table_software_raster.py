@@ -148,7 +148,8 @@ def egl_rows(exp: ExperimentContext, bench: Bench, camera) -> tuple[list[dict], 
     triangles = len(bench.mesh.triangles)
     for label, name, options in (("EGL position-only (the floor)", "position", {}),
                                  ("EGL flat", "flat", {}), ("EGL bands", "pixel_color", BANDS)):
-        m = exp.measure(bench.mesh, name, Style(**options), camera=camera, size=bench.size)
+        m = exp.measure(bench.mesh, name, Style(**options), camera=camera, size=bench.size,
+                        repeats=exp.pick(7, 5))
         gl_wall[name] = m.row["wall_ms"]
         images[label] = m.image
         rows.append(dict(scene=bench.label, triangles=triangles, size=m.row["size"],
@@ -178,7 +179,7 @@ def bench_rows(exp: ExperimentContext, bench: Bench) -> tuple[list[dict], dict]:
     triangles = len(mesh.triangles)
     for label, name, options, raster in software_configs(bench.main):
         path = SoftwarePath(name, Style(**options), raster)
-        m = exp.measure(mesh, path, camera=camera, size=size,
+        m = exp.measure(mesh, path, camera=camera, size=size, repeats=exp.pick(7, 5),
                         probe=software_probe(exp, bench, label),
                         backend=SoftwareRasterizer(raster))
         images[label] = m.image
