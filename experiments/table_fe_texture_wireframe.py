@@ -2,7 +2,8 @@
 original mesh with line overdraw, run time against error.
 
 For every mesh of the suite (the car refined to the paper's size with a smooth displacement, the
-car itself, generated stamped panels) and each of the paper's parameter sets A and B
+car itself, generated stamped panels; quick: the car displaced unrefined, the car, 1 000 quads of
+panels) and each of the paper's parameter sets A and B
 (:data:`workbench.algo.fepatch.pipeline.PARAMETER_SETS`):
 
 * ``params`` (Table 1): the parameter sets;
@@ -28,7 +29,8 @@ car itself, generated stamped panels) and each of the paper's parameter sets A a
   the width rule (``[distance texture]``), so that each change shows its cost: the bound in
   triangles and speed, the texture rule and the encoding in texels per element, speed and
   wire fidelity;
-* ``sweep``: on the car refined 2×2 and displaced, the parameters scaled around sets A and B,
+* ``sweep``: on the car refined 2×2 and displaced (quick: the car displaced, one configuration
+  of each kind), the parameters scaled around sets A and B,
   and set A under the paper's rules, each change alone and the texture rule varied (wire
   encoding, texels across the scale-setting element width or extent, its quantile, narrow
   elements drawn as lines or not, normal map size; every build_model keyword in the row):
@@ -92,6 +94,11 @@ DISTANCE_TEXTURE = {"wire_encoding": "distance"}
 RULES = {"paper": PAPER_RULES, "certified d, paper texture": PAPER_TEXTURE_RULE,
          "distance texture": DISTANCE_TEXTURE, "new": {}}
 NEW = "new"
+# the sweep's configurations at the quick size: the sets, one scaled, and one of each change
+# of set A's rules
+QUICK_SWEEP = ("A", "B", "Bx2", "A, paper rules", "A, paper texture rule",
+               "A, d/2 fit, not certified", "A, width 1 q0.1, no narrow lines", "A, extent 1.5",
+               "A, no turns", "A, normal map 1/4", "A, distance texture, width 3")
 # the tiny size: every table, row kind and column, numbers meaningless
 TINY_SIZE, TINY_CLOSEUP_SIZE = (160, 120), (120, 120)
 # the sets, one scaled, the paper's rules and a texture rule without narrow lines
@@ -104,24 +111,17 @@ def refined_car(car: FEMesh, k: int) -> Case:
     return Case(f"car {k}x{k} displaced", generators.displaced(generators.refine(car, k)))
 
 
-def cases(exp: ExperimentContext, car: FEMesh | None) -> list[Case]:
-    """The meshes of Tables 2-3 at the run's size: the car's two where ``car`` is given, the
-    stamped panels; at the tiny size the panels alone, small."""
-    if exp.tiny:
-        return [Case("stamped panels", generators.stamped_panels(200, parts=1))]
-    found = []
-    if car is not None:
-        found += [refined_car(car, exp.pick(8, 2)), Case("car", car)]
-    found.append(Case("stamped panels", generators.stamped_panels(exp.pick(26_284, 2_215))))
-    return found
-
-
-def sweep_case(exp: ExperimentContext, car: FEMesh | None, first: Case) -> Case | None:
-    """The sweep's mesh: the car refined 2×2 and displaced (None without the car); at the tiny
-    size the ``first`` mesh."""
-    if exp.tiny:
-        return first
-    return None if car is None else refined_car(car, 2)
+def cases(exp: ExperimentContext, car: FEMesh | None) -> tuple[list[Case], Case | None]:
+    """The meshes of Tables 2-3 at the run's size and the sweep's mesh: the car's two where
+    ``car`` is given and the stamped panels, and the car refined 2×2 and displaced (quick: the
+    first mesh, the car displaced), None without the car; at the tiny size the panels alone,
+    small, for both."""
+    panels = Case("stamped panels", generators.stamped_panels(200, parts=1) if exp.tiny
+                  else generators.stamped_panels(exp.pick(26_284, 1_000)))
+    if exp.tiny or car is None:
+        return [panels], (panels if exp.tiny else None)
+    first = refined_car(car, exp.pick(8, 1))
+    return [first, Case("car", car), panels], (first if exp.quick else refined_car(car, 2))
 
 
 # ---------------------------------------------------------------------------- rows
@@ -324,9 +324,8 @@ def sweep_configs(exp: ExperimentContext) -> list[tuple[str, FEPatchParams, dict
                     ("A, width 1 q0.3, no narrow lines", a, {"texels_per_edge": 1.0,
                                                             "scale_quantile": 0.3,
                                                             "min_width": None})]
-    if exp.tiny:
-        configs = [c for c in configs if c[0] in TINY_SWEEP]
-    return configs
+    kept = exp.pick(None, QUICK_SWEEP, TINY_SWEEP)
+    return configs if kept is None else [c for c in configs if c[0] in kept]
 
 
 def build_settings(kwargs: dict) -> dict:
@@ -335,14 +334,32 @@ def build_settings(kwargs: dict) -> dict:
     return {k: kwargs.get(k, defaults[k].default) for k in SWEEP_KEYS}
 
 
-def sweep_rows(exp: ExperimentContext, case: Case, drawer: Drawer) -> list[dict]:
+def build_key(params: FEPatchParams, kwargs: dict) -> tuple:
+    """What makes one model of a mesh: its parameters and build_model keywords."""
+    return params, tuple(sorted(kwargs.items()))
+
+
+def models_by_build(models: dict, variants: dict) -> dict:
+    """Table 3's models of one mesh (see :func:`mesh_models`) by :func:`build_key`."""
+    built = {build_key(PARAMETER_SETS[name], {}): model for name, model in models.items()}
+    built.update({build_key(PARAMETER_SETS[name], RULES[rules]): model
+                  for (name, rules), model in variants.items()})
+    return built
+
+
+def sweep_rows(exp: ExperimentContext, case: Case, drawer: Drawer,
+               built: dict | None = None) -> list[dict]:
     """One row per :func:`sweep_configs` entry: its parameters and build keywords, speed
-    against the overdraw, wire agreement and certified Hausdorff distance (mm)."""
+    against the overdraw, wire agreement and certified Hausdorff distance (mm). ``built``:
+    models already built on this mesh, by :func:`build_key`, used instead of building them
+    again (the build is deterministic; its seconds are those of that build)."""
     overdraw = drawer.draw("gouraud", overdraw_style())
     rows = []
     for label, params, kwargs in sweep_configs(exp):
         # rules of its own: built here, the simplified surface drawn as the scene
-        model = build_model(case.scene.elements, case.scene.nodes, params, **kwargs)
+        model = (built or {}).get(build_key(params, kwargs))
+        if model is None:
+            model = build_model(case.scene.elements, case.scene.nodes, params, **kwargs)
         style = Style(crease_deg=params.alpha_g1_deg, wire_color=WIRE)
         m = drawer.draw("fe_normal_wire", style, model.simplified)
         row = dict(scene=case.label, case=label, alpha_g1_deg=params.alpha_g1_deg,
@@ -480,8 +497,8 @@ def run(exp: ExperimentContext) -> list[dict]:
     size = exp.pick((1000, 750), (500, 375), TINY_SIZE)
     exp.table(params_rows(), "params", "fe2003 Table 1: parameter sets")
     car = None if exp.tiny else exp.builtin("car")
-    meshes = cases(exp, car)
-    pre, rows, sweep, closeups = [], [], [], []
+    meshes, swept = cases(exp, car)
+    pre, rows, sweep, closeups, built = [], [], [], [], None
     for i, case in enumerate(meshes):
         exp.say(f"{case.label}: {case.scene.n_elements} elements")
         models, variants, mesh_pre = mesh_models(exp, case)
@@ -492,10 +509,11 @@ def run(exp: ExperimentContext) -> list[dict]:
         closeups += near_rows
         if i == 0:
             save_first_figures(exp, case, images, near_images, size)
-    swept = sweep_case(exp, car, meshes[0])
+        if case is swept:
+            built = models_by_build(models, variants)
     if swept is not None:
         exp.say(f"sweep on {swept.label}")
-        sweep = sweep_rows(exp, swept, Drawer(exp, swept.scene, size))
+        sweep = sweep_rows(exp, swept, Drawer(exp, swept.scene, size), built)
     exp.table(pre, "preprocessing", "fe2003 Table 2: preprocessing seconds")
     exp.table(closeups, "closeup",
               "Wire fidelity magnified: set A's wire frames against line overdraw")
