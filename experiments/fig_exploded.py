@@ -63,18 +63,19 @@ from __future__ import annotations
 import math
 import statistics
 import time
-from pathlib import Path
 
 import numpy as np
 
 from workbench.algo.explode import o_max_of, occlusion_ratio, uniform_explosion
-from workbench.data import CAR_DECK, shared_file
-from workbench.experiment.figures import save_animation, save_image_grid, with_progress_bar
+from workbench.experiment.context import Case, ExperimentContext
+from workbench.experiment.figures import (
+    save_animation,
+    save_image_grid,
+    with_progress_bar,
+)
 from workbench.experiment.measure import default_camera
-from workbench.experiment.context import ExperimentContext
 from workbench.experiment.registry import experiment
-from workbench.experiment.tables import write_table
-from workbench.gl import Framebuffer, GpuTimer, create_context, renderer
+from workbench.gl import Framebuffer, GpuTimer
 from workbench.gl.camera import up_frame
 from workbench.paths import make_path
 from workbench.paths.exploded import exploded_camera
@@ -90,6 +91,7 @@ BOX_FOCUS, BOX_HALF, FOCUS_HALF = 7, 1.0, 0.2
 DEFAULT_VIEW = (30.0, 25.0)
 STRIP_FRAMES = 8
 BAR_PX = 3
+TINY_SIZE, TINY_FRAMES = (80, 60), 10  # every row and column, numbers meaningless
 
 
 # ---------------------------------------------------------------------------- scenes
@@ -123,15 +125,19 @@ def camera_along(scene, size, direction):
 
 
 def default_view_camera(scene, size):
+    """The default camera at :data:`DEFAULT_VIEW`, its depth range widened for the halves."""
     return exploded_camera(default_camera(scene, size, view=DEFAULT_VIEW, up="z"), scene)
 
 
 def view_dir(camera) -> np.ndarray:
+    """The unit view direction of ``camera`` (eye toward target)."""
     v = np.asarray(camera.target, np.float64) - np.asarray(camera.eye, np.float64)
     return v / np.linalg.norm(v)
 
 
 def sweep_direction(w, n, theta_deg) -> np.ndarray:
+    """The view direction at ``theta_deg`` degrees from ``w`` (in the plane) towards the
+    plane's normal ``n``."""
     t = math.radians(theta_deg)
     return math.cos(t) * w + math.sin(t) * n
 
@@ -154,8 +160,8 @@ def animate(ctx, scene, focus, plane, camera, size, frames, exponent=1.0, keep_i
     path = make_path("exploded", focus=focus, plane=plane, speed=1.0, dt=0.1,
                      ratio_exponent=exponent)
     fb = Framebuffer(ctx, size)
-    rec = dict(r=[], offset=[], alpha=[], in_frame=[], step_wall=[], sep_gpu=[], sep_wall=[],
-               d_gpu=[], d_wall=[], c_wall=[], images=[])
+    rec = {key: [] for key in ("r", "offset", "alpha", "in_frame", "step_wall", "sep_gpu",
+                               "sep_wall", "d_gpu", "d_wall", "c_wall", "images")}
     try:
         path.prepare(ctx, scene, camera)
         timer = GpuTimer(ctx)
@@ -231,6 +237,7 @@ def measured_reveal_offset(ctx, scene, focus, plane, camera, size, o_max, iters=
 
 
 def r_fixed(ctx, scene, focus, plane, camera, size, offset) -> float:
+    """The occlusion ratio r of ``focus`` with the halves held at ``offset`` (no dynamics)."""
     path = make_path("exploded", focus=focus, plane=plane)
     fb = Framebuffer(ctx, size)
     try:
@@ -262,11 +269,15 @@ def uniform_mesh(scene: FEMesh, displacement: float) -> FEMesh:
 
 
 def r_uniform(ctx, scene, focus, direction, size, displacement) -> float:
+    """The occlusion ratio r of ``focus`` in the uniform explosion by ``displacement``, seen
+    along ``direction`` with the camera refitted to it."""
     moved = uniform_mesh(scene, displacement)
     return r_fixed(ctx, moved, focus, "x", camera_along(moved, size, direction), size, 0.0)
 
 
 def most_hidden_part(ctx, scene, size) -> tuple[int, list[dict]]:
+    """The part with the largest r from the default view at offset 0 (ties: more pixels), and
+    every part's counts and r."""
     camera = default_view_camera(scene, size)
     found = []
     for p in sorted(int(v) for v in np.unique(scene.parts)):
@@ -279,7 +290,7 @@ def most_hidden_part(ctx, scene, size) -> tuple[int, list[dict]]:
         finally:
             fb.release()
             path.release()
-        found.append(dict(part=p, p_unocc=pu, p_occ=po, r=occlusion_ratio(pu, po)))
+        found.append({"part": p, "p_unocc": pu, "p_occ": po, "r": occlusion_ratio(pu, po)})
     best = max(found, key=lambda f: (f["r"], f["p_unocc"]))
     return best["part"], found
 
@@ -294,24 +305,25 @@ def sweep_row(rec, label, focus, kind, theta, v, frames, exponent) -> dict:
     occlusion = statistics.median(c - d + s for c, d, s in
                                   zip(rec["c_wall"], rec["d_wall"], rec["step_wall"]))
     separate = statistics.median(rec["sep_wall"])
-    return dict(scene=label, focus_part=focus, plane=kind, ratio_exponent=exponent,
-                normal=",".join(f"{c:.3f}" for c in normal),
-                view_to_plane_deg=theta if kind == "manual" else round(plane_angle, 2),
-                sweep_deg=theta, frames=frames,
-                frames_to_reveal=hit if hit is not None else f"not within {frames}",
-                offset_at_reveal_over_o_max=((rec["offset"][hit - 1] / o_max if hit else 0.0)
-                                             if hit is not None else None),
-                final_r=rec["final_r"], final_offset_over_o_max=rec["offset"][-1] / o_max,
-                final_phase=rec["phase"], o_max=o_max, final_alpha=rec["alpha"][-1],
-                visible_through_ghost_pct=(None if rec["ghost_visible"] is None
-                                           else 100.0 * rec["ghost_visible"]),
-                draw_gpu_ms=statistics.median(rec["d_gpu"]), draw_wall_ms=draw,
-                counted_in_frame_pct=100.0 * sum(rec["in_frame"]) / len(rec["in_frame"]),
-                occlusion_wall_ms=occlusion,
-                occlusion_over_draw=occlusion / draw if draw > 0 else None,
-                separate_pass_gpu_ms=statistics.median(rec["sep_gpu"]),
-                separate_pass_wall_ms=separate,
-                separate_over_draw=separate / draw if draw > 0 else None)
+    return {
+        "scene": label, "focus_part": focus, "plane": kind, "ratio_exponent": exponent,
+        "normal": ",".join(f"{c:.3f}" for c in normal),
+        "view_to_plane_deg": theta if kind == "manual" else round(plane_angle, 2),
+        "sweep_deg": theta, "frames": frames,
+        "frames_to_reveal": hit if hit is not None else f"not within {frames}",
+        "offset_at_reveal_over_o_max": ((rec["offset"][hit - 1] / o_max if hit else 0.0)
+                                        if hit is not None else None),
+        "final_r": rec["final_r"], "final_offset_over_o_max": rec["offset"][-1] / o_max,
+        "final_phase": rec["phase"], "o_max": o_max, "final_alpha": rec["alpha"][-1],
+        "visible_through_ghost_pct": (None if rec["ghost_visible"] is None
+                                      else 100.0 * rec["ghost_visible"]),
+        "draw_gpu_ms": statistics.median(rec["d_gpu"]), "draw_wall_ms": draw,
+        "counted_in_frame_pct": 100.0 * sum(rec["in_frame"]) / len(rec["in_frame"]),
+        "occlusion_wall_ms": occlusion,
+        "occlusion_over_draw": occlusion / draw if draw > 0 else None,
+        "separate_pass_gpu_ms": statistics.median(rec["sep_gpu"]),
+        "separate_pass_wall_ms": separate,
+        "separate_over_draw": separate / draw if draw > 0 else None}
 
 
 def compare_row(ctx, scene, label, focus, manual, camera, direction, size, theta, rec) -> dict:
@@ -319,14 +331,19 @@ def compare_row(ctx, scene, label, focus, manual, camera, direction, size, theta
     d, o_max = rec["offset"][-1], rec["o_max"]
     ru = r_uniform(ctx, scene, focus, direction, size, d)
     rf = r_fixed(ctx, scene, focus, manual, camera, size, d)
-    return dict(scene=label, focus_part=focus, sweep_deg=theta,
-                displacement=d, displacement_over_o_max=d / o_max,
-                occlusion_driven_revealed=1.0 - rec["final_r"], uniform_revealed=1.0 - ru,
-                fixed_offset_manual_plane_revealed=1.0 - rf,
-                beats_uniform=ru > rec["final_r"], beats_fixed_offset=rf > rec["final_r"])
+    return {"scene": label, "focus_part": focus, "sweep_deg": theta,
+            "displacement": d, "displacement_over_o_max": d / o_max,
+            "occlusion_driven_revealed": 1.0 - rec["final_r"], "uniform_revealed": 1.0 - ru,
+            "fixed_offset_manual_plane_revealed": 1.0 - rf,
+            "beats_uniform": ru > rec["final_r"], "beats_fixed_offset": rf > rec["final_r"]}
 
 
-def sweep_rows(ctx, label, scene, focus, manual, w, size, frames, say, known=None):
+def sweep_rows(exp: ExperimentContext, case: Case, focus, manual, w, size, frames,
+               known=None) -> tuple[list[dict], list[dict]]:
+    """The view sweep's rows of one scene (manual plane ``manual`` with the views turned from
+    ``w`` towards its normal) and its comparison rows; ``known(θ)``, where given, is the
+    closed-form reveal offset."""
+    ctx, label, scene = exp.gl, case.label, case.scene
     n = {"x": np.array([1.0, 0, 0]), "y": np.array([0, 1.0, 0]), "z": np.array([0, 0, 1.0])}[manual]
     rows, compare = [], []
     for theta in ANGLES:
@@ -347,75 +364,69 @@ def sweep_rows(ctx, label, scene, focus, manual, w, size, frames, say, known=Non
                     row["measured_reveal_over_o_max"] = (None if measured is None
                                                          else measured / rec["o_max"])
                 rows.append(row)
-                say(f"{label} θ={theta:g}° {kind} p={exponent:g}: reveal frame "
-                    f"{row['frames_to_reveal']}, final r {rec['final_r']:.3f}, offset/o_max "
-                    f"{row['final_offset_over_o_max']:.3f}, occlusion/draw "
-                    f"{row['occlusion_over_draw']:.2f}")
+                exp.say(f"{label} θ={theta:g}° {kind} p={exponent:g}: reveal frame "
+                        f"{row['frames_to_reveal']}, final r {rec['final_r']:.3f}, "
+                        f"offset/o_max {row['final_offset_over_o_max']:.3f}, occlusion/draw "
+                        f"{row['occlusion_over_draw']:.2f}")
                 if kind == "auto" and exponent == EXPONENTS[0]:
                     compare.append(compare_row(ctx, scene, label, focus, manual, camera,
                                                direction, size, theta, rec))
     return rows, compare
 
 
-def figures(ctx, out_dir, label, scene, focus, plane, camera, size, frames):
-    rec = animate(ctx, scene, focus, plane, camera, size, frames, keep_images=True)
+def figures(exp: ExperimentContext, case: Case, focus, plane, camera, size, frames) -> None:
+    """``strip_<label>.png`` (:data:`STRIP_FRAMES` frames of the animation) and
+    ``<label>.gif`` (every frame, with a progress bar)."""
+    rec = animate(exp.gl, case.scene, focus, plane, camera, size, frames, keep_images=True)
     images = rec["images"]
     pick = np.unique(np.linspace(0, len(images) - 1, STRIP_FRAMES).round().astype(int))
-    save_image_grid(out_dir / f"strip_{label}.png", [images[i] for i in pick],
+    save_image_grid(exp.file(f"strip_{case.label}.png"), [images[i] for i in pick],
                     [f"frame {i + 1}: r {rec['r'][i]:.2f} -> offset {rec['offset'][i]:.3g}"
                      for i in pick], columns=4)
-    save_animation(out_dir / f"{label}.gif", images)
+    save_animation(exp.file(f"{case.label}.gif"), images)
 
 
-def load_car(say):
-    if shared_file(CAR_DECK) is None:
-        say(f"car deck not found ({CAR_DECK}; set WORKBENCH_DATA): the car rows are skipped")
-        return None
-    from workbench.scene.builtin import builtin_scene
-
-    return builtin_scene("car")
+def car_rows(exp: ExperimentContext, car: FEMesh, size, frames) -> tuple[list[dict], list[dict]]:
+    """The car's sweep and comparison rows, ``car_parts`` and its figures: the focus is the
+    part most hidden from the default view, the manual plane y."""
+    focus, scan = most_hidden_part(exp.gl, car, size)
+    exp.table(scan, "car_parts",
+              f"Car parts from the default view {DEFAULT_VIEW} at offset 0 "
+              f"(focus: part {focus}, the most hidden)")
+    exp.say(f"car: focus part {focus} (most hidden from {DEFAULT_VIEW})")
+    default = view_dir(default_view_camera(car, size))
+    n = np.array([0.0, 1.0, 0.0])
+    w = default - float(default @ n) * n
+    w /= np.linalg.norm(w)
+    case = Case("car", car)
+    rows, compare = sweep_rows(exp, case, focus, "y", w, size, frames)
+    figures(exp, case, focus, "auto", default_view_camera(car, size), size, frames)
+    return rows, compare
 
 
 @experiment("fig_exploded", "ghost2013: occlusion-driven ghosted exploded views over view "
             "angles on the car and a box of panels, against uniform and fixed-offset explosions")
 def run(exp: ExperimentContext) -> list[dict]:
-    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
-    size = (200, 150) if quick else (400, 300)
-    frames = 40 if quick else 60
-    ctx = create_context()
-    say(f"renderer: {renderer(ctx)}")
-    rows, compare = [], []
+    size = exp.pick((400, 300), (200, 150), TINY_SIZE)
+    frames = exp.pick(60, 40, TINY_FRAMES)
+    exp.say(f"renderer: {exp.renderer}")
 
-    box = box_scene()
+    box = Case("box", box_scene())
     w_box = np.array([0.0, 1.0, 0.0])  # the +y view: the x plane's normal perpendicular to it
-    r, c = sweep_rows(ctx, "box", box, BOX_FOCUS, "x", w_box, size, frames, say,
-                      known=box_reveal_offset)
-    rows += r
-    compare += c
-    figures(ctx, out_dir, "box", box, BOX_FOCUS, "x",
-            camera_along(box, size, sweep_direction(w_box, np.array([1.0, 0, 0]), 20.0)),
+    rows, compare = sweep_rows(exp, box, BOX_FOCUS, "x", w_box, size, frames,
+                               known=box_reveal_offset)
+    figures(exp, box, BOX_FOCUS, "x",
+            camera_along(box.scene, size, sweep_direction(w_box, np.array([1.0, 0, 0]), 20.0)),
             size, frames)
 
-    car = load_car(say)
+    car = exp.builtin("car", "car rows")
     if car is not None:
-        focus, scan = most_hidden_part(ctx, car, size)
-        write_table(scan, out_dir, "car_parts",
-                    title=f"Car parts from the default view {DEFAULT_VIEW} at offset 0 "
-                          f"(focus: part {focus}, the most hidden)")
-        say(f"car: focus part {focus} (most hidden from {DEFAULT_VIEW})")
-        default = view_dir(default_view_camera(car, size))
-        n = np.array([0.0, 1.0, 0.0])
-        w = default - float(default @ n) * n
-        w /= np.linalg.norm(w)
-        r, c = sweep_rows(ctx, "car", car, focus, "y", w, size, frames, say)
+        r, c = car_rows(exp, car, size, frames)
         rows += r
         compare += c
-        figures(ctx, out_dir, "car", car, focus, "auto",
-                default_view_camera(car, size), size, frames)
 
-    write_table(compare, out_dir, "compare",
-                title="Revealed share (1 - r) at equal displacement D (each half's offset): "
-                      "occlusion-driven (auto plane), uniform explosion, fixed offset on the "
-                      "manual plane")
+    exp.table(compare, "compare",
+              "Revealed share (1 - r) at equal displacement D (each half's offset): "
+              "occlusion-driven (auto plane), uniform explosion, fixed offset on the "
+              "manual plane")
     return rows
-

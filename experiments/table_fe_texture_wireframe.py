@@ -2,7 +2,8 @@
 original mesh with line overdraw, run time against error.
 
 For every mesh of the suite (the car refined to the paper's size with a smooth displacement, the
-car itself, generated stamped panels) and each of the paper's parameter sets A and B
+car itself, generated stamped panels; quick: the car displaced unrefined, the car, 1 000 quads of
+panels) and each of the paper's parameter sets A and B
 (:data:`workbench.algo.fepatch.pipeline.PARAMETER_SETS`):
 
 * ``params`` (Table 1): the parameter sets;
@@ -13,7 +14,8 @@ car itself, generated stamped panels) and each of the paper's parameter sets A a
   the paper's construction and texture scale; "certified d, paper texture", the distance bound
   alone; "distance texture", the width scale rule with fe2003's distance texture, before the
   element-id wire frame);
-* ``table3`` (Table 3; every column in ``table``): per render path, triangles, GPU and wall time per frame, the speed factor
+* ``table3`` (Table 3; every column in ``table``): per render path configuration (``case``),
+  triangles, GPU and wall time per frame, the speed factor
   against original + line overdraw, texture memory in RGBA texels (4 bytes) per element, and
   the errors the paper does not give: the certified one-sided Hausdorff distance original →
   simplified (upper end of a bracket of width 1e-4 of the bounding-box diagonal or 1 % of
@@ -21,13 +23,14 @@ car itself, generated stamped panels) and each of the paper's parameter sets A a
   fidelity against the line-overdraw image (precision, recall and IoU of wire pixels with a
   one-pixel tolerance,
   :func:`workbench.experiment.compare.wire_agreement`), and SSIM of the image against the
-  original's (shaded paths against "original, shaded", wire paths against the overdraw);
+  ``reference`` (shaded paths against "original, shaded", wire paths against the overdraw);
   Set A's rows come also built with the paper's rules (``[paper]``), with the certified
   distance bound alone (``[certified d, paper texture]``) and with the distance texture under
   the width rule (``[distance texture]``), so that each change shows its cost: the bound in
   triangles and speed, the texture rule and the encoding in texels per element, speed and
   wire fidelity;
-* ``sweep``: on the car refined 2×2 and displaced, the parameters scaled around sets A and B,
+* ``sweep``: on the car refined 2×2 and displaced (quick: the car displaced, one configuration
+  of each kind), the parameters scaled around sets A and B,
   and set A under the paper's rules, each change alone and the texture rule varied (wire
   encoding, texels across the scale-setting element width or extent, its quantile, narrow
   elements drawn as lines or not, normal map size; every build_model keyword in the row):
@@ -40,18 +43,21 @@ car itself, generated stamped panels) and each of the paper's parameter sets A a
   texture.
 
 Lighting follows the workbench's two-sided headlight; the original is Gouraud-shaded with the
-crease angle of set A, the simplified surfaces shade per pixel from the normal map.
+crease angle of set A, the simplified surfaces shade per pixel from the normal map. Model
+units are millimetres.
 
 Run: ``workbench run table_fe_texture_wireframe [--quick]``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import dataclasses
+import inspect
 from pathlib import Path
 
 import numpy as np
 
+from workbench.algo.fepatch.mesh_model import fepatch_model
 from workbench.algo.fepatch.pipeline import (
     PAPER_RULES,
     PAPER_TEXTURE_RULE,
@@ -60,19 +66,15 @@ from workbench.algo.fepatch.pipeline import (
     FEPatchParams,
     build_model,
 )
-from workbench.algo.fepatch.mesh_model import fepatch_model
 from workbench.algo.hausdorff import hausdorff
-from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.compare import compare_images, wire_agreement
+from workbench.experiment.context import Case, ExperimentContext
 from workbench.experiment.figures import save_image_grid
-from workbench.experiment.measure import measure
-from workbench.experiment.context import ExperimentContext
 from workbench.experiment.registry import experiment
-from workbench.experiment.tables import atomic_open, write_table
-from workbench.gl import Camera, create_context, renderer
+from workbench.experiment.tables import atomic_open
+from workbench.gl import Camera
 from workbench.paths import Style
 from workbench.scene import generators
-from workbench.scene.builtin import builtin_scene
 from workbench.scene.mesh import FEMesh
 
 VIEW = {"azimuth": -35.0, "elevation": 25.0, "up": "z"}
@@ -81,7 +83,7 @@ OVERDRAW = "original + line overdraw"
 SHADED = "original, shaded"
 BRACKET_REL = 1e-4  # of the bounding-box diagonal, ...
 BRACKET_OF_D = 0.01  # ... or of d, whichever is smaller: narrow enough to tell "within d"
-TABLE3 = ("renderer", "mesh", "size", "path", "rules", "triangles", "line_edges", "gpu_ms",
+TABLE3 = ("renderer", "scene", "size", "case", "rules", "triangles", "line_edges", "gpu_ms",
           "wall_ms", "speed_vs_overdraw", "rgba_texels_per_element", "hausdorff_mm", "d_mm",
           "wire_precision_1px", "wire_recall_1px", "wire_iou_1px", "ssim")
 # build_model keywords of the rows that show each change on its own: the paper's construction
@@ -92,32 +94,45 @@ DISTANCE_TEXTURE = {"wire_encoding": "distance"}
 RULES = {"paper": PAPER_RULES, "certified d, paper texture": PAPER_TEXTURE_RULE,
          "distance texture": DISTANCE_TEXTURE, "new": {}}
 NEW = "new"
+# the sweep's configurations at the quick size: the sets, one scaled, and one of each change
+# of set A's rules
+QUICK_SWEEP = ("A", "B", "Bx2", "A, paper rules", "A, paper texture rule",
+               "A, d/2 fit, not certified", "A, width 1 q0.1, no narrow lines", "A, extent 1.5",
+               "A, no turns", "A, normal map 1/4", "A, distance texture, width 3")
+# the tiny size: every table, row kind and column, numbers meaningless
+TINY_SIZE, TINY_CLOSEUP_SIZE = (160, 120), (120, 120)
+# the sets, one scaled, the paper's rules and a texture rule without narrow lines
+TINY_SWEEP = ("A", "B", "A/2", "A, paper rules", "A, width 1 q0.1, no narrow lines")
 
 
-@dataclass
-class Case:
-    label: str
-    mesh: FEMesh
+# ---------------------------------------------------------------------------- scenes
+def refined_car(car: FEMesh, k: int) -> Case:
+    """The car refined k×k with the smooth displacement."""
+    return Case(f"car {k}x{k} displaced", generators.displaced(generators.refine(car, k)))
 
 
-def cases(quick: bool, say):
-    if shared_file(CAR_DECK) is None:
-        say(f"car skipped: {CAR_DECK} not found (set WORKBENCH_DATA to the shared data folder)")
-    else:
-        car = builtin_scene("car")
-        k = 2 if quick else 8
-        yield Case(f"car {k}x{k} displaced", generators.displaced(generators.refine(car, k)))
-        yield Case("car", car)
-    yield Case("stamped panels", generators.stamped_panels(2_215 if quick else 26_284))
+def cases(exp: ExperimentContext, car: FEMesh | None) -> tuple[list[Case], Case | None]:
+    """The meshes of Tables 2-3 at the run's size and the sweep's mesh: the car's two where
+    ``car`` is given and the stamped panels, and the car refined 2×2 and displaced (quick: the
+    first mesh, the car displaced), None without the car; at the tiny size the panels alone,
+    small, for both."""
+    panels = Case("stamped panels", generators.stamped_panels(200, parts=1) if exp.tiny
+                  else generators.stamped_panels(exp.pick(26_284, 1_000)))
+    if exp.tiny or car is None:
+        return [panels], (panels if exp.tiny else None)
+    first = refined_car(car, exp.pick(8, 1))
+    return [first, Case("car", car), panels], (first if exp.quick else refined_car(car, 2))
 
 
+# ---------------------------------------------------------------------------- rows
 def params_rows() -> list[dict]:
     return [{"set": name, "alpha_g1_deg": p.alpha_g1_deg, "d_mm": p.d, "l_outer_mm": p.l_outer,
              "l_inner_mm": p.l_inner} for name, p in PARAMETER_SETS.items()]
 
 
 def preprocessing_row(case: Case, model, rules: str = NEW) -> dict:
-    row = {"mesh": case.label, "set": model.params.label, "rules": rules,
+    """Table 2's row of ``model`` of ``case``, built with ``rules``; stage times in seconds."""
+    row = {"scene": case.label, "set": model.params.label, "rules": rules,
            "elements": model.n_elements,
            "patches": model.n_patches, "subpatches": model.n_subpatches,
            "g0_edges": model.features["G0"], "g1_edges": model.features["G1"],
@@ -140,9 +155,9 @@ def preprocessing_row(case: Case, model, rules: str = NEW) -> dict:
 
 
 def simplification_error(case: Case, model) -> dict:
-    """Certified one-sided Hausdorff distance original → simplified surface."""
+    """Certified one-sided Hausdorff distance original → simplified surface (mm)."""
     orig, simp = model.original, model.simplified
-    lo, hi = case.mesh.bounds()
+    lo, hi = case.scene.bounds()
     diag = float(np.linalg.norm(hi - lo))
     tol = BRACKET_REL * diag
     if model.params.d > 0:
@@ -155,34 +170,37 @@ def simplification_error(case: Case, model) -> dict:
 
 
 class Drawer:
-    """What every draw of one mesh shares: the camera (fitted to the mesh at ``VIEW``), the
-    image size (W, H) and the timed repetitions; :meth:`draw` measures one path."""
+    """What every draw of one mesh shares: the camera (fitted to the mesh at ``VIEW``) and the
+    image size (W, H); :meth:`draw` measures one path with the run's repeats."""
 
-    def __init__(self, ctx, mesh: FEMesh, size, repeat: int):
-        self.ctx, self.mesh, self.size, self.repeat = ctx, mesh, size, repeat
+    def __init__(self, exp: ExperimentContext, mesh: FEMesh, size):
+        self.exp, self.mesh, self.size = exp, mesh, size
         lo, hi = mesh.bounds()
         self.camera = Camera.fit_box(lo, hi, aspect=size[0] / size[1], **VIEW)
 
     def draw(self, name: str, style: Style, scene=None):
         """The :class:`~workbench.experiment.measure.Measurement` of path ``name`` drawing
         ``scene`` (default the mesh; or a TexturedSurface built by the caller)."""
-        return measure(self.ctx, self.mesh if scene is None else scene, name, style,
-                       camera=self.camera, size=self.size, repeats=self.repeat)
+        return self.exp.measure(self.mesh if scene is None else scene, name, style,
+                                camera=self.camera, size=self.size)
+
+
+def overdraw_style() -> Style:
+    """The original with line overdraw: Gouraud at set A's crease angle, black lines."""
+    return Style(crease_deg=PARAMETER_SETS["A"].alpha_g1_deg, wireframe=True, wire_color=WIRE)
 
 
 def variant_label(name: str, rules: str, what: str) -> str:
-    """The Table 3 path label of set ``name`` built with ``rules`` (the new rules unnamed)."""
+    """The Table 3 case label of set ``name`` built with ``rules`` (the new rules unnamed)."""
     return f"simplified {name}{'' if rules == NEW else f' [{rules}]'} {what}"
 
 
-def table_rows(case: Case, models: dict, variants: dict, drawer: Drawer, gl_renderer: str, say):
-    """Table 3 rows of one mesh, and the images by path label. ``models``: {set: the mesh's
-    cached model (new rules)}; ``variants``: {(set, rules): model built with other rules},
-    drawn as textured surfaces."""
+def table3_configs(models: dict, variants: dict) -> list[tuple]:
+    """(case label, path, set, rules, style) of every Table 3 row of one mesh; a style of None
+    is made from the set's model."""
     crease = PARAMETER_SETS["A"].alpha_g1_deg
     configs = [(SHADED, "gouraud", None, NEW, Style(crease_deg=crease)),
-               (OVERDRAW, "gouraud", None, NEW, Style(crease_deg=crease, wireframe=True,
-                                                      wire_color=WIRE)),
+               (OVERDRAW, "gouraud", None, NEW, overdraw_style()),
                ("original + wire texture", "fe_wire_texture", "A", NEW, None)]
     for name in models:
         configs += [(variant_label(name, NEW, "+ normal map"), "fe_normal_map", name, NEW, None),
@@ -191,10 +209,17 @@ def table_rows(case: Case, models: dict, variants: dict, drawer: Drawer, gl_rend
     for name, rules in variants:
         configs.append((variant_label(name, rules, "+ normal map + wire texture"),
                         "fe_normal_wire", name, rules, None))
+    return configs
+
+
+def drawn_rows(exp: ExperimentContext, case: Case, models: dict, variants: dict,
+               drawer: Drawer) -> tuple[list[dict], dict]:
+    """Table 3's measured columns of one mesh, and the images by case label. ``models``:
+    {set: the mesh's cached model (new rules)}; ``variants``: {(set, rules): model built with
+    other rules}, drawn as textured surfaces."""
     rows, images = [], {}
-    for label, path_name, set_name, rules, style in configs:
-        model = None
-        scene = None
+    for label, path_name, set_name, rules, style in table3_configs(models, variants):
+        model = scene = None
         if set_name is not None and rules == NEW:  # the mesh's cached model of this set
             model = models[set_name]
         elif set_name is not None:
@@ -204,8 +229,8 @@ def table_rows(case: Case, models: dict, variants: dict, drawer: Drawer, gl_rend
             style = Style(fepatch=set_name, crease_deg=model.params.alpha_g1_deg, wire_color=WIRE)
         m = drawer.draw(path_name, style, scene)
         images[label] = m.image
-        row = dict(renderer=gl_renderer, mesh=case.label, size=f"{drawer.size[0]}x{drawer.size[1]}",
-                   path=label, set=set_name or "", rules=rules if model is not None else "",
+        row = dict(renderer=exp.renderer, scene=case.label, size="x".join(map(str, drawer.size)),
+                   case=label, set=set_name or "", rules=rules if model is not None else "",
                    triangles=m.row["triangles"], line_edges=m.row["edges"], **m.timing.as_row())
         if model is not None:
             surface = model.original if path_name == "fe_wire_texture" else model.simplified
@@ -213,21 +238,32 @@ def table_rows(case: Case, models: dict, variants: dict, drawer: Drawer, gl_rend
                        texture_mb=surface.texture_bytes / 2**20,
                        narrow_elements=model.narrow_elements)
         rows.append(row)
-        say(f"  {case.label} {label}: {m.row['triangles']} triangles, "
-            f"wall {m.timing.wall_ms:.1f} ms")
-    by = {r["path"]: r for r in rows}
-    base = by[OVERDRAW]
+        exp.say(f"  {case.label} {label}: {m.row['triangles']} triangles, "
+                f"wall {m.timing.wall_ms:.1f} ms")
+    return rows, images
+
+
+def add_image_comparisons(rows: list[dict], images: dict) -> None:
+    """Speed against the overdraw, SSIM against the ``reference`` and the wire agreement with
+    the overdraw, into ``rows`` of one mesh."""
+    base = next(r for r in rows if r["case"] == OVERDRAW)
     for r in rows:
         r["speed_vs_overdraw"] = base["wall_ms"] / r["wall_ms"]
         if r["gpu_ms"] and base["gpu_ms"]:
             r["gpu_speed_vs_overdraw"] = base["gpu_ms"] / r["gpu_ms"]
-        wire = "wire" in r["path"] or r["path"] == OVERDRAW
+        wire = "wire" in r["case"] or r["case"] == OVERDRAW
         reference = OVERDRAW if wire else SHADED
-        if r["path"] != reference:
-            r["ssim"] = compare_images(images[reference], images[r["path"]]).ssim
-            r["ssim_against"] = reference
-        if wire and r["path"] != OVERDRAW:
-            r.update(wire_agreement(images[r["path"]], images[OVERDRAW], WIRE))
+        if r["case"] != reference:
+            r["ssim"] = compare_images(images[reference], images[r["case"]]).ssim
+            r["reference"] = reference
+        if wire and r["case"] != OVERDRAW:
+            r.update(wire_agreement(images[r["case"]], images[OVERDRAW], WIRE))
+
+
+def add_simplification_errors(exp: ExperimentContext, case: Case, rows: list[dict],
+                              models: dict, variants: dict) -> None:
+    """``d`` and the certified Hausdorff distance of each model, into its simplified rows."""
+    by = {r["case"]: r for r in rows}
     measured = [(name, NEW, model) for name, model in models.items()]
     measured += [(name, rules, model) for (name, rules), model in variants.items()]
     for name, rules, model in measured:
@@ -236,24 +272,34 @@ def table_rows(case: Case, models: dict, variants: dict, drawer: Drawer, gl_rend
                       variant_label(name, rules, "+ normal map + wire texture")):
             if label in by:
                 by[label].update(d_mm=model.params.d, **error)
-        say(f"  {case.label} set {name} ({rules} rules): one-sided Hausdorff <= "
-            f"{error['hausdorff_mm']:.3f} mm (d = {model.params.d} mm)")
+        exp.say(f"  {case.label} set {name} ({rules} rules): one-sided Hausdorff <= "
+                f"{error['hausdorff_mm']:.3f} mm (d = {model.params.d} mm)")
+
+
+def table3_rows(exp: ExperimentContext, case: Case, models: dict, variants: dict,
+                drawer: Drawer) -> tuple[list[dict], dict]:
+    """Table 3 rows of one mesh (see :func:`drawn_rows`), and the images by case label."""
+    rows, images = drawn_rows(exp, case, models, variants, drawer)
+    add_image_comparisons(rows, images)
+    add_simplification_errors(exp, case, rows, models, variants)
     return rows, images
 
 
+# ---------------------------------------------------------------------------- sweep
 SWEEP_KEYS = ("fit_share", "certify", "wire_encoding", "texels_per_edge", "scale_by",
               "scale_quantile", "atlas_turns", "border", "normal_reduction", "min_width")
 
 
-def sweep_configs(quick: bool) -> list[tuple[str, FEPatchParams, dict]]:
-    """(label, parameters, build_model keywords) of the sweep: the parameter sets scaled, and
-    set A under the paper's rules, each change alone and the texture rule varied."""
+def scaled(p: FEPatchParams, f: float) -> FEPatchParams:
+    """Parameter set ``p`` with its lengths scaled by ``f``, named ``<name>x<f>``."""
+    return FEPatchParams(p.alpha_g1_deg, p.d * f, p.l_outer * f, p.l_inner * f,
+                         f"{p.name}x{f:g}")
+
+
+def sweep_configs(exp: ExperimentContext) -> list[tuple[str, FEPatchParams, dict]]:
+    """(case label, parameters, build_model keywords) of the sweep: the parameter sets scaled,
+    and set A under the paper's rules, each change alone and the texture rule varied."""
     a, b = PARAMETER_SETS["A"], PARAMETER_SETS["B"]
-
-    def scaled(p: FEPatchParams, f: float) -> FEPatchParams:
-        return FEPatchParams(p.alpha_g1_deg, p.d * f, p.l_outer * f, p.l_inner * f,
-                             f"{p.name}x{f:g}")
-
     configs = [("A", a, {}), ("B", b, {}), ("A/2", scaled(a, 0.5), {}),
                ("Bx2", scaled(b, 2.0), {}),
                ("A, paper rules", a, PAPER_RULES),
@@ -272,34 +318,52 @@ def sweep_configs(quick: bool) -> list[tuple[str, FEPatchParams, dict]]:
                ("A, distance texture, width 3", a, DISTANCE_TEXTURE),
                ("A, distance texture, width 2.5", a, {**DISTANCE_TEXTURE, "texels_per_edge": 2.5,
                                                       "min_width": 2.5})]
-    if not quick:
+    if not exp.quick:
         configs += [("Ax2", scaled(a, 2.0), {}), ("A/4", scaled(a, 0.25), {}),
                     ("A, width 1.5 q0.3", a, {"scale_quantile": 0.3}),
                     ("A, width 1 q0.3, no narrow lines", a, {"texels_per_edge": 1.0,
                                                             "scale_quantile": 0.3,
                                                             "min_width": None})]
-    return configs
+    kept = exp.pick(None, QUICK_SWEEP, TINY_SWEEP)
+    return configs if kept is None else [c for c in configs if c[0] in kept]
 
 
 def build_settings(kwargs: dict) -> dict:
     """Every :data:`SWEEP_KEYS` keyword of a build: ``kwargs`` over build_model's defaults."""
-    import inspect
-
     defaults = inspect.signature(build_model).parameters
     return {k: kwargs.get(k, defaults[k].default) for k in SWEEP_KEYS}
 
 
-def sweep_rows(case: Case, drawer: Drawer, quick: bool, say) -> list[dict]:
-    overdraw = drawer.draw("gouraud", Style(crease_deg=PARAMETER_SETS["A"].alpha_g1_deg,
-                                            wireframe=True, wire_color=WIRE))
+def build_key(params: FEPatchParams, kwargs: dict) -> tuple:
+    """What makes one model of a mesh: its parameters and build_model keywords."""
+    return params, tuple(sorted(kwargs.items()))
+
+
+def models_by_build(models: dict, variants: dict) -> dict:
+    """Table 3's models of one mesh (see :func:`mesh_models`) by :func:`build_key`."""
+    built = {build_key(PARAMETER_SETS[name], {}): model for name, model in models.items()}
+    built.update({build_key(PARAMETER_SETS[name], RULES[rules]): model
+                  for (name, rules), model in variants.items()})
+    return built
+
+
+def sweep_rows(exp: ExperimentContext, case: Case, drawer: Drawer,
+               built: dict | None = None) -> list[dict]:
+    """One row per :func:`sweep_configs` entry: its parameters and build keywords, speed
+    against the overdraw, wire agreement and certified Hausdorff distance (mm). ``built``:
+    models already built on this mesh, by :func:`build_key`, used instead of building them
+    again (the build is deterministic; its seconds are those of that build)."""
+    overdraw = drawer.draw("gouraud", overdraw_style())
     rows = []
-    for label, params, kwargs in sweep_configs(quick):
+    for label, params, kwargs in sweep_configs(exp):
         # rules of its own: built here, the simplified surface drawn as the scene
-        model = build_model(case.mesh.elements, case.mesh.nodes, params, **kwargs)
+        model = (built or {}).get(build_key(params, kwargs))
+        if model is None:
+            model = build_model(case.scene.elements, case.scene.nodes, params, **kwargs)
         style = Style(crease_deg=params.alpha_g1_deg, wire_color=WIRE)
         m = drawer.draw("fe_normal_wire", style, model.simplified)
-        row = dict(mesh=case.label, config=label, alpha_g1_deg=params.alpha_g1_deg, d_mm=params.d,
-                   l_outer_mm=params.l_outer, l_inner_mm=params.l_inner,
+        row = dict(scene=case.label, case=label, alpha_g1_deg=params.alpha_g1_deg,
+                   d_mm=params.d, l_outer_mm=params.l_outer, l_inner_mm=params.l_inner,
                    **build_settings(kwargs), triangles=m.row["triangles"],
                    line_edges=m.row["edges"], narrow_elements=model.narrow_elements,
                    preprocessing_s=sum(model.seconds.values()),
@@ -309,14 +373,16 @@ def sweep_rows(case: Case, drawer: Drawer, quick: bool, say) -> list[dict]:
                    **wire_agreement(m.image, overdraw.image, WIRE),
                    **simplification_error(case, model))
         rows.append(row)
-        say(f"  sweep {label}: {m.row['triangles']} triangles, "
-            f"speed x{row['speed_vs_overdraw']:.2f}, "
-            f"wire IoU {row['wire_iou_1px']:.3f}, Hausdorff {row['hausdorff_mm']:.3f} mm, "
-            f"{row['rgba_texels_per_element']:.1f} RGBA texels per element")
+        exp.say(f"  sweep {label}: {m.row['triangles']} triangles, "
+                f"speed x{row['speed_vs_overdraw']:.2f}, "
+                f"wire IoU {row['wire_iou_1px']:.3f}, Hausdorff {row['hausdorff_mm']:.3f} mm, "
+                f"{row['rgba_texels_per_element']:.1f} RGBA texels per element")
     return rows
 
 
 def save_sweep_figure(path: Path, rows: list[dict], title: str) -> None:
+    """Speed factor against wire IoU and against the Hausdorff distance, coloured by texture
+    memory, each point named by its case."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -325,11 +391,12 @@ def save_sweep_figure(path: Path, rows: list[dict], title: str) -> None:
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     speed = [r["speed_vs_overdraw"] for r in rows]
     for ax, key, xlabel in ((axes[0], "wire_iou_1px", "wire IoU against line overdraw (1 px)"),
-                            (axes[1], "hausdorff_mm", "one-sided Hausdorff original → simplified [mm]")):
+                            (axes[1], "hausdorff_mm",
+                             "one-sided Hausdorff original → simplified [mm]")):
         x = [r[key] for r in rows]
         sc = ax.scatter(x, speed, c=[r["rgba_texels_per_element"] for r in rows], cmap="viridis")
         for r, xi, yi in zip(rows, x, speed):
-            ax.annotate(r["config"], (xi, yi), textcoords="offset points", xytext=(4, 4),
+            ax.annotate(r["case"], (xi, yi), textcoords="offset points", xytext=(4, 4),
                         fontsize=8)
         ax.set_xlabel(xlabel)
         ax.set_ylabel("speed factor against original + line overdraw")
@@ -341,7 +408,7 @@ def save_sweep_figure(path: Path, rows: list[dict], title: str) -> None:
     plt.close(fig)
 
 
-CLOSEUP_SIZE = (400, 400)
+# ---------------------------------------------------------------------------- close-up
 CLOSEUP_ELEMENTS = 6.0  # elements across the close-up view's radius
 
 
@@ -349,8 +416,6 @@ def closeup_camera(mesh: FEMesh) -> Camera:
     """A magnified view at ``VIEW``'s angles: centred on the node nearest to the top centre of the
     mesh's bounding box, ``CLOSEUP_ELEMENTS`` median element edges in radius; its near and far
     planes open so that the surface is not cut to the view sphere."""
-    import dataclasses
-
     lo, hi = mesh.bounds()
     nodes = mesh.nodes
     e = np.asarray(mesh.elements)
@@ -362,94 +427,100 @@ def closeup_camera(mesh: FEMesh) -> Camera:
     return dataclasses.replace(cam, near=0.01 * radius, far=cam.far + 100.0 * radius)
 
 
-def closeup_rows(case: Case, models: dict, variants: dict, ctx, say) -> tuple[list, dict]:
+def closeup_rows(exp: ExperimentContext, case: Case, models: dict,
+                 variants: dict) -> tuple[list, dict]:
     """Wire fidelity magnified (:func:`closeup_camera`): each wire path of set A against line
-    overdraw, untimed, and the images by label."""
-    camera = closeup_camera(case.mesh)
-    crease = PARAMETER_SETS["A"].alpha_g1_deg
-    overdraw = measure(ctx, case.mesh, "gouraud", Style(crease_deg=crease, wireframe=True,
-                                                        wire_color=WIRE),
-                       camera=camera, size=CLOSEUP_SIZE, timed=False).image
+    overdraw, untimed, and the images by case label."""
+    camera = closeup_camera(case.scene)
+    size = exp.pick((400, 400), (400, 400), TINY_CLOSEUP_SIZE)
+    overdraw = exp.measure(case.scene, "gouraud", overdraw_style(), camera=camera, size=size,
+                           timed=False).image
     images = {OVERDRAW: overdraw}
     rows = []
     drawn = [(NEW, models["A"])] + [(rules, m) for (name, rules), m in variants.items()
                                      if name == "A"]
     for rules, model in drawn:
         label = variant_label("A", rules, "+ normal map + wire texture")
-        image = measure(ctx, model.simplified, "fe_normal_wire", Style(wire_color=WIRE),
-                        camera=camera, size=CLOSEUP_SIZE, timed=False).image
+        image = exp.measure(model.simplified, "fe_normal_wire", Style(wire_color=WIRE),
+                            camera=camera, size=size, timed=False).image
         images[label] = image
-        rows.append(dict(mesh=case.label, view=f"close-up, {CLOSEUP_SIZE[0]}x{CLOSEUP_SIZE[1]}",
-                         path=label, rules=rules,
+        rows.append(dict(scene=case.label, view=f"close-up, {size[0]}x{size[1]}",
+                         case=label, rules=rules,
                          wire_encoding=model.wire_encoding,
                          **wire_agreement(image, overdraw, WIRE),
                          ssim=compare_images(overdraw, image).ssim))
-        say(f"  {case.label} close-up {label}: wire IoU {rows[-1]['wire_iou_1px']:.3f}")
+        exp.say(f"  {case.label} close-up {label}: wire IoU {rows[-1]['wire_iou_1px']:.3f}")
     return rows, images
 
 
-def crop(image: np.ndarray, box) -> np.ndarray:
-    y0, y1, x0, x1 = box
-    return image[y0:y1, x0:x1]
+def save_first_figures(exp: ExperimentContext, case: Case, images: dict, near_images: dict,
+                       size) -> None:
+    """``closeup.png`` and ``crops.png`` of the first mesh."""
+    save_image_grid(exp.file("closeup.png"), list(near_images.values()),
+                    [f"{case.label}: {OVERDRAW}"]
+                    + [label.replace(" + normal map + wire texture", "")
+                       for label in list(near_images)[1:]], columns=3)
+    h, w = size[1], size[0]
+    y0, x0 = h // 3, w // 3
+    simplified = "simplified A + normal map + wire texture"
+    save_image_grid(exp.file("crops.png"),
+                    [images[OVERDRAW][y0:y0 + h // 3, x0:x0 + w // 3],
+                     images[simplified][y0:y0 + h // 3, x0:x0 + w // 3]],
+                    [f"{case.label}: original + line overdraw", simplified])
+
+
+# ---------------------------------------------------------------------------- the run
+def mesh_models(exp: ExperimentContext, case: Case) -> tuple[dict, dict, list[dict]]:
+    """The models of one mesh: {set: new rules, cached by the mesh}, {("A", rules): set A
+    before each change}, and their preprocessing rows."""
+    models, variants, pre = {}, {}, []
+    for name in PARAMETER_SETS:
+        models[name] = fepatch_model(case.scene, name)  # derived once, cached by the mesh
+        pre.append(preprocessing_row(case, models[name]))
+        exp.say(f"  set {name}: preprocessing {pre[-1]['total s']:.1f} s, "
+                f"{pre[-1]['simplified_triangles']} of {pre[-1]['original_triangles']} "
+                f"triangles")
+    for rules, kwargs in RULES.items():  # set A before each change
+        if rules == NEW:
+            continue
+        variants[("A", rules)] = build_model(case.scene.elements, case.scene.nodes, "A",
+                                             **kwargs)
+        pre.append(preprocessing_row(case, variants[("A", rules)], rules))
+        exp.say(f"  set A, {rules} rules: preprocessing {pre[-1]['total s']:.1f} s, "
+                f"{pre[-1]['simplified_triangles']} triangles")
+    return models, variants, pre
 
 
 @experiment("table_fe_texture_wireframe", "fe2003 Tables 1-3: simplified FE meshes with normal "
                                           "maps and a wire-frame texture against line overdraw")
 def run(exp: ExperimentContext) -> list[dict]:
-    out_dir, quick, say = exp.out_dir, exp.quick, exp.say
-    size = (500, 375) if quick else (1000, 750)
-    repeat = 5 if quick else 9
-    ctx = create_context()
-    gl_renderer = renderer(ctx)
-    write_table(params_rows(), out_dir, "params", title="fe2003 Table 1: parameter sets")
-    pre, rows, sweep, closeups = [], [], [], []
-    first = True
-    for case in cases(quick, say):
-        say(f"{case.label}: {case.mesh.n_elements} elements")
-        models, variants = {}, {}
-        for name in PARAMETER_SETS:
-            models[name] = fepatch_model(case.mesh, name)  # derived once, cached by the mesh
-            pre.append(preprocessing_row(case, models[name]))
-            say(f"  set {name}: preprocessing {pre[-1]['total s']:.1f} s, "
-                f"{pre[-1]['simplified_triangles']} of {pre[-1]['original_triangles']} triangles")
-        for rules, kwargs in RULES.items():  # set A before each change
-            if rules == NEW:
-                continue
-            variants[("A", rules)] = build_model(case.mesh.elements, case.mesh.nodes, "A",
-                                                 **kwargs)
-            pre.append(preprocessing_row(case, variants[("A", rules)], rules))
-            say(f"  set A, {rules} rules: preprocessing {pre[-1]['total s']:.1f} s, "
-                f"{pre[-1]['simplified_triangles']} triangles")
-        drawer = Drawer(ctx, case.mesh, size, repeat)
-        mesh_rows, images = table_rows(case, models, variants, drawer, gl_renderer, say)
+    size = exp.pick((1000, 750), (500, 375), TINY_SIZE)
+    exp.table(params_rows(), "params", "fe2003 Table 1: parameter sets")
+    car = None if exp.tiny else exp.builtin("car")
+    meshes, swept = cases(exp, car)
+    pre, rows, sweep, closeups, built = [], [], [], [], None
+    for i, case in enumerate(meshes):
+        exp.say(f"{case.label}: {case.scene.n_elements} elements")
+        models, variants, mesh_pre = mesh_models(exp, case)
+        pre += mesh_pre
+        mesh_rows, images = table3_rows(exp, case, models, variants, Drawer(exp, case.scene, size))
         rows += mesh_rows
-        near_rows, near_images = closeup_rows(case, models, variants, ctx, say)
+        near_rows, near_images = closeup_rows(exp, case, models, variants)
         closeups += near_rows
-        if first:
-            save_image_grid(out_dir / "closeup.png", list(near_images.values()),
-                            [f"{case.label}: {OVERDRAW}"]
-                            + [label.replace(" + normal map + wire texture", "")
-                               for label in list(near_images)[1:]], columns=3)
-            h, w = size[1], size[0]
-            box = (h // 3, h // 3 + h // 3, w // 3, w // 3 + w // 3)
-            save_image_grid(out_dir / "crops.png",
-                            [crop(images[OVERDRAW], box),
-                             crop(images["simplified A + normal map + wire texture"], box)],
-                            [f"{case.label}: original + line overdraw",
-                             "simplified A + normal map + wire texture"])
-            first = False
-    sweep_case = next((c for c in cases(True, say) if c.label.startswith("car")), None)
-    if sweep_case is not None:
-        say(f"sweep on {sweep_case.label}")
-        sweep = sweep_rows(sweep_case, Drawer(ctx, sweep_case.mesh, size, repeat), quick, say)
-    write_table(pre, out_dir, "preprocessing", title="fe2003 Table 2: preprocessing seconds")
-    write_table(closeups, out_dir, "closeup",
-                title="Wire fidelity magnified: set A's wire frames against line overdraw")
-    write_table(rows, out_dir, "table3", columns=TABLE3,
-                title="fe2003 Table 3: time per frame against error (all columns: table.md)")
+        if i == 0:
+            save_first_figures(exp, case, images, near_images, size)
+        if case is swept:
+            built = models_by_build(models, variants)
+    if swept is not None:
+        exp.say(f"sweep on {swept.label}")
+        sweep = sweep_rows(exp, swept, Drawer(exp, swept.scene, size), built)
+    exp.table(pre, "preprocessing", "fe2003 Table 2: preprocessing seconds")
+    exp.table(closeups, "closeup",
+              "Wire fidelity magnified: set A's wire frames against line overdraw")
+    exp.table(rows, "table3", "fe2003 Table 3: time per frame against error (all columns: "
+              "table.md)", columns=TABLE3)
     if sweep:
-        write_table(sweep, out_dir, "sweep", title="Parameter sweep: speed against error")
-        save_sweep_figure(out_dir / "sweep.png", sweep,
-                          f"{sweep[0]['mesh']}: simplified + wire texture, speed against error")
+        exp.table(sweep, "sweep", "Parameter sweep: speed against error")
+        save_sweep_figure(exp.file("sweep.png"), sweep,
+                          f"{sweep[0]['scene']}: simplified + wire texture, speed against error")
     return rows
-

@@ -1,4 +1,8 @@
-"""The table_fe_texture_wireframe experiment end to end in its quick form: what its tables show."""
+"""The table_fe_texture_wireframe experiment end to end: what its tables show, at the tiny size
+(every table, row kind and column, on small stamped panels) and at the quick size (the car
+meshes too; marked slow)."""
+
+import csv
 
 import pytest
 
@@ -6,13 +10,72 @@ from workbench.algo.fepatch.pipeline import PARAMETER_SETS
 from workbench.experiment.registry import discover, run_experiment
 from workbench.experiment.tables import read_table
 
+ERRORS = ["d_mm", "hausdorff_mm", "hausdorff_lower_mm", "hausdorff_pct_diag", "hausdorff_s",
+          "within_d"]
+WIRE = ["wire_pixels", "overdraw_wire_pixels", "wire_recall_1px", "wire_precision_1px",
+        "wire_iou_1px", "wire_exact_overlap"]
+TABLES = {
+    "params": ["set", "alpha_g1_deg", "d_mm", "l_outer_mm", "l_inner_mm"],
+    "preprocessing": [
+        "scene", "set", "rules", "elements", "patches", "subpatches", "g0_edges", "g1_edges",
+        "closing_edges", "line_nodes", "line_nodes_kept", "fallback_subpatches",
+        "original_triangles", "simplified_triangles", "atlas", "rgba_texels_per_element",
+        "wire_encoding", "narrow_elements", "fit_share", "split_subpatches", "kept_subpatches",
+        "certified_bound_mm", "features, subpatches, lines s", "retriangulation s",
+        "textures s", "certification s", "total s"],
+    "table": [
+        "renderer", "scene", "size", "case", "set", "rules", "triangles", "line_edges", "gpu_ms",
+        "gpu_ms_min", "gpu_ms_max", "wall_ms", "wall_ms_min", "wall_ms_max", "readback_ms",
+        "repeats", "speed_vs_overdraw", "gpu_speed_vs_overdraw", "rgba_texels_per_element",
+        "texture_mb", "narrow_elements", "ssim", "reference", *WIRE, *ERRORS],
+    "table3": ["renderer", "scene", "size", "case", "rules", "triangles", "line_edges",
+               "gpu_ms", "wall_ms", "speed_vs_overdraw", "rgba_texels_per_element",
+               "hausdorff_mm", "d_mm", "wire_precision_1px", "wire_recall_1px",
+               "wire_iou_1px", "ssim"],
+    "sweep": [
+        "scene", "case", "alpha_g1_deg", "d_mm", "l_outer_mm", "l_inner_mm", "fit_share",
+        "certify", "wire_encoding", "texels_per_edge", "scale_by", "scale_quantile",
+        "atlas_turns", "border", "normal_reduction", "min_width", "triangles", "line_edges",
+        "narrow_elements", "preprocessing_s", "wall_ms", "speed_vs_overdraw",
+        "rgba_texels_per_element", *WIRE, *ERRORS[1:]],
+    "closeup": ["scene", "view", "case", "rules", "wire_encoding", *WIRE, "ssim"],
+}
+
 
 @pytest.fixture(scope="module")
-def result(tmp_path_factory):
+def tiny(tmp_path_factory):
     discover()
     root = tmp_path_factory.mktemp("figures")
-    rows, out_dir = run_experiment("table_fe_texture_wireframe", figures_root=root, quick=True)
-    return rows, out_dir
+    return run_experiment("table_fe_texture_wireframe", figures_root=root, size="tiny")
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    discover()
+    root = tmp_path_factory.mktemp("figures")
+    return run_experiment("table_fe_texture_wireframe", figures_root=root, quick=True)
+
+
+@pytest.fixture(params=["tiny", pytest.param("quick", marks=pytest.mark.slow)])
+def result(request):
+    """The tiny run, and the quick run (slow): the assertions below hold at either size."""
+    return request.getfixturevalue(request.param)
+
+
+def _columns(path):
+    with open(path, encoding="utf-8", newline="") as handle:
+        return next(csv.reader(handle))
+
+
+def test_tiny_writes_every_table_with_its_columns(tiny):
+    _, out_dir = tiny
+    for name, columns in TABLES.items():
+        assert (out_dir / f"{name}.md").is_file()
+        assert _columns(out_dir / f"{name}.csv") == columns, name
+    rows = read_table(out_dir / "table.csv")
+    assert {r["case"] for r in rows} >= {"original, shaded", "original + line overdraw",
+                                         "original + wire texture"}
+    assert (out_dir / "sweep.png").stat().st_size > 1000
 
 
 def test_every_table_and_figure_is_written(result):
@@ -28,10 +91,10 @@ def test_every_table_and_figure_is_written(result):
 
 def test_simplified_paths_draw_fewer_triangles_and_report_their_errors(result):
     rows, _ = result
-    meshes = {r["mesh"] for r in rows}
-    assert "stamped panels" in meshes
-    for mesh in meshes:
-        by = {r["path"]: r for r in rows if r["mesh"] == mesh}
+    scenes = {r["scene"] for r in rows}
+    assert "stamped panels" in scenes
+    for scene in scenes:
+        by = {r["case"]: r for r in rows if r["scene"] == scene}
         assert by["original + line overdraw"]["speed_vs_overdraw"] == 1.0
         assert by["original + line overdraw"]["line_edges"] > 0
         original = by["original, shaded"]["triangles"]
@@ -66,8 +129,8 @@ def test_preprocessing_times_every_stage(result):
 
 def test_before_and_after_rows_show_the_bound_and_the_texture_memory(result):
     rows, out_dir = result
-    for mesh in {r["mesh"] for r in rows}:
-        by = {r["path"]: r for r in rows if r["mesh"] == mesh}
+    for scene in {r["scene"] for r in rows}:
+        by = {r["case"]: r for r in rows if r["scene"] == scene}
         new = by["simplified A + normal map + wire texture"]
         paper = by["simplified A [paper] + normal map + wire texture"]
         bound_only = by["simplified A [certified d, paper texture] + normal map + wire texture"]
@@ -89,7 +152,7 @@ def test_before_and_after_rows_show_the_bound_and_the_texture_memory(result):
         if r["rules"] != "paper":
             assert r["certified_bound_mm"] <= PARAMETER_SETS[r["set"]].d
     sweep = read_table(out_dir / "sweep.csv")
-    configs = {r["config"]: r for r in sweep}
+    configs = {r["case"]: r for r in sweep}
     assert configs["A, paper rules"]["fit_share"] == 1 and not configs["A, paper rules"]["certify"]
     assert configs["A"]["within_d"] and configs["A"]["hausdorff_mm"] <= configs["A"]["d_mm"]
 
@@ -97,10 +160,10 @@ def test_before_and_after_rows_show_the_bound_and_the_texture_memory(result):
 def test_closeup_compares_every_wire_frame_of_set_a_magnified(result):
     _, out_dir = result
     rows = read_table(out_dir / "closeup.csv")
-    meshes = {r["mesh"] for r in rows}
-    assert "stamped panels" in meshes
-    for mesh in meshes:
-        by = {r["rules"]: r for r in rows if r["mesh"] == mesh}
+    scenes = {r["scene"] for r in rows}
+    assert "stamped panels" in scenes
+    for scene in scenes:
+        by = {r["rules"]: r for r in rows if r["scene"] == scene}
         assert set(by) == {"new", "paper", "certified d, paper texture", "distance texture"}
         for r in by.values():
             assert 0 < r["wire_recall_1px"] <= 1 and 0 < r["wire_precision_1px"] <= 1
