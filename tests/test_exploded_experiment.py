@@ -6,7 +6,7 @@ import csv
 import pytest
 from PIL import Image
 
-from workbench.data import CAR_DECK, shared_file
+import workbench.data
 from workbench.experiment.registry import discover, run_experiment
 from workbench.experiment.tables import read_table
 
@@ -110,11 +110,10 @@ def test_car_rows_name_their_focus(tiny, car_deck):
     assert {r["focus_part"] for r in car} == {hidden["part"]}
 
 
-def test_no_car_rows_without_the_shared_deck(tiny):
-    if shared_file(CAR_DECK) is not None:
-        pytest.skip("the shared car deck is present")
-    rows, _ = tiny
-    assert not [r for r in rows if r["scene"] == "car"]
+def test_no_car_rows_without_the_shared_deck(tmp_path, monkeypatch):
+    monkeypatch.setattr(workbench.data, "shared_data_dir", lambda: None)
+    rows, _ = _run(tmp_path, "tiny")
+    assert rows and not [r for r in rows if r["scene"] == "car"]
 
 
 # ---------------------------------------------------------------------------- quick size
