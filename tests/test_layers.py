@@ -1,8 +1,9 @@
 """The shape of the package: every layer imports only downward, no module imports another in a
 circle, and no private name is imported across packages.
 
-Layers, bottom to top: ``gl``, ``scene`` (with ``data``) → ``algo`` → ``paths`` →
-``experiment`` → ``sweep`` → ``reliability`` → ``cli``, and the experiment scripts on top. A
+Layers, bottom to top: ``gl`` (with the shaders, ``glsl``), ``scene`` (with ``data``) → ``algo`` → ``paths`` →
+``experiment`` → ``sweep`` → ``reliability`` → ``cli``, and the experiment scripts
+(``reproductions``) on top. A
 module may import its own layer and the layers below. Imports inside functions count: a lazy
 import that points up, or closes a circle, is the same coupling. The checks are tested on a
 small package with the faults they exist to catch.
@@ -16,8 +17,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 LAYERS = {"gl": 0, "scene": 0, "data": 0, "algo": 1, "paths": 2, "experiment": 3, "sweep": 4,
-          "reliability": 5, "cli": 6, "experiments": 7, "__init__": 0}
-PACKAGE_DIRS = {"workbench": ROOT / "workbench", "workbench.experiments": ROOT / "experiments"}
+          "reliability": 5, "cli": 6, "reproductions": 7, "glsl": 0, "__init__": 0}
+PACKAGE_DIRS = {"workbench": ROOT / "workbench"}
 
 
 def modules_of(package: str, folder: Path) -> dict[str, Path]:
@@ -56,8 +57,6 @@ def imports_of(module: str, path: Path, known: set[str]) -> set[str]:
 def layer_of(module: str) -> str:
     """The layer of a dotted module name (``workbench.paths.mesh`` → ``paths``)."""
     parts = module.split(".")
-    if parts[:2] == ["workbench", "experiments"]:
-        return "experiments"
     return parts[1] if len(parts) > 1 else "__init__"
 
 
@@ -132,7 +131,7 @@ def test_no_import_cycles(graph):
 
 def test_no_private_names_imported_across_packages():
     offenders = []
-    for path in [*ROOT.joinpath("workbench").rglob("*.py"), *ROOT.joinpath("experiments").glob("*.py")]:
+    for path in ROOT.joinpath("workbench").rglob("*.py"):
         package = ".".join(path.relative_to(ROOT).parent.parts)
         for node in ast.walk(ast.parse(path.read_text())):
             if not isinstance(node, ast.ImportFrom):

@@ -107,7 +107,7 @@ def test_a_flagged_sampled_value_is_the_tool_s_error_not_ours(result, tmp_path):
     # sampling of the same pair must side with our bracket
     from workbench.algo.distance import points_triangles_distance
     from workbench.experiment.simplifiers import simplify_with
-    from workbench.experiments.simplify_tradeoff import models
+    from workbench.reproductions.simplify_tradeoff import models
 
     size, rows, _ = result
     flagged = [r for r in rows

@@ -1,7 +1,7 @@
 """The experiment registry behind ``workbench reproduce``.
 
-An experiment script in the top-level ``experiments/`` folder (the package
-``workbench.experiments``) registers a function with :func:`experiment`; the function
+An experiment script in the package ``workbench.reproductions`` (one module per paper table
+or figure) registers a function with :func:`experiment`; the function
 ``run(exp)`` receives an :class:`~workbench.experiment.context.ExperimentContext` (size,
 output folder, progress, GL context, measurement defaults, the shared-data guard), writes its
 figures and further tables into the context's folder and returns its rows.
@@ -27,7 +27,7 @@ from .tables import write_table
 Progress = Callable[[str], None]
 RunFunction = Callable[[ExperimentContext], list]
 
-EXPERIMENTS_PACKAGE = "workbench.experiments"
+EXPERIMENTS_PACKAGE = "workbench.reproductions"
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 

@@ -1,4 +1,4 @@
-"""Loading the shaders of the top-level ``glsl/`` folder (shipped in the wheel as ``workbench.glsl``)."""
+"""Loading the shaders of the package ``workbench.glsl`` (its ``*.glsl`` files)."""
 
 from __future__ import annotations
 

@@ -1,1 +1,0 @@
-"""Experiment scripts, one per paper table or figure; each registers itself for `workbench reproduce`."""
