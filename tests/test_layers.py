@@ -1,12 +1,11 @@
 """The shape of the package: every layer imports only downward, no module imports another in a
 circle, and no private name is imported across packages.
 
-Layers, bottom to top: ``gl`` (with the shaders, ``glsl``), ``scene`` (with ``data``) → ``algo`` → ``paths`` →
-``experiment`` → ``sweep`` → ``reliability`` → ``cli``, and the experiment scripts
-(``reproductions``) on top. A
-module may import its own layer and the layers below. Imports inside functions count: a lazy
-import that points up, or closes a circle, is the same coupling. The checks are tested on a
-small package with the faults they exist to catch.
+Layers, bottom to top: ``gl`` (with the shaders, ``glsl``), ``scene`` (with ``data``) →
+``algo`` → ``paths`` → ``experiment`` → ``sweep`` → ``reliability`` → ``cli``, and the
+experiment scripts (``reproductions``) on top. A module may import its own layer and the layers
+below. Imports inside functions count: a lazy import that points up, or closes a circle, is the
+same coupling. The checks are tested on a small package with the faults they exist to catch.
 """
 
 import ast
