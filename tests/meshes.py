@@ -1,5 +1,6 @@
 """Small meshes the tests build again and again: regular or jittered quad grids (as quads or
-split into triangles), a plate folded along a grid line, and barycentric sample grids.
+split into triangles), a random tiling of quads and triangles, a plate folded along a grid line,
+and barycentric sample grids.
 
 Imported by the test modules as ``from meshes import quad_grid`` (the tests folder is on the
 import path when pytest runs). Every builder is deterministic: the same arguments give the same
@@ -98,6 +99,21 @@ def quad_grid(nx: int, ny: int, *, cell=1.0, span=None, centred: bool = False, z
             nodes[inner, :2] += rng.uniform(-jitter, jitter, (int(inner.sum()), 2))
     quads = grid_quads(nx, ny, ij=ij)
     return nodes, split_quads(quads) if triangles else quads
+
+
+def random_tiling(n: int, jitter: float, seed=0) -> np.ndarray:
+    """(P, 4, 2) corners of the cells of an n × n grid of unit squares, inner nodes jittered by
+    up to ``jitter`` (:func:`quad_grid` with ``ij``, drawn first): cell by cell, x outer, each
+    cell by a coin toss the quad (a, b, c, d) or its two triangles (a, b, c, c), (a, c, d, d)."""
+    rng = np.random.default_rng(seed)
+    pts, _ = quad_grid(n, n, jitter=jitter, seed=rng, jitter_border=False, ij=True, dim=2)
+    pts = pts.reshape(n + 1, n + 1, 2)
+    polys = []
+    for i in range(n):
+        for j in range(n):
+            a, b, c, d = pts[i, j], pts[i + 1, j], pts[i + 1, j + 1], pts[i, j + 1]
+            polys += [[a, b, c, d]] if rng.random() < 0.5 else [[a, b, c, c], [a, c, d, d]]
+    return np.array(polys)
 
 
 def folded(nodes: np.ndarray, at: float, angle_deg: float) -> np.ndarray:
