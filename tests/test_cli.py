@@ -5,10 +5,10 @@ import sys
 
 import numpy as np
 import pytest
+from meshes import quad_grid
 from PIL import Image
 
 from workbench.cli import main
-from workbench.data import CAR_DECK, D3PLOT, shared_file
 
 DECK = """*KEYWORD
 *NODE
@@ -57,14 +57,10 @@ def test_render_draws_the_same_plate_with_quad_strips(deck, tmp_path, capsys):
 
 def grid_deck(n: int, cell: float) -> str:
     """A flat n × n quad plate as a fixed-format keyword deck."""
-    nodes = [f"{1 + i + (n + 1) * j:8d}{i * cell:16.1f}{j * cell:16.1f}{0.0:16.1f}"
-             for j in range(n + 1) for i in range(n + 1)]
-    elements = []
-    for j in range(n):
-        for i in range(n):
-            a = 1 + i + (n + 1) * j
-            elements.append(f"{len(elements) + 1:8d}{1:8d}{a:8d}{a + 1:8d}{a + n + 2:8d}"
-                            f"{a + n + 1:8d}")
+    coords, quads = quad_grid(n, n, cell=cell)
+    nodes = [f"{k + 1:8d}" + "".join(f"{c:16.1f}" for c in xyz) for k, xyz in enumerate(coords)]
+    elements = [f"{k + 1:8d}{1:8d}" + "".join(f"{a + 1:8d}" for a in quad)
+                for k, quad in enumerate(quads)]
     return "\n".join(["*KEYWORD", "*NODE", *nodes, "*ELEMENT_SHELL", *elements, "*END", ""])
 
 
@@ -93,9 +89,8 @@ def test_render_the_plate_simplified_with_a_wire_texture(tmp_path):
                  "-o", str(tmp_path / "bad.png")]) != 0
 
 
+@pytest.mark.usefixtures("car_deck")
 def test_render_car_with_field_writes_a_colour_bar_figure(tmp_path):
-    if shared_file(CAR_DECK) is None:
-        pytest.skip("shared car deck not found (set WORKBENCH_DATA)")
     out = tmp_path / "car.png"
     assert main(["render", "car", "--field", "thickness", "--bands", "4", "--wireframe",
                  "--size", "320x200", "-o", str(out)]) == 0
@@ -104,10 +99,9 @@ def test_render_car_with_field_writes_a_colour_bar_figure(tmp_path):
     assert image.shape[1] > 320
 
 
+@pytest.mark.usefixtures("d3plot_file")
 def test_render_constant_field_of_the_d3plot(tmp_path):
     # the sample result has one state with zero stress everywhere: a constant field still gets a scale
-    if shared_file(D3PLOT) is None:
-        pytest.skip("shared d3plot not found (set WORKBENCH_DATA)")
     out = tmp_path / "d3plot.png"
     assert main(["render", "d3plot", "--field", "von_mises", "--size", "200x150", "-o", str(out)]) == 0
     assert out.stat().st_size > 1000

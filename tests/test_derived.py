@@ -10,6 +10,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
+from meshes import folded, quad_grid
 
 from workbench.scene import FEMesh
 from workbench.scene.crease import GouraudSplit, gouraud_split
@@ -247,27 +248,12 @@ def ref_split_normals(elements, vertex_of, sign, n_vertices, coords):
 
 # --------------------------------------------------------------------------- grids
 def grid(nx: int, ny: int, flip=None):
-    """Nodes and quads of an nx x ny grid in the z = 0 plane; ``flip`` reverses some windings."""
-    x, y = np.meshgrid(np.arange(nx + 1.0), np.arange(ny + 1.0), indexing="ij")
-    nodes = np.stack([x.ravel(), y.ravel(), np.zeros(x.size)], axis=1)
-    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
-    i, j = i.ravel(), j.ravel()
-    at = lambda a, b: a * (ny + 1) + b  # noqa: E731
-    quads = np.stack([at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)], axis=1)
+    """Nodes and int32 quads of an nx x ny grid of unit cells in the z = 0 plane, node (i, j) at
+    i * (ny + 1) + j; ``flip`` reverses some windings."""
+    nodes, quads = quad_grid(nx, ny, ij=True)
     if flip is not None:
         quads[flip] = quads[flip][:, ::-1]
     return nodes, quads.astype(np.int32)
-
-
-def folded(nodes: np.ndarray, fold_x: float, angle_deg: float) -> np.ndarray:
-    """Rotate the part x > fold_x about the line x = fold_x, z = 0 by ``angle_deg`` (upwards)."""
-    out = nodes.copy()
-    right = nodes[:, 0] > fold_x
-    t = np.radians(angle_deg)
-    r = nodes[right, 0] - fold_x
-    out[right, 0] = fold_x + r * np.cos(t)
-    out[right, 2] = r * np.sin(t)
-    return out
 
 
 def rotation(seed: int) -> np.ndarray:

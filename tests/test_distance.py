@@ -5,6 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
+from meshes import barycentric_grid
 
 from workbench.algo.distance import (closest_point_on_triangle, point_triangle_distance,
                                      points_triangles_distance, triangle_bounds)
@@ -15,9 +16,7 @@ vec3 = arrays(np.float64, 3, elements=coords)
 
 def dense_min(p, a, b, c, n=120):
     """Smallest distance from p to a dense barycentric grid on abc, and the grid's spacing."""
-    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1))
-    keep = i + j <= n
-    u, v = i[keep] / n, j[keep] / n
+    u, v = barycentric_grid(n)
     pts = a + u[:, None] * (b - a) + v[:, None] * (c - a)
     spacing = max(np.linalg.norm(b - a), np.linalg.norm(c - a), np.linalg.norm(c - b)) / n
     return np.sqrt(((pts - p) ** 2).sum(axis=1)).min(), spacing
@@ -88,9 +87,7 @@ def test_triangle_bounds_bracket_the_farthest_point(seed, n_faces):
     # the 2^6 barycentric grid holds every corner the bounds looked at, and more: its largest
     # distance to the union lies inside the bracket
     n = 64
-    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1))
-    keep = i + j <= n
-    u, v = i[keep] / n, j[keep] / n
+    u, v = barycentric_grid(n)
     pts = t[0] + u[:, None] * (t[1] - t[0]) + v[:, None] * (t[2] - t[0])
     sampled = points_triangles_distance(pts, faces).min(axis=1).max()
     assert lower <= sampled + 1e-9

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import quad_grid
 
 from workbench.algo.fepatch.atlas import build_atlas, plane_frames
 
@@ -17,13 +18,11 @@ def plates(n_plates, seed):
     for k in range(n_plates):
         nx, ny = rng.integers(1, 6, size=2)
         cell = rng.uniform(0.5, 3.0)
-        xs, ys = np.meshgrid(np.arange(nx + 1) * cell, np.arange(ny + 1) * cell * rng.uniform(0.5, 2))
-        p = np.c_[xs.ravel(), ys.ravel(), np.zeros(xs.size)]
+        p, quads = quad_grid(nx, ny, cell=cell)
+        p[:, 1] *= rng.uniform(0.5, 2)
         q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
         coords.append(p @ q.T + rng.normal(size=3) * 50)
-        idx = np.arange((nx + 1) * (ny + 1)).reshape(ny + 1, nx + 1) + base
-        elements.append(np.c_[idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(),
-                              idx[1:, :-1].ravel()])
+        elements.append(quads + base)
         labels.append(np.full(nx * ny, k))
         base += (nx + 1) * (ny + 1)
     return np.concatenate(coords), np.concatenate(elements), np.concatenate(labels)
@@ -80,11 +79,7 @@ def test_frames_are_orthonormal_and_span_the_plane():
 def test_texels_per_element_of_a_uniform_grid():
     # one 10 x 10 grid of unit cells at 2 texels per edge: 21 + 2 x 2 border texels a side
     coords, elements, labels = plates(1, 0)
-    xs, ys = np.meshgrid(np.arange(11.0), np.arange(11.0))
-    coords = np.c_[xs.ravel(), ys.ravel(), np.zeros(121)]
-    idx = np.arange(121).reshape(11, 11)
-    elements = np.c_[idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(),
-                     idx[1:, :-1].ravel()]
+    coords, elements = quad_grid(10, 10)
     atlas = build_atlas(coords, elements, np.zeros(100, int), width=25)
     assert atlas.extents[0] == (25, 25) and atlas.size == (25, 25)
     assert atlas.texels_per_element == pytest.approx(6.25)

@@ -6,26 +6,18 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import quad_grid
 from scipy.ndimage import binary_dilation
 
 from workbench.algo.fepatch.bake import bake_normals, normal_map
 from workbench.algo.fepatch.normalmap import decode_normals, dropped_axis, restore_error_bound
 
 
-def quad_grid(nx, ny, cell, jitter=0.0, offset=(0.0, 0.0), seed=0):
+def texel_grid(nx, ny, cell, jitter=0.0, offset=(0.0, 0.0), seed=0):
     """(nodes (N, 2), elements (M, 4)) of an nx × ny grid with ``cell`` texels per side; inner
     nodes jittered by up to ``jitter`` texels, the border kept straight."""
-    rng = np.random.default_rng(seed)
-    xs, ys = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1))
-    nodes = np.c_[xs.ravel(), ys.ravel()] * float(cell) + np.asarray(offset, float)
-    inner = ((xs > 0) & (xs < nx) & (ys > 0) & (ys < ny)).ravel()
-    nodes[inner] += rng.uniform(-jitter, jitter, (inner.sum(), 2))
-    i, j = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny)))
-
-    def node(a, b):
-        return b * (nx + 1) + a
-
-    return nodes, np.stack([node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)], 1)
+    return quad_grid(nx, ny, cell=cell, origin=offset, jitter=jitter, seed=seed,
+                     jitter_border=False, dim=2)
 
 
 def unit(v):
@@ -43,7 +35,7 @@ def centres(w, h):
        ox=st.floats(1.0, 2.0), oy=st.floats(1.0, 2.0))
 def test_constant_normal_covers_the_grid_without_cracks(seed, cell, jitter, ox, oy):
     nx, ny = 4, 3
-    nodes, e = quad_grid(nx, ny, cell, jitter * cell, (ox, oy), seed)
+    nodes, e = texel_grid(nx, ny, cell, jitter * cell, (ox, oy), seed)
     n = unit([0.3, -0.5, 0.8])
     w, h = int(nx * cell + ox) + 3, int(ny * cell + oy) + 3
     normals, owner = bake_normals(nodes[e], np.broadcast_to(n, (len(e), 4, 3)), (w, h))
@@ -58,7 +50,7 @@ def test_a_normal_field_varying_along_u_is_reproduced_at_texel_centres():
     # per element, the corner normals depend on u only: the bake must give the normalised linear
     # blend between the element's left and right normals at every texel centre
     nx, ny, cell, ox, oy = 5, 3, 4.3, 1.37, 0.81
-    nodes, e = quad_grid(nx, ny, cell, offset=(ox, oy))
+    nodes, e = texel_grid(nx, ny, cell, offset=(ox, oy))
     theta = (nodes[:, 0] - ox) / (nx * cell) * 1.2 - 0.6
     node_normal = np.c_[np.sin(theta), np.zeros_like(theta), np.cos(theta)]
     w, h = int(nx * cell + ox) + 2, int(ny * cell + oy) + 2
@@ -98,7 +90,7 @@ def test_a_triangle_element_covers_exactly_its_texel_centres():
 
 def test_the_encoded_map_decodes_within_the_quantisation_bound():
     rng = np.random.default_rng(7)
-    nodes, e = quad_grid(6, 5, 5.0, 1.0, (2.0, 2.0), seed=3)
+    nodes, e = texel_grid(6, 5, 5.0, 1.0, (2.0, 2.0), seed=3)
     # a wavy surface: node normals vary smoothly, every element drops its mean's largest axis
     node_normal = unit(np.c_[0.6 * np.sin(nodes[:, 0] / 6), 0.5 * np.cos(nodes[:, 1] / 5),
                              np.ones(len(nodes))] + rng.normal(0, 0.05, (len(nodes), 3)))
@@ -118,7 +110,7 @@ def test_the_encoded_map_decodes_within_the_quantisation_bound():
 
 @pytest.mark.parametrize("passes", [0, 1, 2, 3])
 def test_dilation_covers_the_ring_around_the_mask(passes):
-    nodes, e = quad_grid(3, 2, 4.0, offset=(5.3, 6.2))
+    nodes, e = texel_grid(3, 2, 4.0, offset=(5.3, 6.2))
     n = unit([0.2, 0.1, -0.9])
     texels = normal_map(nodes[e], np.broadcast_to(n, (len(e), 4, 3)), np.full(len(e), 2),
                         (26, 22), dilate=passes)

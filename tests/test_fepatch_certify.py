@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import quad_grid
 
 from workbench.algo.fepatch.certify import subpatch_distance_bounds, subpatch_neighbours
 from workbench.algo.fepatch.features import feature_edges, patches
@@ -19,18 +20,6 @@ from workbench.algo.fepatch.pipeline import (
 )
 from workbench.algo.hausdorff import hausdorff
 from workbench.scene.derived import triangulate
-
-
-def plate(nx: int, ny: int, h: float, height) -> tuple[np.ndarray, np.ndarray]:
-    """(elements (M, 4), coords (N, 3)) of an nx × ny grid of quads of size h displaced along z
-    by ``height(x, y)``."""
-    ii, jj = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1), indexing="ij")
-    x, y = ii.ravel() * h, jj.ravel() * h
-    c = np.c_[x, y, height(x, y)]
-    i, j = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij"))
-    node = lambda a, b: a * (ny + 1) + b
-    e = np.c_[node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)]
-    return e.astype(np.int64), c
 
 
 def smooth_field(rng, size: float, amplitude: float):
@@ -65,7 +54,7 @@ def test_certified_distance_of_random_displaced_plates_is_within_d(seed, bumpy, 
     rng = np.random.default_rng(seed)
     size = n * h
     field = (bumpy_field if bumpy else smooth_field)(rng, size, amplitude)
-    e, c = plate(n, n + int(rng.integers(0, 4)), h, field)
+    c, e = quad_grid(n, n + int(rng.integers(0, 4)), cell=h, z=field, ij=True)
     m = build_model(e, c, FEPatchParams(12.0, d, l_outer, l_inner))
     assert m.distance_bound <= d
     # independent of the construction: the exact metric on the whole surfaces, a bracket of
@@ -79,7 +68,8 @@ def test_certified_distance_of_random_displaced_plates_is_within_d(seed, bumpy, 
 def test_the_paper_construction_alone_exceeds_d_on_a_bowl():
     # a bowl: a subpatch holds its nodes within d of the plane on both sides, and the new
     # surface through its border nodes is up to 2d from its middle
-    e, c = plate(20, 20, 5.0, lambda x, y: 0.004 * ((x - 50.0) ** 2 + (y - 50.0) ** 2))
+    c, e = quad_grid(20, 20, cell=5.0, ij=True,
+                     z=lambda x, y: 0.004 * ((x - 50.0) ** 2 + (y - 50.0) ** 2))
     params = FEPatchParams(12.0, 1.0, 0.5, 8.0)
     paper = build_model(e, c, params, fit_share=1.0, certify=False)
     assert distance(paper, 0.01).lower > params.d
@@ -91,7 +81,7 @@ def test_the_paper_construction_alone_exceeds_d_on_a_bowl():
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_subpatch_bounds_are_never_below_the_exact_distance(seed):
     rng = np.random.default_rng(seed)
-    e, c = plate(12, 10, 6.0, bumpy_field(rng, 72.0, 8.0))
+    c, e = quad_grid(12, 10, cell=6.0, z=bumpy_field(rng, 72.0, 8.0), ij=True)
     params = FEPatchParams(12.0, 0.8, 0.5, 6.0)
     tri = triangulate(e, c)
     patch = patches(e, feature_edges(e, c, params.alpha_g1_deg))
@@ -128,7 +118,7 @@ def test_neighbours_share_a_node():
 
 
 def test_refuses_bad_tolerances():
-    e, c = plate(4, 4, 1.0, lambda x, y: 0 * x)
+    c, e = quad_grid(4, 4, z=lambda x, y: 0 * x, ij=True)
     tri = triangulate(e, c)
     with pytest.raises(ValueError, match="tol"):
         subpatch_distance_bounds(c, tri.triangles, np.zeros(len(tri.triangles), int), {}, [0],

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import folded, quad_grid
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from workbench import data
 from workbench.algo.fepatch.features import (
     CLOSING,
     G0,
@@ -29,16 +29,11 @@ from workbench.scene.generators import semicylinders
 def grid(nx: int, ny: int, surface, triangles: bool = False):
     """Nodes surface(u, v) on an (nx+1) x (ny+1) parameter grid u, v in [0, 1]; quads (or each
     quad split into two triangles). Node (i, j) has index j * (nx + 1) + i."""
-    u, v = np.meshgrid(np.linspace(0, 1, nx + 1), np.linspace(0, 1, ny + 1))
-    nodes = np.stack(surface(u.ravel(), v.ravel()), axis=1).astype(np.float64)
-    i, j = np.meshgrid(np.arange(nx), np.arange(ny))
-    base = (j * (nx + 1) + i).ravel()
-    quads = np.stack([base, base + 1, base + nx + 2, base + nx + 1], axis=1)
+    uv, elements = quad_grid(nx, ny, span=((0, 1), (0, 1)), triangles=triangles, dim=2)
+    nodes = np.stack(surface(*uv.T), axis=1).astype(np.float64)
     if triangles:
-        a = quads[:, [0, 1, 2, 2]]
-        b = quads[:, [0, 2, 3, 3]]
-        quads = np.concatenate([a, b])
-    return nodes, quads.astype(np.int32)
+        elements = elements[:, [0, 1, 2, 2]]
+    return nodes, elements.astype(np.int32)
 
 
 def grid_index(nx: int, ny: int):
@@ -60,11 +55,8 @@ def outline(edges, i, j, nx, ny) -> set[tuple[int, int]]:
 
 def fold(angle_deg: float, at: float = 0.5):
     """A plate in z = 0 for u <= at that turns up by ``angle_deg`` beyond u = at."""
-    t = np.radians(angle_deg)
-
     def surface(u, v):
-        s = np.maximum(u - at, 0.0)
-        return np.minimum(u, at) + s * np.cos(t), v, s * np.sin(t)
+        return tuple(folded(np.c_[u, v, np.zeros_like(u)], at, angle_deg).T)
     return surface
 
 
@@ -346,20 +338,15 @@ def test_subpatch_properties_on_random_bumpy_plates(seed, d, triangles):
     check_subpatches(el, nodes, patch, sub, d)
 
 
-def test_car_deck():
-    path = data.shared_file(data.CAR_DECK)
-    if path is None:
-        pytest.skip("shared car deck (lsopt_car6/car6_crash_v3.k) not available")
-    from workbench.scene.readers import load
-    mesh = load(path)
-    fe = feature_edges(mesh.elements, mesh.nodes)
+def test_car_deck(car):
+    fe = feature_edges(car.elements, car.nodes)
     counts = fe.counts()
     assert counts["G0"] > 0 and counts["G1"] > 0
-    assert not np.any(feature_degree(fe, mesh.n_nodes) == 1)
-    patch = patches(mesh.elements, fe)
-    assert 1 < patch.max() + 1 < mesh.n_elements
-    diag = float(np.linalg.norm(np.subtract(*mesh.bounds())))
+    assert not np.any(feature_degree(fe, car.n_nodes) == 1)
+    patch = patches(car.elements, fe)
+    assert 1 < patch.max() + 1 < car.n_elements
+    diag = float(np.linalg.norm(np.subtract(*car.bounds())))
     d = 1e-3 * diag
-    sub = planar_subpatches(mesh.elements, mesh.nodes, patch, d)
+    sub = planar_subpatches(car.elements, car.nodes, patch, d)
     assert sub.max() + 1 >= patch.max() + 1
-    check_subpatches(mesh.elements, mesh.nodes, patch, sub, d)
+    check_subpatches(car.elements, car.nodes, patch, sub, d)

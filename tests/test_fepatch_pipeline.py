@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from meshes import quad_grid
 
 from workbench.algo.fepatch.atlas import plane_frames
 from workbench.algo.fepatch.lines import simplify_polyline
@@ -32,13 +33,9 @@ from workbench.scene.generators import stamped_panel
 def grid(nx: int, ny: int, h: float = 1.0, drop=()) -> tuple[np.ndarray, np.ndarray]:
     """Quads of an nx × ny grid of cells of size h in the (s, t) plane, cells ``drop`` left out;
     (elements (M, 4), st (N, 2)) with unused nodes removed. Wound counter-clockwise in (s, t)."""
-    ii, jj = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1), indexing="ij")
-    st = np.c_[ii.ravel(), jj.ravel()] * float(h)
+    st, e = quad_grid(nx, ny, cell=h, ij=True, dim=2)
     dropped = set(drop)
-    cells = np.array([(i, j) for i in range(nx) for j in range(ny) if (i, j) not in dropped])
-    i, j = cells[:, 0], cells[:, 1]
-    node = lambda a, b: a * (ny + 1) + b
-    e = np.c_[node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)]
+    e = e[[(i, j) not in dropped for i in range(nx) for j in range(ny)]]
     used = np.unique(e)
     remap = np.full(len(st), -1)
     remap[used] = np.arange(len(used))

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import grid_quads
 
 from workbench.algo.fepatch.atlas import build_atlas
 from workbench.algo.fepatch.pipeline import PAPER_TEXTURE_RULE, build_model
@@ -32,10 +33,7 @@ def graded_plate(seed: int, nx: int, ny: int, grade: float, skew: float, bump: f
     x = x + rng.uniform(-step, step, x.shape)
     y = y + rng.uniform(-step, step, y.shape)
     z = bump * np.sin(np.pi * x / x.max()) * np.sin(np.pi * y / y.max())
-    i, j = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij"))
-    node = lambda a, b: a * (ny + 1) + b
-    e = np.c_[node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)]
-    return e.astype(np.int64), np.c_[x, y, z]
+    return grid_quads(nx, ny, ij=True), np.c_[x, y, z]
 
 
 def corner_vertices(e, coords, surface) -> np.ndarray:

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import quad_grid
 
 from workbench.algo.fepatch.surface import CORNER_ROW, TexturedSurface
 from workbench.algo.fepatch.wireid import (MIN_WIDTH, NO_ELEMENT, corner_table, element_map,
@@ -16,19 +17,16 @@ from workbench.algo.fepatch.wireid import (MIN_WIDTH, NO_ELEMENT, corner_table, 
 from workbench.algo.fepatch.wiretex import element_widths
 
 
-def quad_grid(seed: int, nx: int, ny: int, jitter: float, shear: float, aspect: float,
-              angle: float, width: float) -> tuple[np.ndarray, tuple[int, int]]:
+def atlas_quads(seed: int, nx: int, ny: int, jitter: float, shear: float, aspect: float,
+                angle: float, width: float) -> tuple[np.ndarray, tuple[int, int]]:
     """((M, 4, 2) corners in texels, atlas size): a jittered, stretched, sheared and turned quad
     grid scaled so that its narrowest element is ``width`` texels wide, 3 texels from the atlas
     edges."""
     rng = np.random.default_rng(seed)
-    x, y = np.meshgrid(np.arange(nx + 1.0), np.arange(ny + 1.0))
-    p = np.c_[x.ravel(), y.ravel()] + rng.uniform(-jitter, jitter, ((nx + 1) * (ny + 1), 2))
+    p, quads = quad_grid(nx, ny, jitter=jitter, seed=rng, dim=2)
     p[:, 0] = p[:, 0] * aspect + shear * p[:, 1]
     c, s = np.cos(angle), np.sin(angle)
     p = p @ np.array([[c, -s], [s, c]])
-    idx = np.arange((nx + 1) * (ny + 1)).reshape(ny + 1, nx + 1)
-    quads = np.stack([idx[:-1, :-1], idx[:-1, 1:], idx[1:, 1:], idx[1:, :-1]], -1).reshape(-1, 4)
     corners = p[quads]
     corners = corners * (width / element_widths(corners).min())
     corners = corners - corners.reshape(-1, 2).min(axis=0) + 3.0 + rng.uniform(0, 1, 2)
@@ -75,7 +73,7 @@ def texel_centres(size) -> np.ndarray:
        border=st.integers(0, 2))
 def test_element_map_is_the_element_under_each_texel_or_the_nearest(seed, jitter, shear, aspect,
                                                                    angle, width, border):
-    corners, size = quad_grid(seed, 4, 3, jitter, shear, aspect, angle, width)
+    corners, size = atlas_quads(seed, 4, 3, jitter, shear, aspect, angle, width)
     owner = element_map(corners, size, border=border).ravel()
     centres = texel_centres(size)
     holds = inside(centres, corners)
@@ -97,7 +95,7 @@ def test_element_map_is_the_element_under_each_texel_or_the_nearest(seed, jitter
 
 
 def test_corner_table_quantises_within_half_a_step():
-    corners, size = quad_grid(1, 5, 4, 0.2, 0.3, 2.0, 0.4, 1.5)
+    corners, size = atlas_quads(1, 5, 4, 0.2, 0.3, 2.0, 0.4, 1.5)
     table, frac = corner_table(corners, size)
     assert table.dtype == np.uint16 and table.shape == corners.shape
     assert frac & (frac - 1) == 0 and max(size) * frac <= 65535 < max(size) * frac * 2 or \
@@ -117,7 +115,7 @@ def test_corner_table_quantises_within_half_a_step():
        width=st.floats(MIN_WIDTH, 3.0 * MIN_WIDTH))
 def test_decoded_outline_is_exact_along_edges_and_never_invents_lines(seed, jitter, shear,
                                                                      aspect, angle, width):
-    corners, size = quad_grid(seed, 5, 4, jitter, shear, aspect, angle, width)
+    corners, size = atlas_quads(seed, 5, 4, jitter, shear, aspect, angle, width)
     owner = element_map(corners, size, border=1)
     table, frac = corner_table(corners, size)
     q = table / frac
@@ -147,7 +145,7 @@ def test_decoded_outline_is_exact_along_edges_and_never_invents_lines(seed, jitt
 
 
 def test_on_outline_reads_a_surface_and_refuses_one_without_a_wire_frame():
-    corners, size = quad_grid(2, 3, 3, 0.1, 0.0, 1.0, 0.0, 2.0)
+    corners, size = atlas_quads(2, 3, 3, 0.1, 0.0, 1.0, 0.0, 2.0)
     owner = element_map(corners, size, border=1)
     table, frac = corner_table(corners, size)
     uv = corners.reshape(-1, 2)
@@ -169,7 +167,7 @@ def test_on_outline_reads_a_surface_and_refuses_one_without_a_wire_frame():
 
 
 def test_surface_refuses_an_incomplete_or_doubled_wire_frame():
-    corners, size = quad_grid(3, 2, 2, 0.0, 0.0, 1.0, 0.0, 2.0)
+    corners, size = atlas_quads(3, 2, 2, 0.0, 0.0, 1.0, 0.0, 2.0)
     table, frac = corner_table(corners, size)
     uv = corners.reshape(-1, 2)
     base = {"positions": np.c_[uv, np.zeros(len(uv))], "triangles": np.zeros((0, 3), int),

@@ -6,26 +6,17 @@ import numpy as np
 import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
+from meshes import quad_grid
 
 from workbench.algo.fepatch.surface import WIRE_PAIRS
 from workbench.algo.fepatch.wiretex import (RING, checkerboard, decode_wire, on_outline,
                                             wire_texture)
 
 
-def quad_grid(nx, ny, cell, jitter=0.0, offset=(0.0, 0.0), seed=0):
+def texel_grid(nx, ny, cell, jitter=0.0, offset=(0.0, 0.0), seed=0):
     """(nodes (N, 2), elements (M, 4)) of an nx × ny grid of counter-clockwise quads with
     ``cell`` texels per side, nodes jittered by up to ``jitter`` texels."""
-    rng = np.random.default_rng(seed)
-    xs, ys = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1))
-    nodes = np.c_[xs.ravel(), ys.ravel()] * float(cell) + np.asarray(offset, float)
-    nodes = nodes + rng.uniform(-jitter, jitter, nodes.shape)
-    i, j = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny)))
-
-    def node(a, b):
-        return b * (nx + 1) + a
-
-    elements = np.stack([node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)], 1)
-    return nodes, elements
+    return quad_grid(nx, ny, cell=cell, origin=offset, jitter=jitter, seed=seed, dim=2)
 
 
 def texel_centres(w, h):
@@ -63,7 +54,7 @@ def atlas_for(corners, margin=3):
 # ---------------------------------------------------------------- checkerboard
 
 def test_grid_colours_alternate_across_every_shared_edge():
-    _, e = quad_grid(7, 5, 3.0)
+    _, e = texel_grid(7, 5, 3.0)
     colour, line_edges = checkerboard(e)
     assert colour.dtype == np.int8 and set(np.unique(colour)) == {0, 1}
     assert line_edges.shape == (0, 2)
@@ -147,7 +138,7 @@ def test_checkerboard_refuses_bad_input():
        ox=st.floats(2.0, 3.0), oy=st.floats(2.0, 3.0))
 @example(seed=249, cell=4.8125, jitter=0.171875, nx=1, ny=1, ox=2.25, oy=2.0)  # a 56° corner
 def test_outline_matches_the_element_edges_on_jittered_grids(seed, cell, jitter, nx, ny, ox, oy):
-    nodes, e = quad_grid(nx, ny, cell, jitter * cell, (ox, oy), seed)
+    nodes, e = texel_grid(nx, ny, cell, jitter * cell, (ox, oy), seed)
     colour, line_edges = checkerboard(e)
     assert len(line_edges) == 0
     corners = nodes[e]
@@ -171,7 +162,7 @@ def test_outline_matches_the_element_edges_on_jittered_grids(seed, cell, jitter,
 @settings(max_examples=20, deadline=None)
 @given(seed=st.integers(0, 10**6), cell=st.floats(7.0, 10.0), jitter=st.floats(0.0, 0.1))
 def test_own_pair_is_positive_just_inside_each_edge_and_negative_just_outside(seed, cell, jitter):
-    nodes, e = quad_grid(3, 3, cell, jitter * cell, (2.3, 2.6), seed)
+    nodes, e = texel_grid(3, 3, cell, jitter * cell, (2.3, 2.6), seed)
     colour, _ = checkerboard(e)
     corners = nodes[e]
     tex = wire_texture(corners, colour, atlas_for(corners))
@@ -224,7 +215,7 @@ def test_a_triangle_outlines_its_three_edges(seed, size):
 
 
 def test_unwritten_texels_are_outside_and_far_interior_is_clamped():
-    nodes, e = quad_grid(1, 1, 12.0, offset=(4.0, 4.0))
+    nodes, e = texel_grid(1, 1, 12.0, offset=(4.0, 4.0))
     tex = wire_texture(nodes[e], np.array([0]), (24, 24))
     g, b = WIRE_PAIRS[0]
     r, a = WIRE_PAIRS[1]
@@ -238,7 +229,7 @@ def test_unwritten_texels_are_outside_and_far_interior_is_clamped():
 def test_same_colour_neighbours_have_no_zero_crossing_on_their_shared_edge():
     # why line_edges exist: across the common edge of two quads of one colour the pair stays
     # positive (each side keeps its own element's distance), so no isoline marks the edge
-    nodes, e = quad_grid(2, 1, 6.0, offset=(3.2, 3.4))
+    nodes, e = texel_grid(2, 1, 6.0, offset=(3.2, 3.4))
     corners = nodes[e]
     shared = edge_probes(corners[0, 1][None], corners[0, 2][None])
     across = np.array([0.4, 0.0])

@@ -11,6 +11,7 @@ import types
 
 import numpy as np
 import pytest
+from meshes import quad_grid
 
 import workbench.paths.fetexture  # noqa: F401  (registers the paths)
 from workbench.algo.fepatch import pipeline
@@ -34,21 +35,12 @@ NAMES = ("fe_wire_texture", "fe_normal_map", "fe_normal_wire")
 # --------------------------------------------------------------------------- synthetic surface
 def grid_nodes(centre=FAR, z=None):
     """(nodes (N+1)², quads) of the grid around ``centre`` (z = z(x, y) relative, default 0)."""
-    c = (np.arange(N + 1) - N / 2) * CELL
-    X, Y = np.meshgrid(c, c)
-    Z = np.zeros_like(X) if z is None else z(X, Y)
-    nodes = np.c_[X.ravel(), Y.ravel(), Z.ravel()] + np.asarray(centre, np.float64)
-    idx = np.arange((N + 1) ** 2).reshape(N + 1, N + 1)
-    quads = np.c_[idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(),
-                  idx[1:, :-1].ravel()]
-    return nodes, quads
+    return quad_grid(N, N, cell=CELL, centred=True, z=z, origin=centre)
 
 
 def grid_uv():
     """(N+1)² node texel coordinates: u along x, v along y."""
-    t = MARGIN + np.arange(N + 1) * float(TEXELS)
-    U, V = np.meshgrid(t, t)
-    return np.c_[U.ravel(), V.ravel()]
+    return quad_grid(N, N, cell=TEXELS, origin=(MARGIN, MARGIN), dim=2)[0]
 
 
 def wire_map(wire_range=2.0, ring=1.5):

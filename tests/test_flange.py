@@ -3,6 +3,7 @@ farther than the threshold hidden by the alpha test."""
 
 import numpy as np
 import pytest
+from meshes import quad_grid
 
 from workbench.algo.part_distance import flange_distances
 from workbench.experiment.compare import coverage
@@ -14,27 +15,16 @@ from workbench.scene.mesh import FEMesh
 SIZE = (300, 200)
 
 
-def plate(x0, x1, y0, y1, z, nx, ny, node_offset):
-    xs, ys = np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1)
-    gx, gy = np.meshgrid(xs, ys)
-    nodes = np.c_[gx.ravel(), gy.ravel(), np.full(gx.size, z)]
-    elements = []
-    for j in range(ny):
-        for i in range(nx):
-            a = node_offset + j * (nx + 1) + i
-            elements.append([a, a + 1, a + nx + 2, a + nx + 1])
-    return nodes, np.array(elements)
-
-
 @pytest.fixture(scope="module")
 def plates():
     """Part 0: a plate at z = 0 over x 0..100; part 1 at z = 1 over x 0..40 (1 mm away);
     part 2 at z = 30 over x 60..100 (30 mm away)."""
-    blocks = [plate(0, 100, 0, 50, 0.0, 20, 10, 0)]
-    blocks.append(plate(0, 40, 0, 50, 1.0, 8, 10, len(blocks[0][0])))
-    blocks.append(plate(60, 100, 0, 50, 30.0, 8, 10, sum(len(b[0]) for b in blocks)))
+    blocks = [quad_grid(20, 10, span=((0, 100), (0, 50)), z=0.0),
+              quad_grid(8, 10, span=((0, 40), (0, 50)), z=1.0),
+              quad_grid(8, 10, span=((60, 100), (0, 50)), z=30.0)]
+    first = np.cumsum([0] + [len(b[0]) for b in blocks[:-1]])
     nodes = np.concatenate([b[0] for b in blocks])
-    elements = np.concatenate([b[1] for b in blocks]).astype(np.int32)
+    elements = np.concatenate([b[1] + k for b, k in zip(blocks, first)]).astype(np.int32)
     parts = np.repeat(np.arange(3), [len(b[1]) for b in blocks]).astype(np.int32)
     return FEMesh(nodes=nodes, elements=elements, parts=parts, name="plates")
 

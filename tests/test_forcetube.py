@@ -7,7 +7,6 @@ import pytest
 from workbench.algo.forcetube import (STRESS_FIELDS, TUBE_FIELD, crossing_elements, force_tube,
                                       prismatic_tube, section_force, section_planes,
                                       stress_tensor, tube_mesh, with_tube)
-from workbench.data import D3PLOT, shared_file
 from workbench.scene.mesh import FEMesh
 
 REL = 1e-9
@@ -329,13 +328,10 @@ def test_d3plot_stress_components_are_the_layer_mean_in_d3plot_order(tmp_path):
                                           stress_components=False).element_fields
 
 
-def test_shared_d3plot_stresses_and_a_section():
-    path = shared_file(D3PLOT)
-    if path is None:
-        pytest.skip(f"shared data {D3PLOT} not available (set WORKBENCH_DATA)")
+def test_shared_d3plot_stresses_and_a_section(d3plot_file):
     from workbench.scene.readers import load
 
-    mesh = load(path)
+    mesh = load(d3plot_file)
     for name in (*STRESS_FIELDS, "thickness"):
         values = mesh.element_fields[name]
         assert values.shape == (1, 4696) and np.isfinite(values).all(), name

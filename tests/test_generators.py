@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import quad_grid
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
@@ -70,15 +71,14 @@ def boundary_loops(mesh: FEMesh) -> dict[int, int]:
     return loops
 
 
-def quad_grid(nx: int, ny: int, jitter: float = 0.0, z_jitter: float = 0.0, seed: int = 0) -> FEMesh:
+def jittered_grid(nx: int, ny: int, jitter: float = 0.0, z_jitter: float = 0.0,
+                  seed: int = 0) -> FEMesh:
+    """An nx × ny grid of 10 mm quads, nodes moved by up to ``jitter`` and ``z_jitter`` cells,
+    elements in random parts 0..2."""
     rng = np.random.default_rng(seed)
-    x, y = np.meshgrid(np.arange(nx + 1, dtype=float), np.arange(ny + 1, dtype=float))
-    nodes = np.stack([x, y, np.zeros_like(x)], -1).reshape(-1, 3) * 10.0
+    nodes, elements = quad_grid(nx, ny, cell=10.0)
     nodes[:, :2] += rng.uniform(-jitter, jitter, (len(nodes), 2)) * 10.0
     nodes[:, 2] += rng.uniform(-z_jitter, z_jitter, len(nodes)) * 10.0
-    j, i = np.mgrid[:ny, :nx]
-    base = (j * (nx + 1) + i).ravel()
-    elements = np.stack([base, base + 1, base + nx + 2, base + nx + 1], 1)
     return FEMesh(nodes=nodes, elements=elements, parts=rng.integers(0, 3, len(elements)))
 
 
@@ -262,7 +262,7 @@ def test_stamped_panels_refuses_bad_input():
 @settings(max_examples=40, deadline=None)
 @given(nx=st.integers(1, 4), ny=st.integers(1, 4), k=st.integers(1, 4), seed=st.integers(0, 10**6))
 def test_refine_quad_grid_properties(nx, ny, k, seed):
-    m = quad_grid(nx, ny, jitter=0.2, z_jitter=0.3, seed=seed)
+    m = jittered_grid(nx, ny, jitter=0.2, z_jitter=0.3, seed=seed)
     rng = np.random.default_rng(seed)
     coeff = rng.normal(size=3)
     m.node_fields["lin"] = m.nodes @ coeff + 2.0
@@ -294,7 +294,7 @@ def test_refine_quad_grid_properties(nx, ny, k, seed):
 @settings(max_examples=30, deadline=None)
 @given(nx=st.integers(1, 4), ny=st.integers(1, 4), k=st.integers(1, 4), seed=st.integers(0, 10**6))
 def test_refine_preserves_planar_area_and_winding(nx, ny, k, seed):
-    m = quad_grid(nx, ny, jitter=0.25, seed=seed)     # planar, convex quads
+    m = jittered_grid(nx, ny, jitter=0.25, seed=seed)     # planar, convex quads
     r = refine(m, k)
     parent_area = areas(m.elements, m.nodes)
     child_area = areas(r.elements, r.nodes).reshape(-1, k * k).sum(axis=1)
@@ -309,7 +309,7 @@ def test_refine_mixed_mesh_against_brute_force(nx, ny, k, seed):
     """Quads and triangles (split quads, some rotated to other triangle storage): refined node set
     equals the deduplicated per-element parameter points; triangles become k² triangles."""
     rng = np.random.default_rng(seed)
-    base = quad_grid(nx, ny, jitter=0.2, z_jitter=0.2, seed=seed)
+    base = jittered_grid(nx, ny, jitter=0.2, z_jitter=0.2, seed=seed)
     elements = []
     for q in base.elements.tolist():
         if rng.random() < 0.5:

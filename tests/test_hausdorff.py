@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import barycentric_grid, quad_grid
 
-from workbench import data
 from workbench.algo.bvh import TriangleBVH
 from workbench.algo.distance import point_triangle_distance, points_triangles_distance
 from workbench.algo.hausdorff import hausdorff
@@ -16,14 +16,8 @@ from workbench.algo.hausdorff import hausdorff
 def grid(n: int, m: int | None = None, height=None, size: float = 1.0):
     """An n×m grid over [-size, size]², two triangles per cell, z = height(x, y)."""
     m = n if m is None else m
-    x, y = np.meshgrid(np.linspace(-size, size, n + 1), np.linspace(-size, size, m + 1),
-                       indexing="ij")
-    z = np.zeros_like(x) if height is None else height(x, y)
-    v = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
-    i, j = (a.ravel() for a in np.meshgrid(np.arange(n), np.arange(m), indexing="ij"))
-    k = i * (m + 1) + j
-    f = np.concatenate([np.stack([k, k + m + 1, k + m + 2], 1), np.stack([k, k + m + 2, k + 1], 1)])
-    return v, f
+    return quad_grid(n, m, span=((-size, size), (-size, size)), z=height, ij=True,
+                     triangles=True)
 
 
 def height_field(rng, n, m, amplitude):
@@ -42,9 +36,7 @@ def soup(rng, n_vertices, n_triangles, spread):
 def dense_points(v, f, n):
     """A barycentric grid of spacing 1/n on every triangle, and the largest spacing between
     neighbouring grid points (every point of the surface is within it of a grid point)."""
-    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1))
-    keep = i + j <= n
-    u, w = i[keep] / n, j[keep] / n
+    u, w = barycentric_grid(n)
     c = v[f]
     e1, e2 = c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]
     pts = c[:, None, 0] + u[None, :, None] * e1[:, None] + w[None, :, None] * e2[:, None]
@@ -312,14 +304,11 @@ def test_bad_input_is_refused_naming_the_input():
 
 # --------------------------------------------------------------------------- the car
 @pytest.fixture(scope="module")
-def car_pair():
-    path = data.shared_file(data.CAR_DECK)
-    if path is None:
-        pytest.skip("the shared car deck (lsopt_car6) is not available")
+def car_pair(car_deck):
     pymeshlab = pytest.importorskip("pymeshlab")
-    from workbench.scene.readers import load
+    from workbench.scene.builtin import fresh_scene
 
-    car = load(path)
+    car = fresh_scene("car")
     used, inverse = np.unique(car.triangles, return_inverse=True)
     v, f = car.nodes[used], inverse.reshape(-1, 3).astype(np.int64)
     ms = pymeshlab.MeshSet()

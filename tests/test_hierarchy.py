@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import quad_grid
 
 from workbench.algo.distance import points_triangles_distance
 from workbench.algo.hierarchy import ElementHierarchy, squared_bound
@@ -179,11 +180,8 @@ def test_obb_frames_of_a_planar_part_lie_in_its_plane(leaf):
     f = _frame(rng)
     normal = f[2]
     n = 12
-    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-    uv = np.stack([i.ravel() * 1.0, j.ravel() * 0.7], axis=1) + rng.uniform(-0.2, 0.2, (len(i.ravel()), 2))
+    uv, quads = quad_grid(n, n, cell=(1.0, 0.7), jitter=0.2, seed=rng, ij=True, dim=2)
     pts = np.array([1e3, -2e3, 5e2]) + uv @ f[:2]
-    ids = np.arange(len(pts)).reshape(n + 1, n + 1)
-    quads = np.stack([ids[:-1, :-1], ids[1:, :-1], ids[1:, 1:], ids[:-1, 1:]], axis=-1).reshape(-1, 4)
     # a degenerate element (two nodes) and a zero-area collinear one in the same plane
     elements = np.concatenate([quads, [[0, 0, 1, 1], [0, 1, 2, 2]]])
     mesh = FEMesh(nodes=pts, elements=elements)
@@ -207,10 +205,8 @@ def test_obb_of_a_tilted_plate_is_tighter_than_its_aabb():
     rng = np.random.default_rng(8)
     f = _frame(rng)
     n = 10
-    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-    pts = np.stack([i.ravel(), j.ravel()], axis=1) @ f[:2] * 1.0
-    ids = np.arange(len(pts)).reshape(n + 1, n + 1)
-    quads = np.stack([ids[:-1, :-1], ids[1:, :-1], ids[1:, 1:], ids[:-1, 1:]], axis=-1).reshape(-1, 4)
+    plane, quads = quad_grid(n, n, ij=True, dim=2)
+    pts = plane @ f[:2] * 1.0
     mesh = FEMesh(nodes=pts, elements=quads)
     vol = {}
     for kind in KINDS:

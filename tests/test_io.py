@@ -7,7 +7,6 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from workbench.data import CAR_DECK, D3PLOT, shared_file
 from workbench.scene.readers import (
     MESHIO_SUFFIXES,
     ParseError,
@@ -57,11 +56,8 @@ def ids_of(mesh):
 
 
 # --------------------------------------------------------------------------- shared data
-def test_car_deck():
-    path = shared_file(CAR_DECK)
-    if path is None:
-        pytest.skip(f"shared data {CAR_DECK} not available")
-    mesh = load(path)
+def test_car_deck(car_deck):
+    mesh = load(car_deck)
     assert (mesh.n_nodes, mesh.n_elements) == (4395, 4366)
     assert sorted(np.unique(mesh.parts).tolist()) == list(range(1, 9))
     assert set(mesh.part_names) == set(range(1, 9))
@@ -84,11 +80,8 @@ def test_car_deck():
     assert mesh.units == "mm"
 
 
-def test_d3plot_sample():
-    path = shared_file(D3PLOT)
-    if path is None:
-        pytest.skip(f"shared data {D3PLOT} not available")
-    mesh = load(path)
+def test_d3plot_sample(d3plot_file):
+    mesh = load(d3plot_file)
     assert (mesh.n_nodes, mesh.n_elements) == (4915, 4696)
     assert mesh.steps.shape == (1, 4915, 3) and mesh.times.shape == (1,)
     # the state array holds coordinates (equal to the geometry at t = 0), not displacements
@@ -682,10 +675,9 @@ def test_integer_field_parser_refuses_fractional_and_non_finite(value):
 
 
 # --------------------------------------------------------------------------- damaged decks
-@pytest.mark.skipif(shared_file(CAR_DECK) is None, reason="shared car deck absent")
-def test_deck_cut_off_inside_its_last_card_is_refused(tmp_path):
+def test_deck_cut_off_inside_its_last_card_is_refused(tmp_path, car_deck):
     """``head -c`` through the last node card: the missing fields must not read as 0."""
-    data = shared_file(CAR_DECK).read_bytes()
+    data = car_deck.read_bytes()
     start = data.index(b"*NODE")
     end = data.index(b"\n*", start + 1)  # the end of the node block's last card
     cut = tmp_path / "cut.k"
@@ -912,15 +904,15 @@ def test_missing_or_extra_card_in_a_thickness_block_is_reported_where_it_breaks(
     assert info.value.line == 7 + 21
 
 
-@pytest.mark.skipif(shared_file(D3PLOT) is None, reason="shared d3plot absent")
 @pytest.mark.parametrize("fraction, status", [(0.5, 2), (0.8, 0)])
-def test_damaged_d3plot_says_what_is_missing_in_one_line_each(tmp_path, fraction, status):
+def test_damaged_d3plot_says_what_is_missing_in_one_line_each(tmp_path, d3plot_file, fraction,
+                                                               status):
     """lasso-python logs tracebacks for the sections it gives up on; the workbench reports each
     as one line (a warning when the mesh is still read, within the error otherwise)."""
     import subprocess
     import sys
 
-    data = shared_file(D3PLOT).read_bytes()
+    data = d3plot_file.read_bytes()
     damaged = tmp_path / "d3plot"
     damaged.write_bytes(data[:int(len(data) * fraction)])
     result = subprocess.run([sys.executable, "-m", "workbench.cli", "render", str(damaged),

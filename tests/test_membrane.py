@@ -4,6 +4,7 @@ degenerate elements, the stress fields for force tubes, and the car deck's trace
 
 import numpy as np
 import pytest
+from meshes import quad_grid
 from scipy.spatial.transform import Rotation
 
 from workbench.algo.forcetube import (
@@ -14,7 +15,6 @@ from workbench.algo.forcetube import (
     stress_tensor,
 )
 from workbench.algo.membrane import membrane_stress, with_membrane_stress
-from workbench.data import CAR_DECK, shared_file
 from workbench.scene.mesh import FEMesh
 
 YOUNG, NU = 210000.0, 0.3
@@ -23,12 +23,9 @@ REL = 1e-12
 
 
 def grid(nx=4, ny=3, hx=10.0, hy=7.0, z=None):
-    """A flat (or, with ``z`` (N,), warped) plate of nx × ny quads in the x-y plane."""
-    x, y = np.meshgrid(np.arange(nx + 1) * hx, np.arange(ny + 1) * hy, indexing="ij")
-    nodes = np.stack([x.ravel(), y.ravel(), np.zeros(x.size) if z is None else z], axis=1)
-    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
-    a = (i * (ny + 1) + j).ravel()
-    return nodes, np.stack([a, a + ny + 1, a + ny + 2, a + 1], axis=1)
+    """A flat (or, with ``z`` (N,), warped) plate of nx × ny quads of hx × hy in the x-y plane,
+    node (i, j) at i * (ny + 1) + j."""
+    return quad_grid(nx, ny, cell=(hx, hy), z=z, ij=True)
 
 
 def two_step(nodes, elements, current) -> FEMesh:
@@ -294,14 +291,6 @@ def test_a_stretched_prismatic_tube_carries_sigma_t_perimeter(sides, lam):
 
 
 # --------------------------------------------------------------------------- the car deck
-@pytest.fixture(scope="module")
-def car():
-    if shared_file(CAR_DECK) is None:
-        pytest.skip(f"shared data {CAR_DECK} not available (set WORKBENCH_DATA)")
-    from workbench.scene.builtin import builtin_scene
-    return builtin_scene("car")
-
-
 def test_the_car_trace_line_follows_a_front_rail(car):
     from workbench.scene.car_views import (
         car_barrier_parts,

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import quad_grid
 from test_hierarchy import mesh_options, random_mesh
 
-from workbench import data
 from workbench.algo.distance import points_triangles_distance
 from workbench.algo.hierarchy import local_origin
 from workbench.algo.part_distance import (
@@ -155,10 +155,7 @@ def test_plane_test_skips_elements_in_big_leaves():
     # a flat plate under a corrugated one: the elements of a leaf lie in different planes, and
     # those farther by their plane than the nearest element so far are skipped
     n = 24
-    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-    p = np.stack([i.ravel(), j.ravel(), np.zeros(i.size)], 1) * 0.25
-    ids = np.arange(len(p)).reshape(n + 1, n + 1)
-    q = np.stack([ids[:-1, :-1], ids[1:, :-1], ids[1:, 1:], ids[:-1, 1:]], -1).reshape(-1, 4)
+    p, q = quad_grid(n, n, cell=0.25, ij=True)
     wave = p + [0.0, 0.0, 1.0]
     wave[:, 2] += 0.4 * np.sin(4.0 * p[:, 0]) * np.cos(3.0 * p[:, 1])
     mesh = FEMesh(nodes=np.concatenate([p, wave]), elements=np.concatenate([q, q + len(p)]),
@@ -197,19 +194,17 @@ def test_results_do_not_depend_on_the_thread_count():
 
 # --------------------------------------------------------------------------- the car
 @pytest.fixture(scope="module")
-def car():
-    path = data.shared_file(data.CAR_DECK)
-    if path is None:
-        pytest.skip("the shared car deck (lsopt_car6) is not available")
-    from workbench.scene.readers import load
+def car_distances(car_deck):
+    """The car deck and its brute-force part distances within 1.5 mm."""
+    from workbench.scene.builtin import fresh_scene
 
-    mesh = load(path)
+    mesh = fresh_scene("car")
     return mesh, brute_force_part_distances(mesh, 1.5)
 
 
 @pytest.mark.parametrize("kind,leaf", CONFIGS)
-def test_car_every_node_equals_brute_force(car, kind, leaf):
-    mesh, expected = car
+def test_car_every_node_equals_brute_force(car_distances, kind, leaf):
+    mesh, expected = car_distances
     r = part_distances(mesh, 1.5, kind=kind, leaf_size=leaf)
     assert_matches(mesh, r, expected, 1.5)
     assert np.isfinite(r.distance).sum() > 100  # flanges and seams of the deck
@@ -218,8 +213,8 @@ def test_car_every_node_equals_brute_force(car, kind, leaf):
         assert r.plane_skips > 0.5 * r.leaf_elements
 
 
-def test_car_far_from_the_origin(car):
-    mesh, _ = car
+def test_car_far_from_the_origin(car_distances):
+    mesh, _ = car_distances
     near = part_distances(mesh, 1.5)
     far = part_distances(mesh.translated([1e6, 1e6, -1e6]), 1.5, kind="obb")
     finite = np.isfinite(near.distance)

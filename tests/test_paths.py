@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import quad_grid
 
 from workbench.experiment.measure import measure
 from workbench.gl import Camera, Framebuffer
@@ -32,13 +33,7 @@ MESH_PATHS = sorted(name for name, cls in PATHS.items()
 
 def grid(nx=1, ny=1, x0=-0.5, x1=0.5, y0=-0.5, y1=0.5, offset=(0.0, 0.0, 0.0), z=None):
     """An nx × ny quad grid in the plane z = 0 (or z = z(x, y)), with fields x, xy and cell."""
-    xs, ys = np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1)
-    X, Y = np.meshgrid(xs, ys)
-    Z = np.zeros_like(X) if z is None else z(X, Y)
-    nodes = np.c_[X.ravel(), Y.ravel(), Z.ravel()]
-    idx = np.arange((nx + 1) * (ny + 1)).reshape(ny + 1, nx + 1)
-    quads = np.c_[idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(),
-                  idx[1:, :-1].ravel()]
+    nodes, quads = quad_grid(nx, ny, span=((x0, x1), (y0, y1)), z=z)
     return FEMesh(nodes + np.asarray(offset, np.float64), quads,
                   node_fields={"x": nodes[:, 0], "xy": nodes[:, 0] + 0.5 * nodes[:, 1]},
                   element_fields={"cell": np.arange(len(quads), dtype=np.float64)})

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 import trimesh
+from meshes import quad_grid
 
 from workbench.experiment.simplifiers import (PART_SIMPLIFIERS, SIMPLIFIERS, Simplified,
                                               igl_hausdorff, open3d_distances,
@@ -56,14 +57,10 @@ def test_distance_tools_on_a_lifted_copy():
 def two_parts():
     """A curved 16×16 grid split into two parts along x = 0.5 (they share 17 vertices)."""
     n = 16
-    x, y = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1))
-    z = 0.2 * np.sin(3 * x) * np.cos(2 * y)
-    v = np.stack([x.ravel(), y.ravel(), z.ravel()], 1)
-    i, j = np.meshgrid(np.arange(n), np.arange(n))
-    base = (i + (n + 1) * j).ravel()
-    f = np.concatenate([np.stack([base, base + 1, base + n + 2], 1),
-                        np.stack([base, base + n + 2, base + n + 1], 1)])
-    parts = (np.tile(i.ravel(), 2) >= n // 2).astype(np.int32)
+    v, f = quad_grid(n, n, span=((0, 1), (0, 1)), triangles=True,
+                     z=lambda x, y: 0.2 * np.sin(3 * x) * np.cos(2 * y))
+    column = np.tile(np.arange(n), 2 * n)  # of each triangle's square
+    parts = (column >= n // 2).astype(np.int32)
     return v, f, parts
 
 

@@ -6,28 +6,21 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import barycentric_grid, folded, quad_grid, split_quads
 
-import workbench.data
 from workbench.algo.distance import points_triangles_distance
 from workbench.algo.simplify import Decimation, hausdorff_decimate
 
 
 # --------------------------------------------------------------------------- meshes and checks
 def grid(n, height=None, size=1.0, offset=(0.0, 0.0, 0.0), diagonal_flip=False):
-    """An n×n grid of squares over [0, size]², split into triangles wound counter-clockwise
-    seen from +z; z = height(x, y)."""
-    x, y = np.meshgrid(np.linspace(0, size, n + 1), np.linspace(0, size, n + 1))
-    z = np.zeros_like(x) if height is None else height(x, y)
-    v = np.stack([x.ravel(), y.ravel(), z.ravel()], 1) + np.asarray(offset, np.float64)
-    i = np.arange(n)
-    base = (i[None, :] + (n + 1) * i[:, None]).ravel()
+    """An n×n grid of squares over [0, size]² (moved by ``offset``), split into triangles wound
+    counter-clockwise seen from +z, along the other diagonal with ``diagonal_flip``;
+    z = height(x, y)."""
+    v, quads = quad_grid(n, n, span=((0, size), (0, size)), z=height, origin=offset)
     if diagonal_flip:
-        t = np.concatenate([np.stack([base, base + 1, base + n + 1], 1),
-                            np.stack([base + 1, base + n + 2, base + n + 1], 1)])
-    else:
-        t = np.concatenate([np.stack([base, base + 1, base + n + 2], 1),
-                            np.stack([base, base + n + 2, base + n + 1], 1)])
-    return v, t
+        return v, np.concatenate([quads[:, [0, 1, 3]], quads[:, [1, 2, 3]]])
+    return v, split_quads(quads)
 
 
 def wave(a=0.15, fx=2.0, fy=1.5, phase=0.0):
@@ -37,9 +30,7 @@ def wave(a=0.15, fx=2.0, fy=1.5, phase=0.0):
 def samples(corners, n=6):
     """Points of a barycentric grid with n steps on each triangle of (K, 3, 3) corners,
     (K, S, 3)."""
-    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1))
-    keep = i + j <= n
-    u, w = i[keep] / n, j[keep] / n
+    u, w = barycentric_grid(n)
     weights = np.stack([1 - u - w, u, w], 1)       # (S, 3)
     return np.einsum("sk,tkc->tsc", weights, corners)
 
@@ -220,13 +211,8 @@ def test_smaller_tolerance_never_gives_fewer_triangles():
 def folded_plate(angle_deg: float = 35.0):
     """(vertices, triangles): the 8×8 grid over [0, 2]² folded up by ``angle_deg`` along x = 1
     (the ridge, two units long, on z = 0)."""
-    angle = np.radians(angle_deg)
     v, t = grid(8, size=2.0)
-    fold = v[:, 0] > 1.0
-    run = v[fold, 0] - 1.0
-    v[fold, 0] = 1.0 + run * np.cos(angle)
-    v[fold, 2] = run * np.sin(angle)
-    return v, t
+    return folded(v, 1.0, angle_deg), t
 
 
 def test_feature_edges_are_kept():
@@ -390,15 +376,9 @@ def test_bad_input_is_refused(kwargs, message):
 
 
 # --------------------------------------------------------------------------- the car
-def test_car_parts_within_tolerance():
-    path = workbench.data.shared_file(workbench.data.CAR_DECK)
-    if path is None:
-        pytest.skip("shared LS-DYNA car deck not available")
-    from workbench.scene.readers import load
-
-    mesh = load(path)
-    v, t = mesh.nodes, mesh.triangles
-    parts = mesh.parts[mesh.triangulation.element_of]
+def test_car_parts_within_tolerance(car):
+    v, t = car.nodes, car.triangles
+    parts = car.parts[car.triangulation.element_of]
     r = hausdorff_decimate(v, t, 0.005, parts=parts)
     assert len(r.triangles) < len(t) / 5
     assert r.part_labels.tolist() == np.unique(parts).tolist()

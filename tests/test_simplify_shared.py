@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import quad_grid
 
-import workbench.data
 from workbench.algo.hausdorff import hausdorff
 from workbench.algo.simplify import (MAX_AUTO_DEPTH, MIN_DEPTH, certification_depths,
                                       hausdorff_decimate)
@@ -17,14 +17,10 @@ def two_part_grid(n, walk, amplitude, phase):
     """An n×n grid over [0, 1]² with z = amplitude·sin(3x + phase)·cos(2y), split into part 0
     (below) and part 1 (above) along the grid polyline that runs at row ``walk[i]`` in column i
     (a staircase from the left side to the right side). Triangles wound counter-clockwise."""
-    x, y = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1))
-    z = amplitude * np.sin(3 * x + phase) * np.cos(2 * y)
-    v = np.stack([x.ravel(), y.ravel(), z.ravel()], 1)
-    i, j = np.meshgrid(np.arange(n), np.arange(n))      # column i, row j of each square
-    base = (i + (n + 1) * j).ravel()
-    t = np.concatenate([np.stack([base, base + 1, base + n + 2], 1),
-                        np.stack([base, base + n + 2, base + n + 1], 1)])
-    row, col = np.tile(j.ravel(), 2), np.tile(i.ravel(), 2)
+    v, t = quad_grid(n, n, span=((0, 1), (0, 1)), triangles=True,
+                     z=lambda x, y: amplitude * np.sin(3 * x + phase) * np.cos(2 * y))
+    # row and column of each triangle's square
+    row, col = np.tile(np.repeat(np.arange(n), n), 2), np.tile(np.arange(n), 2 * n)
     parts = (row >= np.asarray(walk)[col]).astype(np.int32)
     return v, t, parts
 
@@ -201,19 +197,17 @@ def test_the_crack_check_sees_a_crack():
 
 # --------------------------------------------------------------------------- the car deck
 @pytest.fixture(scope="module")
-def car():
-    path = workbench.data.shared_file(workbench.data.CAR_DECK)
-    if path is None:
-        pytest.skip("shared LS-DYNA car deck not available (set WORKBENCH_DATA)")
-    from workbench.scene.readers import load
+def car_triangles(car_deck):
+    """The car deck's nodes, triangles and the part of each triangle."""
+    from workbench.scene.builtin import fresh_scene
 
-    mesh = load(path)
+    mesh = fresh_scene("car")
     return mesh.nodes, mesh.triangles.astype(np.int64), mesh.parts[mesh.triangulation.element_of]
 
 
 @pytest.mark.parametrize("tol", [0.001, 0.005])
-def test_car_shared_boundaries_stay_watertight_and_within_tolerance(car, tol):
-    v, t, parts = car
+def test_car_shared_boundaries_stay_watertight_and_within_tolerance(car_triangles, tol):
+    v, t, parts = car_triangles
     r = hausdorff_decimate(v, t, tol, parts=parts)
     locked = hausdorff_decimate(v, t, tol, parts=parts, slide_shared=False)
     for result in (r, locked):
@@ -244,12 +238,7 @@ def test_a_flat_plate_of_large_triangles_reaches_its_corners_at_a_small_toleranc
     # a 4 × 4 grid of 2.5 mm squares, tolerance 0.1 % of its diagonal (0.014 mm): a fixed depth
     # of 5 leaves pieces of 0.1 mm, too coarse to certify those that straddle two coplanar
     # faces, so not one collapse passes; the automatic depth certifies down to the corners
-    x, y = np.meshgrid(np.linspace(0, 10, 5), np.linspace(0, 10, 5))
-    v = np.stack([x.ravel(), y.ravel(), np.zeros(x.size)], 1)
-    i, j = np.meshgrid(np.arange(4), np.arange(4))
-    base = (i + 5 * j).ravel()
-    t = np.concatenate([np.stack([base, base + 1, base + 6], 1),
-                        np.stack([base, base + 6, base + 5], 1)])
+    v, t = quad_grid(4, 4, span=((0, 10), (0, 10)), triangles=True)
     auto = hausdorff_decimate(v, t, 0.001)
     fixed = hausdorff_decimate(v, t, 0.001, max_depth=5)
     assert len(auto.triangles) == 2 and len(fixed.triangles) == len(t)

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from meshes import random_tiling
 from scipy.ndimage import binary_dilation
 
 from workbench.algo.spacetime.exact import colour_error, element_boundary, exact_image
@@ -22,16 +23,7 @@ CELL = 5.0  # mm
 
 def _polygons(n, offset, seed):
     """n×n cells of CELL mm, each a quad or two triangles, jittered: a tiling of a square."""
-    rng = np.random.default_rng(seed)
-    pts = np.stack(np.meshgrid(np.arange(n + 1.0), np.arange(n + 1.0), indexing="ij"), -1)
-    pts[1:n, 1:n] += rng.uniform(-0.25, 0.25, (n - 1, n - 1, 2))
-    pts = pts * CELL + offset
-    polys = []
-    for i in range(n):
-        for j in range(n):
-            a, b, c, d = pts[i, j], pts[i + 1, j], pts[i + 1, j + 1], pts[i, j + 1]
-            polys += [[a, b, c, d]] if rng.random() < 0.5 else [[a, b, c, c], [a, c, d, d]]
-    return np.array(polys)
+    return random_tiling(n, 0.25, seed) * CELL + offset
 
 
 def _scene(n=4, offset=(0.0, 0.0), seed=0, t=3.0, moving=True, scale=1.0):

@@ -4,27 +4,10 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from meshes import random_tiling
 
 from workbench.algo.spacetime.raster import PixelGrid, locate_pixels
 from workbench.algo.spacetime.shading import LIGHT, log_scale, phong, ramp_color, shade
-
-
-def _grid_polygons(n, offset, seed):
-    """An n×n grid of unit cells, each split into a quad or two triangles, jittered inside."""
-    rng = np.random.default_rng(seed)
-    pts = np.stack(np.meshgrid(np.arange(n + 1.0), np.arange(n + 1.0), indexing="ij"), -1)
-    inner = (slice(1, n), slice(1, n))
-    pts[inner] += rng.uniform(-0.3, 0.3, pts[inner].shape)
-    pts += offset
-    polys = []
-    for i in range(n):
-        for j in range(n):
-            a, b, c, d = pts[i, j], pts[i + 1, j], pts[i + 1, j + 1], pts[i, j + 1]
-            if rng.random() < 0.5:
-                polys.append([a, b, c, d])
-            else:
-                polys += [[a, b, c, c], [a, c, d, d]]
-    return np.array(polys), pts
 
 
 def _brute(corners, xs, ys):
@@ -45,7 +28,7 @@ def _brute(corners, xs, ys):
        far=st.booleans())
 def test_locate_matches_brute_force_and_covers_the_domain(n, seed, width, far):
     offset = np.array([3.0e5, -7.0e5]) if far else np.zeros(2)
-    corners, _ = _grid_polygons(n, offset, seed)
+    corners = random_tiling(n, 0.3, seed) + offset
     grid = PixelGrid.fit(offset, offset + n, width, margin=0.1)
     loc = locate_pixels(corners, grid)
     xs, ys = grid.centres()

@@ -3,27 +3,12 @@
 import numpy as np
 import pytest
 
-from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.compare import compare_images
 from workbench.experiment.measure import measure
-from workbench.gl import Camera, create_context
+from workbench.gl import Camera
 from workbench.paths import Style
-from workbench.scene import load
 
 SIZE = (320, 200)
-
-
-@pytest.fixture(scope="module")
-def car():
-    path = shared_file(CAR_DECK)
-    if path is None:
-        pytest.skip("shared car deck not found (set WORKBENCH_DATA)")
-    return load(path)
-
-
-@pytest.fixture(scope="module")
-def ctx():
-    return create_context()
 
 
 def render(ctx, mesh, path_name, style):

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from workbench.cli.stress import add_parser as add_stress_parser
-from workbench.data import D3PLOT, shared_file
 from workbench.reliability import (
     BENIGN,
     BOM,
@@ -156,7 +155,7 @@ def test_regression_bom_keeps_line_numbers(tmp_path):
 
 
 # --------------------------------------------------------------------------- damaged d3plots
-@pytest.mark.skipif(shared_file(D3PLOT) is None, reason="shared d3plot absent (set WORKBENCH_DATA)")
+@pytest.mark.usefixtures("d3plot_file")
 def test_damaged_d3plots_are_read_or_refused_never_anything_else():
     from workbench.reliability import run_d3plot_stress
 
@@ -166,14 +165,13 @@ def test_damaged_d3plots_are_read_or_refused_never_anything_else():
     assert totals["read"] > 0 and totals["parse error"] > 0 and sum(totals.values()) == 300
 
 
-@pytest.mark.skipif(shared_file(D3PLOT) is None, reason="shared d3plot absent (set WORKBENCH_DATA)")
-def test_regression_garbled_part_index_is_a_parse_error(tmp_path):
+def test_regression_garbled_part_index_is_a_parse_error(tmp_path, d3plot_file):
     """Damage 175 of seed 0 garbles a shell part index to -1.6e9: once an IndexError."""
     from workbench.reliability import damaged_d3plot
     from workbench.scene.readers import ParseError
     from workbench.scene.readers.d3plot import read_d3plot
 
-    kind, data = damaged_d3plot(shared_file(D3PLOT).read_bytes(), 175, 0)
+    kind, data = damaged_d3plot(d3plot_file.read_bytes(), 175, 0)
     (tmp_path / "d3plot").write_bytes(data)
     with pytest.raises(ParseError, match="part indexes out of range"):
         with warnings.catch_warnings():

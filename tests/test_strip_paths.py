@@ -6,6 +6,7 @@ import functools
 import moderngl
 import numpy as np
 import pytest
+from meshes import quad_grid
 from skimage.morphology import dilation, footprint_rectangle
 from test_paths import render
 
@@ -23,14 +24,9 @@ SHADED = {"position": None, "flat": None, "gouraud": None, "pixel_color": "h",
 def scene_with_defects():
     """A warped 14 × 10 quad grid with a sharp fold, a hole, two triangles, a degenerate element
     and a flipped element: strips break at the fold (crease split), the hole and the flip."""
-    nx, ny = 14, 10
-    xs, ys = np.linspace(-0.8, 0.8, nx + 1), np.linspace(-0.6, 0.6, ny + 1)
-    X, Y = np.meshgrid(xs, ys)
-    Z = 0.2 * np.sin(3 * X) * np.cos(2 * Y) + 0.4 * np.abs(X)  # fold along x = 0
-    nodes = np.c_[X.ravel(), Y.ravel(), Z.ravel()]
-    idx = np.arange((nx + 1) * (ny + 1)).reshape(ny + 1, nx + 1)
-    quads = np.c_[idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(),
-                  idx[1:, :-1].ravel()]
+    nodes, quads = quad_grid(
+        14, 10, span=((-0.8, 0.8), (-0.6, 0.6)),
+        z=lambda x, y: 0.2 * np.sin(3 * x) * np.cos(2 * y) + 0.4 * np.abs(x))  # fold along x = 0
     keep = np.ones(len(quads), bool)
     keep[[30, 31, 45]] = False  # a hole
     split = quads[[60, 61]]
@@ -172,14 +168,7 @@ def test_strip_style_is_checked():
 def facing_grid(nx, ny, cell, shift=(0.0, 0.0)):
     """An nx × ny grid of square cells ``cell`` units wide, centred at ``shift``, facing the
     camera."""
-    xs = (np.arange(nx + 1) - nx / 2) * cell + shift[0]
-    ys = (np.arange(ny + 1) - ny / 2) * cell + shift[1]
-    X, Y = np.meshgrid(xs, ys)
-    nodes = np.c_[X.ravel(), Y.ravel(), np.zeros(X.size)]
-    idx = np.arange((nx + 1) * (ny + 1)).reshape(ny + 1, nx + 1)
-    quads = np.c_[idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(),
-                  idx[1:, :-1].ravel()]
-    return FEMesh(nodes, quads)
+    return FEMesh(*quad_grid(nx, ny, cell=cell, centred=True, origin=(*shift, 0.0)))
 
 
 def wire_mask(image):

@@ -16,7 +16,6 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from workbench.algo.strips import quad_strips, tri_strips
-from workbench.data import CAR_DECK, shared_file
 from workbench.scene.derived import triangulate
 
 RESTART = 0xFFFFFFFF
@@ -556,13 +555,8 @@ def test_bad_cutoff_refused(cutoff):
         quad_strips(np.array(grid(2, 2)), cutoff=cutoff)
 
 
-def test_car_deck():
-    path = shared_file(CAR_DECK)
-    if path is None:
-        pytest.skip(f"shared data {CAR_DECK} not available")
-    from workbench.scene.readers import load
-
-    elements = load(path).elements
+def test_car_deck(car):
+    elements = car.elements
     result = quad_strips(elements, cutoff=1)
     check_invariants(elements, result, 1)
     ref = reference_strips(elements, 1)

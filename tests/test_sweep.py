@@ -17,7 +17,6 @@ from pathlib import Path
 import pytest
 
 import workbench.scene.readers as scene_readers
-from workbench.data import CAR_DECK, shared_file
 from workbench.experiment.tables import read_table
 from workbench.sweep import (
     Point,
@@ -319,17 +318,12 @@ def test_simplification_point_on_the_semicylinders():
     assert none is mesh and same["hausdorff_lower_mm"] == 0
 
 
-@pytest.mark.skipif(shared_file(CAR_DECK) is None,
-                    reason=f"shared data {CAR_DECK} absent (set WORKBENCH_DATA)")
-def test_car_decimation_config_is_valid_and_simplifies_the_car():
-    from workbench.scene.builtin import load_scene
-
+def test_car_decimation_config_is_valid_and_simplifies_the_car(car):
     root = Path(__file__).resolve().parents[1]
     config = load_config(root / "sweeps" / "car_decimation.toml")
     points = grid_points(config, quick=True)
     assert config.metric == "hausdorff_pct_diag" and {p.scene for p in points} == {"car"}
     assert sum(p.simplifier == "none" for p in points) == 1  # tolerance means nothing there
-    car = load_scene("car")
     ours = next(p for p in points if p.simplifier == "ours")
     simplified, columns = simplified_scene(car, ours)
     assert len(simplified.elements) == columns["triangles_after"]

@@ -1,0 +1,136 @@
+"""Small meshes the tests build again and again: regular or jittered quad grids (as quads or
+split into triangles), a random tiling of quads and triangles, a plate folded along a grid line,
+and barycentric sample grids.
+
+Imported by the test modules as ``from meshes import quad_grid`` (the tests folder is on the
+import path when pytest runs). Every builder is deterministic: the same arguments give the same
+node numbering, element order and winding and the same coordinates, bit for bit, so a test may
+rely on them.
+
+Node numbering: node (i, j), i along x and j along y, has index ``j * (nx + 1) + i`` (row by
+row, x fastest) or, with ``ij=True``, ``i * (ny + 1) + j`` (column by column, y fastest); the
+elements follow the same order. Every quad is (i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1):
+counter-clockwise seen from +z.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def grid_quads(nx: int, ny: int, *, ij: bool = False) -> np.ndarray:
+    """(nx · ny, 4) int64 node indices of the quads of an nx × ny grid, numbered as the module
+    docstring says."""
+    if ij:
+        i, j = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij"))
+
+        def node(a, b):
+            return a * (ny + 1) + b
+    else:
+        j, i = (a.ravel() for a in np.meshgrid(np.arange(ny), np.arange(nx), indexing="ij"))
+
+        def node(a, b):
+            return b * (nx + 1) + a
+    return np.stack([node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)], axis=1)
+
+
+def split_quads(quads: np.ndarray) -> np.ndarray:
+    """(2M, 3) triangles of (M, 4) quads a b c d cut along a–c: first every (a, b, c), then
+    every (a, c, d), wound as the quads."""
+    return np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+
+
+def _node_indices(nx: int, ny: int, ij: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(i, j) grid indices of every node, numbered as the module docstring says."""
+    i, j = np.arange(nx + 1), np.arange(ny + 1)
+    if ij:
+        return np.repeat(i, ny + 1), np.tile(j, nx + 1)
+    return np.tile(i, ny + 1), np.repeat(j, nx + 1)
+
+
+def _axis(n: int, cell: float, span, centred: bool) -> np.ndarray:
+    """The n + 1 grid coordinates along one axis."""
+    if span is not None:
+        return np.linspace(span[0], span[1], n + 1)
+    if centred:
+        return (np.arange(n + 1) - n / 2) * cell
+    return np.arange(n + 1) * cell
+
+
+def quad_grid(nx: int, ny: int, *, cell=1.0, span=None, centred: bool = False, z=None,
+              origin=None, jitter: float | None = None, seed=0, jitter_border: bool = True,
+              ij: bool = False, triangles: bool = False,
+              dim: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    """(nodes (N, dim) float64, elements) of an nx × ny grid of quads in the x-y plane.
+
+    Coordinates, in this order:
+
+    * along each axis ``i · cell`` (``cell`` a number or (x, y) pair), ``(i − n/2) · cell``
+      with ``centred``, or ``numpy.linspace(lo, hi, n + 1)`` with ``span=((x0, x1), (y0, y1))``;
+    * z (``dim`` 3 only): 0 (None), a number or (N,) array, or ``z(x, y)`` of the (N,) node
+      coordinates so far;
+    * plus ``origin`` (``dim`` components; None adds nothing);
+    * plus ``jitter``: a uniform offset in [−jitter, jitter] added to x and y of every node
+      (``jitter_border=False``: of the inner nodes only), drawn as one (K, 2) array from
+      ``numpy.random.default_rng(seed)`` (a Generator passed as ``seed`` is drawn from); None
+      draws nothing.
+
+    Elements: (nx · ny, 4) int64 quads numbered as the module docstring says, or with
+    ``triangles`` (2 · nx · ny, 3) triangles (:func:`split_quads`). ``dim`` is 2 or 3."""
+    cx, cy = (float(c) for c in np.broadcast_to(cell, 2))
+    spans = (None, None) if span is None else span
+    i, j = _node_indices(nx, ny, ij)
+    x, y = _axis(nx, cx, spans[0], centred)[i], _axis(ny, cy, spans[1], centred)[j]
+    columns = [x, y]
+    if dim == 3:
+        columns.append(np.zeros(len(x)) if z is None else z(x, y) if callable(z)
+                       else np.broadcast_to(z, x.shape))
+    elif dim != 2 or z is not None:
+        raise ValueError("dim must be 3, or 2 without z")
+    nodes = np.stack(columns, axis=1).astype(np.float64, copy=False)
+    if origin is not None:
+        nodes = nodes + np.asarray(origin, np.float64)
+    if jitter is not None:
+        rng = np.random.default_rng(seed)
+        if jitter_border:
+            nodes[:, :2] += rng.uniform(-jitter, jitter, (len(nodes), 2))
+        else:
+            inner = (i > 0) & (i < nx) & (j > 0) & (j < ny)
+            nodes[inner, :2] += rng.uniform(-jitter, jitter, (int(inner.sum()), 2))
+    quads = grid_quads(nx, ny, ij=ij)
+    return nodes, split_quads(quads) if triangles else quads
+
+
+def random_tiling(n: int, jitter: float, seed=0) -> np.ndarray:
+    """(P, 4, 2) corners of the cells of an n × n grid of unit squares, inner nodes jittered by
+    up to ``jitter`` (:func:`quad_grid` with ``ij``, drawn first): cell by cell, x outer, each
+    cell by a coin toss the quad (a, b, c, d) or its two triangles (a, b, c, c), (a, c, d, d)."""
+    rng = np.random.default_rng(seed)
+    pts, _ = quad_grid(n, n, jitter=jitter, seed=rng, jitter_border=False, ij=True, dim=2)
+    pts = pts.reshape(n + 1, n + 1, 2)
+    polys = []
+    for i in range(n):
+        for j in range(n):
+            a, b, c, d = pts[i, j], pts[i + 1, j], pts[i + 1, j + 1], pts[i, j + 1]
+            polys += [[a, b, c, d]] if rng.random() < 0.5 else [[a, b, c, c], [a, c, d, d]]
+    return np.array(polys)
+
+
+def folded(nodes: np.ndarray, at: float, angle_deg: float) -> np.ndarray:
+    """A copy of ``nodes`` with the part x > ``at`` turned about the line x = ``at``, z = 0 by
+    ``angle_deg`` upwards (its z replaced by the rise): a plate in z = 0 folded there."""
+    out = nodes.copy()
+    right = nodes[:, 0] > at
+    t = np.radians(angle_deg)
+    r = nodes[right, 0] - at
+    out[right, 0] = at + r * np.cos(t)
+    out[right, 2] = r * np.sin(t)
+    return out
+
+
+def barycentric_grid(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(u, v), (K,) each: the points i/n, j/n with i + j ≤ n, the weights of the second and
+    third corner on a barycentric grid of spacing 1/n over a triangle."""
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1))
+    keep = i + j <= n
+    return i[keep] / n, j[keep] / n
