@@ -7,8 +7,12 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from meshes import barycentric_grid
 
-from workbench.algo.distance import (closest_point_on_triangle, point_triangle_distance,
-                                     points_triangles_distance, triangle_bounds)
+from workbench.algo.distance import (
+    closest_point_on_triangle,
+    point_triangle_distance,
+    points_triangles_distance,
+    triangle_bounds,
+)
 
 coords = st.floats(-10, 10, allow_nan=False, width=64)
 vec3 = arrays(np.float64, 3, elements=coords)

@@ -8,9 +8,14 @@ import pytest
 
 from workbench.algo.distance import points_triangles_distance
 from workbench.experiment import distance_refs
-from workbench.experiment.distance_refs import (TOOLS, RefResult, available_tools,
-                                                compare_with_exact, own_part_groups,
-                                                reference_part_distances)
+from workbench.experiment.distance_refs import (
+    TOOLS,
+    RefResult,
+    available_tools,
+    compare_with_exact,
+    own_part_groups,
+    reference_part_distances,
+)
 from workbench.scene.generators import stamped_panels
 from workbench.scene.mesh import FEMesh
 

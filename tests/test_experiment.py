@@ -9,14 +9,30 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from workbench.experiment import (EXPERIMENTS, PyrenderReference, Timing, atomic_write_text,
-                                  compare_images, coverage, difference_map, discover, experiment,
-                                  markdown_table, read_table, run_experiment, save_field_figure,
-                                  save_image_grid, save_png, time_call, time_draw, write_table)
+from workbench.experiment import (
+    EXPERIMENTS,
+    PyrenderReference,
+    Timing,
+    atomic_write_text,
+    compare_images,
+    coverage,
+    difference_map,
+    discover,
+    experiment,
+    markdown_table,
+    read_table,
+    run_experiment,
+    save_field_figure,
+    save_image_grid,
+    save_png,
+    time_call,
+    time_draw,
+    write_table,
+)
 from workbench.experiment import tables as tables_module
-from workbench.experiment.registry import clean_dead_runs
 from workbench.experiment.figures import MIN_PANEL_HEIGHT
 from workbench.experiment.measure import measure
+from workbench.experiment.registry import clean_dead_runs
 from workbench.gl import Camera, Framebuffer, create_context
 from workbench.paths import RenderPath
 

@@ -13,7 +13,7 @@ def deviation(points, kept, closed=False):
     """Largest distance of an original node from the simplified polyline (brute force)."""
     loop = list(kept) + ([kept[0]] if closed else [])
     worst = 0.0
-    for i, q in enumerate(points):
+    for q in points:
         d = min(_segment_distances(q[None], points[a], points[b])[0]
                 for a, b in zip(loop[:-1], loop[1:]))
         worst = max(worst, d)

@@ -6,8 +6,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from workbench.algo.fepatch.normalmap import (decode_normals, dilate_texels, dropped_axis,
-                                              encode_normals, restore_error_bound)
+from workbench.algo.fepatch.normalmap import (
+    decode_normals,
+    dilate_texels,
+    dropped_axis,
+    encode_normals,
+    restore_error_bound,
+)
 
 
 def unit(v):

@@ -5,10 +5,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from matplotlib.path import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from matplotlib.path import Path
 
 from workbench.algo.fepatch.polygon import polygon_area, triangulate_polygon
 
@@ -195,7 +195,7 @@ def test_comb_shaped_concave_polygon():
     teeth, width, gap, depth = 6, 1.0, 0.5, 5.0
     top = []
     x = 0.0
-    for t in range(teeth):
+    for _ in range(teeth):
         top += [(x, 1.0), (x, 1.0 + depth), (x + width, 1.0 + depth), (x + width, 1.0)]
         x += width + gap
     x_end = x - gap

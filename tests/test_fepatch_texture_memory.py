@@ -11,10 +11,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from meshes import grid_quads
 
+from workbench.algo.fepatch import wireid, wiretex
 from workbench.algo.fepatch.atlas import build_atlas
 from workbench.algo.fepatch.pipeline import PAPER_TEXTURE_RULE, build_model
 from workbench.algo.fepatch.surface import TexturedSurface
-from workbench.algo.fepatch import wireid, wiretex
 from workbench.algo.fepatch.wireid import on_outline
 from workbench.algo.fepatch.wiretex import element_widths
 from workbench.scene.derived import triangulate

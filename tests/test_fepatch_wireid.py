@@ -12,8 +12,14 @@ from hypothesis import strategies as st
 from meshes import quad_grid
 
 from workbench.algo.fepatch.surface import CORNER_ROW, TexturedSurface
-from workbench.algo.fepatch.wireid import (MIN_WIDTH, NO_ELEMENT, corner_table, element_map,
-                                           on_outline, outline_distance)
+from workbench.algo.fepatch.wireid import (
+    MIN_WIDTH,
+    NO_ELEMENT,
+    corner_table,
+    element_map,
+    on_outline,
+    outline_distance,
+)
 from workbench.algo.fepatch.wiretex import element_widths
 
 
@@ -42,7 +48,7 @@ def inside(points, corners) -> np.ndarray:
         area = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
         p = points[:, None, :]
 
-        def cross(u, v):
+        def cross(u, v, p=p):
             return (v[None, :, 0] - u[None, :, 0]) * (p[..., 1] - u[None, :, 1]) \
                 - (v[None, :, 1] - u[None, :, 1]) * (p[..., 0] - u[None, :, 0])
         la, lb, lc = cross(b, c) / area, cross(c, a) / area, cross(a, b) / area

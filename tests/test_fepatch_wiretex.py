@@ -9,8 +9,7 @@ from hypothesis import strategies as st
 from meshes import quad_grid
 
 from workbench.algo.fepatch.surface import WIRE_PAIRS
-from workbench.algo.fepatch.wiretex import (RING, checkerboard, decode_wire, on_outline,
-                                            wire_texture)
+from workbench.algo.fepatch.wiretex import RING, checkerboard, decode_wire, on_outline, wire_texture
 
 
 def texel_grid(nx, ny, cell, jitter=0.0, offset=(0.0, 0.0), seed=0):

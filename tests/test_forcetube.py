@@ -4,9 +4,18 @@ rule for nodes and edges on the plane, the tube mesh, and the d3plot's stress fi
 import numpy as np
 import pytest
 
-from workbench.algo.forcetube import (STRESS_FIELDS, TUBE_FIELD, crossing_elements, force_tube,
-                                      prismatic_tube, section_force, section_planes,
-                                      stress_tensor, tube_mesh, with_tube)
+from workbench.algo.forcetube import (
+    STRESS_FIELDS,
+    TUBE_FIELD,
+    crossing_elements,
+    force_tube,
+    prismatic_tube,
+    section_force,
+    section_planes,
+    stress_tensor,
+    tube_mesh,
+    with_tube,
+)
 from workbench.scene.mesh import FEMesh
 
 REL = 1e-9

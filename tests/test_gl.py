@@ -4,8 +4,15 @@ import moderngl
 import numpy as np
 import pytest
 
-from workbench.gl import (Camera, Framebuffer, GpuTimer, SamplesPassed, create_context, renderer,
-                          write_masks)
+from workbench.gl import (
+    Camera,
+    Framebuffer,
+    GpuTimer,
+    SamplesPassed,
+    create_context,
+    renderer,
+    write_masks,
+)
 
 VERT = """#version 330
 uniform mat4 mvp;
@@ -174,7 +181,7 @@ def test_float_depth_framebuffer_draws_like_the_fixed_point_one(ctx, samples):
 
 
 def test_releasing_a_bound_framebuffer_leaves_no_gl_error(ctx):
-    ctx.error  # reading the error flag clears it
+    _ = ctx.error  # reading the error flag clears it
     for bits in (24, 32):
         fb = Framebuffer(ctx, (16, 16), depth_bits=bits)
         fb.clear()

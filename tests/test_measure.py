@@ -6,15 +6,14 @@ import sys
 import numpy as np
 import pytest
 
+from workbench.algo.fepatch.mesh_model import fepatch_model
 from workbench.algo.spacetime.exact import colour_error, element_boundary, exact_image
 from workbench.algo.spacetime.fields import STEEL
-from workbench.algo.fepatch.mesh_model import fepatch_model
 from workbench.algo.spacetime.raster import PixelGrid
 from workbench.algo.spacetime.scene import spacetime_scene
 from workbench.experiment.measure import default_camera, measure
 from workbench.gl import renderer
-from workbench.paths import PATHS, Style, make_path, path_class, path_options
-from workbench.paths import GLPath
+from workbench.paths import PATHS, GLPath, Style, make_path, path_class, path_options
 from workbench.paths.colormap import colormap_lut
 from workbench.paths.spacetime import SpacetimeStyle
 from workbench.scene import generators

@@ -5,10 +5,17 @@ import pytest
 import trimesh
 from meshes import quad_grid
 
-from workbench.experiment.simplifiers import (PART_SIMPLIFIERS, SIMPLIFIERS, Simplified,
-                                              igl_hausdorff, open3d_distances,
-                                              part_border_vertices, pymeshlab_hausdorff,
-                                              simplify_per_part, simplify_with)
+from workbench.experiment.simplifiers import (
+    PART_SIMPLIFIERS,
+    SIMPLIFIERS,
+    Simplified,
+    igl_hausdorff,
+    open3d_distances,
+    part_border_vertices,
+    pymeshlab_hausdorff,
+    simplify_per_part,
+    simplify_with,
+)
 
 
 @pytest.fixture(scope="module")

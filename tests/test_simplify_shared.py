@@ -8,8 +8,12 @@ from hypothesis import strategies as st
 from meshes import quad_grid
 
 from workbench.algo.hausdorff import hausdorff
-from workbench.algo.simplify import (MAX_AUTO_DEPTH, MIN_DEPTH, certification_depths,
-                                      hausdorff_decimate)
+from workbench.algo.simplify import (
+    MAX_AUTO_DEPTH,
+    MIN_DEPTH,
+    certification_depths,
+    hausdorff_decimate,
+)
 
 
 # --------------------------------------------------------------------------- meshes and checks

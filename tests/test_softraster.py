@@ -11,6 +11,8 @@ from workbench.algo.softraster.rule import coverage_mask, snap
 from workbench.scene.generators import semicylinders
 
 W, H = 40, 32
+DEFAULT_OPTIONS = RasterOptions()
+DEFAULT_SHADING = Shading()
 
 
 def pixel_projection(width: int, height: int) -> np.ndarray:
@@ -23,7 +25,8 @@ def pixel_projection(width: int, height: int) -> np.ndarray:
     return proj
 
 
-def draw(points, triangles, options=RasterOptions(), shading=Shading(), size=(W, H), **kw):
+def draw(points, triangles, options=DEFAULT_OPTIONS, shading=DEFAULT_SHADING, size=(W, H),
+         **kw):
     frame, stats = render(np.asarray(points, np.float64), triangles, np.eye(4),
                           pixel_projection(*size), size, shading, options, **kw)
     return frame, stats

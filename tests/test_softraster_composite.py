@@ -12,8 +12,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from workbench.algo.softraster.composite import (CompositeStats, Region, binary_swap,
-                                                 binary_tree, composite, swap_plan, tree_plan)
+from workbench.algo.softraster.composite import (
+    CompositeStats,
+    Region,
+    binary_swap,
+    binary_tree,
+    composite,
+    swap_plan,
+    tree_plan,
+)
 from workbench.algo.softraster.frame import CLEAR_DEPTH, NO_TRIANGLE, Frame
 
 SCHEDULES = [binary_tree, binary_swap]

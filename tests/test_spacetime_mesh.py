@@ -18,9 +18,16 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from workbench.algo.spacetime.mesh import (SpacetimeMesh, front_refined, interval_mesh,
-                                           rect_triangulation, refine, space_measure,
-                                           spacetime_volume, tent_pitch)
+from workbench.algo.spacetime.mesh import (
+    SpacetimeMesh,
+    front_refined,
+    interval_mesh,
+    rect_triangulation,
+    refine,
+    space_measure,
+    spacetime_volume,
+    tent_pitch,
+)
 
 PROPERTY = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 

@@ -14,10 +14,14 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from workbench.algo.spacetime.mesh import (SpacetimeMesh, front_refined, interval_mesh,
-                                           rect_triangulation, tent_pitch)
-from workbench.algo.spacetime.slicing import (Slice, TimeSlicer, polygon_areas, quadrisect,
-                                              slice_at)
+from workbench.algo.spacetime.mesh import (
+    SpacetimeMesh,
+    front_refined,
+    interval_mesh,
+    rect_triangulation,
+    tent_pitch,
+)
+from workbench.algo.spacetime.slicing import Slice, TimeSlicer, polygon_areas, quadrisect, slice_at
 
 PROPERTY = settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 T_END = 0.3

@@ -87,7 +87,8 @@ def test_wrong_mesh_is_detected(tmp_path):
     path.write_bytes(fixed_deck())
     mesh = read_keyword(path)
     lines = fixed_deck().split(b"\n")
-    one_element_less = b"\n".join(l for l in lines if not l.startswith(b"       9       1"))
+    one_element_less = b"\n".join(line for line in lines
+                                   if not line.startswith(b"       9       1"))
     assert "elements read" in mesh_problem(mesh, one_element_less)
     garbled_node = fixed_deck().replace(b"            10.0             0.0",
                                         b"            1x.0             0.0", 1)

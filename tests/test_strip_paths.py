@@ -3,7 +3,6 @@ single-pass quad wire frame against the line-overdraw wire frame."""
 
 import functools
 
-import moderngl
 import numpy as np
 import pytest
 from meshes import quad_grid

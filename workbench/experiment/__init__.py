@@ -5,10 +5,16 @@ from .compare import ImageDiff, compare_images, coverage, difference_map
 from .figures import save_field_figure, save_image_grid, save_png
 from .measure import Measurement, default_camera, measure
 from .reference import PyrenderReference
-from .registry import (EXPERIMENTS, Experiment, discover, experiment, get_experiment,
-                       run_experiment)
-from .tables import (atomic_open, atomic_write_bytes, atomic_write_text, format_number,
-                     markdown_table, read_table, write_table)
+from .registry import EXPERIMENTS, Experiment, discover, experiment, get_experiment, run_experiment
+from .tables import (
+    atomic_open,
+    atomic_write_bytes,
+    atomic_write_text,
+    format_number,
+    markdown_table,
+    read_table,
+    write_table,
+)
 from .timing import MIN_REPEATS, Timing, time_call, time_draw
 
 __all__ = [

@@ -262,7 +262,7 @@ class PyrenderReference:
         platform._egl_context = platform._egl_display = None
         offscreen._renderer = offscreen._platform = None
 
-    def __enter__(self) -> "PyrenderReference":
+    def __enter__(self) -> PyrenderReference:
         return self
 
     def __exit__(self, *exc) -> None:

@@ -17,9 +17,9 @@ import pkgutil
 import re
 import shutil
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 from .context import SIZES, ExperimentContext
 from .tables import write_table

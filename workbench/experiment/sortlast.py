@@ -32,8 +32,15 @@ import numpy as np
 from dask.sizeof import sizeof
 from distributed import Client, wait
 
-from ..algo.softraster.composite import (Region, assemble, bytes_per_pixel, composite, crop,
-                                         swap_plan, tree_plan)
+from ..algo.softraster.composite import (
+    Region,
+    assemble,
+    bytes_per_pixel,
+    composite,
+    crop,
+    swap_plan,
+    tree_plan,
+)
 from ..algo.softraster.frame import Frame
 
 METHODS = ("tree", "swap")

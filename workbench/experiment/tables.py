@@ -11,10 +11,10 @@ import csv
 import math
 import os
 import tempfile
+from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from numbers import Integral, Real
 from pathlib import Path
-from typing import Iterable, Iterator, Sequence
 
 import numpy as np
 

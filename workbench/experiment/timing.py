@@ -10,9 +10,10 @@ backend's ``renderer``), so experiments report ratios from one run.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from statistics import median
-from typing import Any, Callable
+from typing import Any
 
 from ..paths.backends import as_backend
 
@@ -57,7 +58,7 @@ class Timing:
 
     @classmethod
     def from_samples(cls, wall: list[float], gpu: list[float] | None = None,
-                     readback: list[float] | None = None, result: Any = None) -> "Timing":
+                     readback: list[float] | None = None, result: Any = None) -> Timing:
         """Summarise raw samples (ms): medians and ranges; ``gpu``/``readback`` may be None."""
         if len(wall) < MIN_REPEATS:
             raise ValueError(f"need at least {MIN_REPEATS} wall-time samples, got {len(wall)}")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from functools import lru_cache
+from functools import cache
 from importlib import resources
 
 import moderngl
@@ -12,7 +12,7 @@ import moderngl
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$', re.MULTILINE)
 
 
-@lru_cache(maxsize=None)
+@cache
 def shader_source(name: str) -> str:
     """The text of ``glsl/<name>`` with ``#include "file"`` lines expanded (one level deep per file)."""
     path = resources.files("workbench.glsl") / name

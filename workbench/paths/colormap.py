@@ -27,7 +27,7 @@ which moves a colour by at most ``|c[i+1] − c[i]|/512``, far below 1/255 for a
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -41,7 +41,7 @@ LUT_SIZE = 256
 ALPHA_TEST = 0.5
 
 
-@lru_cache(maxsize=None)
+@cache
 def _lut(name: str) -> np.ndarray:
     import matplotlib
 

@@ -24,6 +24,7 @@ from ..gl import Camera, load_program
 from .base import GLPath
 from .colormap import ColorScale, scale_for
 from .drawdata import Layout, MeshDrawData, Topology, compact, vertex_of_node
+from .style import Style
 
 if TYPE_CHECKING:
     from ..scene.mesh import FEMesh

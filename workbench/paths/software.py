@@ -34,6 +34,8 @@ if TYPE_CHECKING:
     from ..scene.protocol import Scene
     from .style import Style
 
+DEFAULT_OPTIONS = RasterOptions()  # frozen: one instance serves as every path's default
+
 SHADING_OF = {"position": "constant", "flat": "flat", "gouraud": "gouraud",
               "vertex_color": "vertex_color", "pixel_color": "pixel_color",
               "element_color": "element_color"}
@@ -76,7 +78,7 @@ class SoftwarePath(RenderPath):
     style: Style
 
     def __init__(self, name: str = "pixel_color", style: Style | None = None,
-                 options: RasterOptions = RasterOptions()) -> None:
+                 options: RasterOptions = DEFAULT_OPTIONS) -> None:
         cls = path_class(name)
         if name not in SHADING_OF:
             raise ValueError(f"the software rasterizer draws the mesh paths "

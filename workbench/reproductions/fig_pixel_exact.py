@@ -51,8 +51,17 @@ from workbench.algo.spacetime.fields import BAR, STEEL, RadialPulse
 from workbench.algo.spacetime.mesh import front_refined, rect_triangulation
 from workbench.algo.spacetime.poly import evaluate, evaluate_float32_global, evaluate_float32_local
 from workbench.algo.spacetime.raster import PixelGrid
-from workbench.algo.spacetime.scene import (DOMAIN, PULSE, T_SLICE, Solution, SpacetimeScene,
-                                            bar_scene, plate_solution, slice_scene, window)
+from workbench.algo.spacetime.scene import (
+    DOMAIN,
+    PULSE,
+    T_SLICE,
+    Solution,
+    SpacetimeScene,
+    bar_scene,
+    plate_solution,
+    slice_scene,
+    window,
+)
 from workbench.algo.spacetime.slicing import TimeSlicer, polygon_areas, quadrisect, slice_at
 from workbench.experiment.compare import crack_pixels
 from workbench.experiment.context import ExperimentContext
@@ -259,7 +268,7 @@ def slicing_rows(exp: ExperimentContext) -> list[dict]:
         polys.append(s.n_polygons)
     # the same frames with the domain-boundary edges the edge overdraw leaves out
     start = time.perf_counter()
-    mesh.shared_facets  # derived once per mesh
+    _ = mesh.shared_facets  # derived once per mesh
     facets_s = time.perf_counter() - start
     _, inc_outer = timed_slices(TimeSlicer(mesh, outer=True), times)
     brute = [time_call(lambda t=t: slice_at(mesh, float(t)), warmup=0, repeat=5).wall_ms

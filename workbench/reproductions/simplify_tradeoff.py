@@ -50,10 +50,16 @@ from workbench.algo.hausdorff import hausdorff
 from workbench.algo.simplify import hausdorff_decimate
 from workbench.experiment.context import ExperimentContext
 from workbench.experiment.registry import experiment
-from workbench.experiment.simplifiers import (PART_SIMPLIFIERS, SIMPLIFIERS, igl_hausdorff,
-                                              open3d_distances, part_border_vertices,
-                                              pymeshlab_hausdorff, simplify_per_part,
-                                              simplify_with)
+from workbench.experiment.simplifiers import (
+    PART_SIMPLIFIERS,
+    SIMPLIFIERS,
+    igl_hausdorff,
+    open3d_distances,
+    part_border_vertices,
+    pymeshlab_hausdorff,
+    simplify_per_part,
+    simplify_with,
+)
 from workbench.scene import generators
 from workbench.scene.mesh import FEMesh
 

@@ -40,13 +40,19 @@ import time
 
 import numpy as np
 
-from workbench.algo.forcetube import (BRUTE_FORCE, force_tube, prismatic_tube, section_force,
-                                      stress_tensor, tube_mesh, with_tube)
+from workbench.algo.forcetube import (
+    BRUTE_FORCE,
+    force_tube,
+    prismatic_tube,
+    section_force,
+    stress_tensor,
+    tube_mesh,
+    with_tube,
+)
 from workbench.algo.membrane import with_membrane_stress
 from workbench.algo.part_distance import brute_force_part_distances, connectivity, part_distances
 from workbench.experiment.context import ExperimentContext
-from workbench.experiment.distance_refs import (TOOLS, compare_with_exact,
-                                                reference_part_distances)
+from workbench.experiment.distance_refs import TOOLS, compare_with_exact, reference_part_distances
 from workbench.experiment.figures import save_field_figure, save_image_grid
 from workbench.experiment.measure import default_camera
 from workbench.experiment.registry import experiment

@@ -43,7 +43,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from workbench.algo.softraster import STEPS, RasterOptions
-from workbench.algo.softraster.spantable import PAPER_MB, build_span_table, forget_tables, span_table
+from workbench.algo.softraster.spantable import (
+    PAPER_MB,
+    build_span_table,
+    forget_tables,
+    span_table,
+)
 from workbench.experiment.compare import compare_images, difference_map
 from workbench.experiment.context import ExperimentContext
 from workbench.experiment.figures import save_image_grid

@@ -186,14 +186,14 @@ class FEMesh:
             units=self.units,
         )
 
-    def part(self, part_id: int) -> "FEMesh":
+    def part(self, part_id: int) -> FEMesh:
         """The sub-mesh of one part, with its nodes compacted (fields follow)."""
         keep = self.parts == part_id
         if not keep.any():
             raise MeshError(f"{self.name}: no part {part_id}")
         return self.subset(keep, name=f"{self.name}:{self.part_names.get(part_id, part_id)}")
 
-    def subset(self, element_mask: np.ndarray, name: str | None = None) -> "FEMesh":
+    def subset(self, element_mask: np.ndarray, name: str | None = None) -> FEMesh:
         """The sub-mesh of the selected elements, with unreferenced nodes removed."""
         elements = self.elements[element_mask]
         used, inverse = np.unique(elements, return_inverse=True)

@@ -183,7 +183,7 @@ def build_atlas(coords, elements, labels, *, texels_per_edge: float = 2.0, borde
         local[label] = (nodes, best[1])
         scales[label] = (float(best[2][0]), float(best[2][1]))
     rects = {}
-    for label, (nodes, c2) in local.items():
+    for label, (_, c2) in local.items():
         lo, hi = c2.min(axis=0), c2.max(axis=0)
         w, h = np.ceil((hi - lo) * np.array(scales[label])).astype(int) + 1 + 2 * border
         rects[label] = (int(w), int(h), lo)

@@ -169,8 +169,6 @@ def build_model(elements, coords, params="A", *, wire_encoding: str = "corners",
     paper's rule is :data:`PAPER_TEXTURE_RULE`. Refuses empty meshes, non-finite coordinates
     and an unknown encoding.
     """
-    from . import wireid, wiretex
-    from .bake import normal_map
     from . import wiretex
 
     corners_encoding, texels_per_edge, min_width, border = _encoding_rule(

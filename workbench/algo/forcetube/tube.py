@@ -10,8 +10,15 @@ import numpy as np
 
 from ...scene.mesh import FEMesh
 from .planes import _control_points, section_planes
-from .section import (STRESS_FIELDS, THICKNESS_FIELD, _candidates, _missing, _section,
-                      crossing_elements, stress_tensor)
+from .section import (
+    STRESS_FIELDS,
+    THICKNESS_FIELD,
+    _candidates,
+    _missing,
+    _section,
+    crossing_elements,
+    stress_tensor,
+)
 
 BRUTE_FORCE = "brute force"  # force_tube(cut=BRUTE_FORCE): test every element against a plane
 

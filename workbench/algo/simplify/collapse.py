@@ -24,8 +24,7 @@ import numpy as np
 from .heap import _cost, _heap_pop, _heap_push, _new_heap
 from .recertify import _recertified
 from .rules import _ACCEPTED, _FIXED, _check_rules
-from .state import (Supports, _corner_links, _initial_supports, _lines_of, _new_marks,
-                    _new_scratch)
+from .state import Supports, _corner_links, _initial_supports, _lines_of, _new_marks, _new_scratch
 from .topology import _edge_key, _gather, _neighbours
 
 

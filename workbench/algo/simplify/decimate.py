@@ -18,8 +18,15 @@ import numpy as np
 from .certify import _final_bounds, certification_depths
 from .collapse import _decimate
 from .constraints import _constraints
-from .inputs import (_centred, _check_inputs, _distinct_faces, _part_tolerances, _quadrics,
-                     _repeated_index, _unit_normals)
+from .inputs import (
+    _centred,
+    _check_inputs,
+    _distinct_faces,
+    _part_tolerances,
+    _quadrics,
+    _repeated_index,
+    _unit_normals,
+)
 from .rules import REJECT_REASONS
 from .state import Originals, Surface
 

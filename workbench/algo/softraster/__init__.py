@@ -7,8 +7,16 @@ domains by depth (sort-last).
 """
 
 from .frame import CLEAR_DEPTH, NO_TRIANGLE, Frame
-from .pipeline import (GENERATORS, SHADINGS, STEPS, TABLE_SIZES, RasterOptions, RenderStats,
-                       Shading, render)
+from .pipeline import (
+    GENERATORS,
+    SHADINGS,
+    STEPS,
+    TABLE_SIZES,
+    RasterOptions,
+    RenderStats,
+    Shading,
+    render,
+)
 
 __all__ = ["CLEAR_DEPTH", "NO_TRIANGLE", "Frame", "GENERATORS", "SHADINGS", "STEPS",
            "TABLE_SIZES", "RasterOptions", "RenderStats", "Shading", "render"]

@@ -28,7 +28,7 @@ class Frame:
     triangle: np.ndarray
 
     @classmethod
-    def empty(cls, width: int, height: int, background=(255, 255, 255, 255)) -> "Frame":
+    def empty(cls, width: int, height: int, background=(255, 255, 255, 255)) -> Frame:
         """A cleared frame: ``background`` RGBA (0–255) everywhere, nothing drawn."""
         color = np.empty((height, width, 4), np.uint8)
         color[...] = np.asarray(background, np.uint8)

@@ -16,10 +16,9 @@ length per time. Everything is float64 numpy; nothing here knows of OpenGL.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
-from math import factorial
-from typing import Callable
 
 import numpy as np
 

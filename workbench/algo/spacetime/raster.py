@@ -34,7 +34,7 @@ class PixelGrid:
             raise ValueError(f"pixel sizes must be positive and coordinates finite: {self}")
 
     @classmethod
-    def fit(cls, lo, hi, width: int, height: int | None = None, margin: float = 0.02) -> "PixelGrid":
+    def fit(cls, lo, hi, width: int, height: int | None = None, margin: float = 0.02) -> PixelGrid:
         """Square pixels showing the box ``lo``–``hi`` (2-D, model units) with ``margin`` (a
         fraction of the larger side) on every side, centred; ``height`` defaults to the box's
         aspect."""

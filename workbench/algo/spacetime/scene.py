@@ -98,7 +98,7 @@ class SpacetimeScene:
                          c[:, 0], c[:, 1], self.t)["speed"]
         return float(speed.max())
 
-    def quadrisected(self, fraction: float) -> "SpacetimeScene":
+    def quadrisected(self, fraction: float) -> SpacetimeScene:
         """The scene with every polygon larger than ``fraction`` × the mean polygon area split
         through its edge midpoints, recursively (st2005 §4.2,
         :func:`workbench.algo.spacetime.slicing.quadrisect`); children keep their element and

@@ -119,7 +119,7 @@ def _row_layout(rng: np.random.Generator, parts: int, triangle_share: float,
     per_row[: parts % n_rows] += 1
     plans: list[_PanelPlan] = []
     y0 = 0.0
-    for row, count in enumerate(per_row):
+    for count in per_row:
         width = float(rng.uniform(250.0, 550.0))
         x0 = 0.0
         for _ in range(count):
