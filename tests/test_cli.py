@@ -31,8 +31,8 @@ def deck(tmp_path):
 
 def test_render_writes_the_image_of_a_plate(deck, tmp_path):
     out = tmp_path / "plate.png"
-    assert main(["render", str(deck), "--view", "0,0", "--up", "y", "--size", "80x60", "--projection",
-                 "orthographic", "-o", str(out)]) == 0
+    assert main(["render", str(deck), "--view", "0,0", "--up", "y", "--size", "80x60",
+                 "--projection", "orthographic", "-o", str(out)]) == 0
     image = np.asarray(Image.open(out))
     assert image.shape[:2] == (60, 80)
     drawn = (image[..., :3] != 255).any(axis=2)
@@ -101,9 +101,11 @@ def test_render_car_with_field_writes_a_colour_bar_figure(tmp_path):
 
 @pytest.mark.usefixtures("d3plot_file")
 def test_render_constant_field_of_the_d3plot(tmp_path):
-    # the sample result has one state with zero stress everywhere: a constant field still gets a scale
+    # the sample result has one state with zero stress everywhere: a constant field still gets a
+    # scale
     out = tmp_path / "d3plot.png"
-    assert main(["render", "d3plot", "--field", "von_mises", "--size", "200x150", "-o", str(out)]) == 0
+    assert main(["render", "d3plot", "--field", "von_mises", "--size", "200x150", "-o",
+                 str(out)]) == 0
     assert out.stat().st_size > 1000
 
 

@@ -268,7 +268,8 @@ def test_triangulation_matches_reference(mesh):
     elements, coords = mesh
     t = triangulate(elements, coords)
     tris, elem, corners = ref_triangulation(elements, coords)
-    assert t.triangles.dtype == np.int32 and t.element_of.dtype == np.int32 and t.corners.dtype == np.int8
+    assert (t.triangles.dtype == np.int32 and t.element_of.dtype == np.int32
+            and t.corners.dtype == np.int8)
     assert t.triangles.tolist() == tris
     assert t.element_of.tolist() == elem
     assert t.corners.tolist() == corners
@@ -291,7 +292,8 @@ def planar_elements(draw):
     origin = rng.uniform(-1, 1, 3) * draw(st.sampled_from([1.0, 1e3]))
     pts = origin + flat @ basis[:2]
     element = [0, 1, 2, 3] if k == 4 else [0, 1, 2, 2]
-    area = 0.5 * abs(np.sum(flat[:, 0] * np.roll(flat[:, 1], -1) - np.roll(flat[:, 0], -1) * flat[:, 1]))
+    area = 0.5 * abs(np.sum(flat[:, 0] * np.roll(flat[:, 1], -1)
+                            - np.roll(flat[:, 0], -1) * flat[:, 1]))
     return np.array([element], np.int32), pts, area, basis[2]
 
 
@@ -439,7 +441,8 @@ def test_gouraud_split_matches_union_find_reference(mesh, crease, seed, two_sets
     split = gouraud_split(elements, sets, crease, t)
     vertex_node, expected, vertex_of, sign = ref_gouraud(elements, sets, crease)
     assert split.vertex_node.tolist() == vertex_node
-    assert np.all(np.diff(split.vertex_node) >= 0)  # a node's vertices are contiguous, in node order
+    # a node's vertices are contiguous, in node order
+    assert np.all(np.diff(split.vertex_node) >= 0)
     assert split.elements.tolist() == expected
     assert split.added == len(vertex_node) - len(np.unique(elements))
     assert split.n_vertices == len(vertex_node)
@@ -504,7 +507,8 @@ def test_fold_normals_follow_each_face():
         users = np.flatnonzero((split.elements == v).any(axis=1))
         assert np.allclose(faces[users], faces[users[0]])  # one side of the fold per vertex
         assert np.allclose(normals[v], faces[users[0]], atol=1e-12)
-    assert {tuple(np.round(normals[v], 12)) for v in np.flatnonzero(on_fold)} == {(0, 0, 1), (-1, 0, 0)}
+    assert ({tuple(np.round(normals[v], 12)) for v in np.flatnonzero(on_fold)}
+            == {(0, 0, 1), (-1, 0, 0)})
 
 
 def test_crease_in_the_last_step_only_is_still_split():
@@ -523,7 +527,8 @@ def test_fold_back_beyond_90_degrees_is_a_crease_but_a_flipped_element_is_not():
     t = triangulate(quads, nodes)
     assert gouraud_split(quads, [hem], 40.0, t).added == 3
     _, flipped = grid(4, 2, flip=np.arange(8) == 5)  # right half, but wound the other way
-    assert gouraud_split(flipped, [folded(nodes, 2.0, 20.0)], 30.0, t := triangulate(flipped, nodes)).added == 0
+    assert gouraud_split(flipped, [folded(nodes, 2.0, 20.0)], 30.0,
+                         t := triangulate(flipped, nodes)).added == 0
     assert gouraud_split(flipped, [hem], 40.0, t).added == 3
 
 

@@ -69,7 +69,8 @@ def test_points_far_away_keep_their_distance():
     # a point above the face centroid: distance along the normal
     centroid = (a + b + c) / 3
     normal = np.ones(3) / np.sqrt(3)
-    assert point_triangle_distance(centroid + 0.25 * normal, a, b, c) == pytest.approx(0.25, abs=1e-15)
+    assert (point_triangle_distance(centroid + 0.25 * normal, a, b, c)
+            == pytest.approx(0.25, abs=1e-15))
 
 
 def test_brute_force_table_agrees_with_single_calls():
@@ -105,6 +106,7 @@ def test_a_triangle_on_its_own_face_is_at_distance_zero():
     t = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float64)
     assert triangle_bounds(t, t[None], 0.0, 4) == (0.0, 0.0)
     # split in two faces along the diagonal: the union covers t exactly
-    halves = np.array([[[0, 0, 0], [1, 0, 0], [0.5, 0.5, 0]], [[0, 0, 0], [0.5, 0.5, 0], [0, 1, 0]]])
+    halves = np.array([[[0, 0, 0], [1, 0, 0], [0.5, 0.5, 0]],
+                       [[0, 0, 0], [0.5, 0.5, 0], [0, 1, 0]]])
     lower, upper = triangle_bounds(t, halves, 1e-3, 12)
     assert lower == 0.0 and upper <= 1e-3

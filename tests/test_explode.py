@@ -183,7 +183,8 @@ def test_offset_clipped_to_range():
     big = ExplodeSettings(o_max=1.0, speed=30.0, dt=0.1)
     assert next_state(ExplodeState(offset=0.5), 1.0, big).offset == 1.0
     assert next_state(ExplodeState(offset=0.5), 0.0, big).offset == 0.0
-    assert next_state(ExplodeState(offset=5.0), 0.0, ExplodeSettings(o_max=1.0)).offset == pytest.approx(0.9)
+    assert next_state(ExplodeState(offset=5.0), 0.0,
+                      ExplodeSettings(o_max=1.0)).offset == pytest.approx(0.9)
 
 
 def test_occlusion_ratio():
@@ -306,7 +307,8 @@ def test_auto_plane_refused_when_all_rejected():
 
 def test_manual_plane_specs():
     obj = box_points((1, 2, 3), (3, 4, 7))
-    for spec, n in (("x", (1, 0, 0)), ("Y", (0, 1, 0)), ("z", (0, 0, 1)), ((0, 3, 4), (0, 0.6, 0.8))):
+    for spec, n in (("x", (1, 0, 0)), ("Y", (0, 1, 0)), ("z", (0, 0, 1)),
+                    ((0, 3, 4), (0, 0.6, 0.8))):
         plane = manual_plane(spec, obj)
         assert np.allclose(plane.normal, n) and np.allclose(plane.point, (2, 3, 5))
     with pytest.raises(ValueError, match="unknown split plane"):

@@ -114,7 +114,8 @@ def brute_angle(elements, coords, alpha):
             (f, df), (g, dg) = s
             cos = float(normals[f] @ normals[g]) * (1 if df != dg else -1)
             zero = not normals[f].any() or not normals[g].any()
-            out[key] = G1 if not zero and np.degrees(np.arccos(np.clip(cos, -1, 1))) > alpha else SMOOTH
+            out[key] = (G1 if not zero and np.degrees(np.arccos(np.clip(cos, -1, 1))) > alpha
+                        else SMOOTH)
     return out
 
 
@@ -122,7 +123,8 @@ def components(elements, labels, value):
     """Number of edge-connected components among the elements carrying ``value``."""
     idx = np.flatnonzero(labels == value)
     indptr, indices = element_adjacency(elements[idx])
-    graph = coo_matrix((np.ones(len(indices)), (np.repeat(np.arange(len(idx)), np.diff(indptr)), indices)),
+    graph = coo_matrix((np.ones(len(indices)),
+                        (np.repeat(np.arange(len(idx)), np.diff(indptr)), indices)),
                        shape=(len(idx), len(idx)))
     return connected_components(graph, directed=False)[0]
 
@@ -254,7 +256,8 @@ def test_kinds_match_a_brute_force_reference(seed, alpha, triangles):
     nodes, el = grid(5, 4, lambda u, v: (u, v, 0 * u), triangles)
     nodes[:, 2] = rng.normal(0.0, 0.08, len(nodes))
     flip = rng.random(len(el)) < 0.3
-    el[flip] = np.where(el[flip, 3:4] == el[flip, 2:3], el[flip][:, [2, 1, 0, 0]], el[flip][:, ::-1])
+    el[flip] = np.where(el[flip, 3:4] == el[flip, 2:3], el[flip][:, [2, 1, 0, 0]],
+                        el[flip][:, ::-1])
     fe = feature_edges(el, nodes, alpha, close_lines=False)
     ref = brute_angle(el, nodes, alpha)
     assert {(int(a), int(b)): int(k) for (a, b), k in zip(fe.edges, fe.kind)} == ref
@@ -332,7 +335,8 @@ def test_subpatches_respect_patches_on_a_folded_plate():
 def test_subpatch_properties_on_random_bumpy_plates(seed, d, triangles):
     rng = np.random.default_rng(seed)
     nodes, el = grid(6, 5, lambda u, v: (u, v, 0 * u), triangles)
-    nodes[:, 2] = 0.2 * np.sin(3 * nodes[:, 0] + rng.uniform(0, 6)) + rng.normal(0, 0.01, len(nodes))
+    nodes[:, 2] = (0.2 * np.sin(3 * nodes[:, 0] + rng.uniform(0, 6))
+                   + rng.normal(0, 0.01, len(nodes)))
     patch = patches(el, feature_edges(el, nodes, 20.0))
     sub = planar_subpatches(el, nodes, patch, d)
     check_subpatches(el, nodes, patch, sub, d)

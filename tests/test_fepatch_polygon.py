@@ -16,7 +16,8 @@ from workbench.algo.fepatch.polygon import polygon_area, triangulate_polygon
 # ----------------------------------------------------------------- brute-force references
 def signed_areas(pts, tris):
     a, b, c = pts[tris[:, 0]], pts[tris[:, 1]], pts[tris[:, 2]]
-    return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+    return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1])
+                  - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
 
 
 def interiors_overlap(pts, tris, rel_tol=1e-12):
@@ -35,7 +36,8 @@ def interiors_overlap(pts, tris, rel_tol=1e-12):
         for s in range(3):
             p, q = A[:, s], A[:, (s + 1) % 3]
             e = q - p
-            d = e[:, None, 0] * (B[:, :, 1] - p[:, None, 1]) - e[:, None, 1] * (B[:, :, 0] - p[:, None, 0])
+            d = (e[:, None, 0] * (B[:, :, 1] - p[:, None, 1])
+                 - e[:, None, 1] * (B[:, :, 0] - p[:, None, 0]))
             sep |= (d <= rel_tol * scale).all(axis=1)
         return sep
 
@@ -54,7 +56,8 @@ def angles_deg(pts, tris):
     for s in range(3):
         u = T[:, (s + 1) % 3] - T[:, s]
         v = T[:, (s + 2) % 3] - T[:, s]
-        out.append(np.degrees(np.arctan2(np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]), (u * v).sum(1))))
+        out.append(np.degrees(np.arctan2(np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]),
+                                         (u * v).sum(1))))
     return np.stack(out, axis=1)
 
 
@@ -78,7 +81,8 @@ def check_triangulation(pts, outer, holes, tris):
 
 
 # ----------------------------------------------------------------- random polygons with holes
-HOLE_CENTRES = [(0.0, 0.0), (0.5, 0.0), (-0.5, 0.0), (0.0, 0.5), (0.0, -0.5), (0.5, 0.5), (-0.5, -0.5)]
+HOLE_CENTRES = [(0.0, 0.0), (0.5, 0.0), (-0.5, 0.0), (0.0, 0.5), (0.0, -0.5), (0.5, 0.5),
+                (-0.5, -0.5)]
 
 
 @st.composite
@@ -133,7 +137,8 @@ def _segments_meet(p, q, r, s):
         return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
 
     def on(a, b, c):  # c on segment ab, given collinear
-        return min(a[0], b[0]) <= c[0] <= max(a[0], b[0]) and min(a[1], b[1]) <= c[1] <= max(a[1], b[1])
+        return (min(a[0], b[0]) <= c[0] <= max(a[0], b[0])
+                and min(a[1], b[1]) <= c[1] <= max(a[1], b[1]))
 
     d1, d2, d3, d4 = orient(r, s, p), orient(r, s, q), orient(p, q, r), orient(p, q, s)
     if ((d1 > 0) != (d2 > 0)) and d1 and d2 and ((d3 > 0) != (d4 > 0)) and d3 and d4:
@@ -165,7 +170,8 @@ def brute_force_simple(xy):
 
 
 @settings(max_examples=300, deadline=None)
-@given(st.lists(st.tuples(st.integers(0, 4), st.integers(0, 4)), min_size=3, max_size=9, unique=True))
+@given(st.lists(st.tuples(st.integers(0, 4), st.integers(0, 4)), min_size=3, max_size=9,
+                unique=True))
 def test_random_grid_loops_are_refused_exactly_when_not_simple(xy):
     # A 5 x 5 grid makes collinear points, touching edges and flat corners common.
     pts = np.asarray(xy, dtype=float)
@@ -212,12 +218,14 @@ def test_comb_shaped_concave_polygon():
 def test_comb_with_holes_in_every_tooth_and_offset_far_from_origin():
     # Holes share their rightmost x with each other (a column) and sit in concave pockets;
     # coordinates near 1e6 mm like a car body.
-    pts = [(0, 0), (9, 0), (9, 6), (7, 6), (7, 2), (5, 2), (5, 6), (3, 6), (3, 2), (2, 2), (2, 6), (0, 6)]
+    pts = [(0, 0), (9, 0), (9, 6), (7, 6), (7, 2), (5, 2), (5, 6), (3, 6), (3, 2), (2, 2), (2, 6),
+           (0, 6)]
     holes = []
     for cx in (1.0, 4.0, 8.0):
         for cy in (1.0, 4.0):
             base = len(pts)
-            pts += [(cx - 0.3, cy - 0.3), (cx + 0.3, cy - 0.3), (cx + 0.3, cy + 0.3), (cx - 0.3, cy + 0.3)]
+            pts += [(cx - 0.3, cy - 0.3), (cx + 0.3, cy - 0.3), (cx + 0.3, cy + 0.3),
+                    (cx - 0.3, cy + 0.3)]
             holes.append(list(range(base, base + 4)))
     pts = np.asarray(pts, dtype=float) + 1.0e6
     outer = list(range(12))
@@ -279,7 +287,8 @@ def test_triangle_input_returns_itself_counter_clockwise():
 
 
 # ----------------------------------------------------------------- refused input
-SQUARE = np.array([[0, 0], [4, 0], [4, 4], [0, 4], [1, 1], [2, 1], [2, 2], [5, 5], [1, 2]], dtype=float)
+SQUARE = np.array([[0, 0], [4, 0], [4, 4], [0, 4], [1, 1], [2, 1], [2, 2], [5, 5], [1, 2]],
+                  dtype=float)
 
 
 @pytest.mark.parametrize(
@@ -305,7 +314,8 @@ def test_refuses_bad_loops(outer, holes, message):
 def test_refuses_hole_crossing_a_pocket_of_a_comb():
     # A long thin hole spans the comb's pockets: its long edges cross the tooth walls that
     # lie between their ends in x, which the x-range candidate pairs must not miss.
-    comb = [(0, 0), (9, 0), (9, 6), (7, 6), (7, 2), (5, 2), (5, 6), (3, 6), (3, 2), (2, 2), (2, 6), (0, 6)]
+    comb = [(0, 0), (9, 0), (9, 6), (7, 6), (7, 2), (5, 2), (5, 6), (3, 6), (3, 2), (2, 2), (2, 6),
+            (0, 6)]
     pts = np.asarray(comb + [(0.5, 4.0), (8.5, 4.0), (8.5, 4.2)], dtype=float)
     with pytest.raises(ValueError, match="cross or touch"):
         triangulate_polygon(pts, list(range(12)), [[12, 13, 14]])

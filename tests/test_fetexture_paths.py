@@ -322,7 +322,8 @@ def test_clip_plane(ctx):
     assert mask.any()
     assert (x[mask] >= -PIXEL).all()
     assert mask[np.abs(x) < N / 2 * CELL - PIXEL].sum() > 0
-    assert (mask & (x > PIXEL) & (np.abs(pixel_centres()[1]) < 0.7)).sum() > 0.3 * SIZE * SIZE * 0.35
+    assert ((mask & (x > PIXEL) & (np.abs(pixel_centres()[1]) < 0.7)).sum()
+            > 0.3 * SIZE * SIZE * 0.35)
 
 
 def test_model_built_once_per_mesh_and_parameters(ctx, monkeypatch):

@@ -1,4 +1,5 @@
-"""Scene generators: the es2008 semicylinders, stamped sheet-metal parts, k×k refinement, crash steps."""
+"""Scene generators: the es2008 semicylinders, stamped sheet-metal parts, k×k refinement, crash
+steps."""
 
 from __future__ import annotations
 
@@ -194,7 +195,7 @@ def test_stamped_panels_have_holes_creases_and_a_clean_conforming_surface(target
     pair = k[1:] == k[:-1]
     cos = np.sum(n[e[1:][pair]] * n[e[:-1][pair]], axis=1)
     sharp = int((cos < np.cos(np.radians(60))).sum())
-    assert sharp >= 4 * len(np.unique(m.parts)) * 5          # four bend lines per part, many edges each
+    assert sharp >= 4 * len(np.unique(m.parts)) * 5  # four bend lines per part, many edges each
     assert np.all(areas(m.elements, m.nodes) > 0)
 
 
@@ -300,7 +301,7 @@ def test_refine_preserves_planar_area_and_winding(nx, ny, k, seed):
     child_area = areas(r.elements, r.nodes).reshape(-1, k * k).sum(axis=1)
     assert np.allclose(child_area, parent_area, rtol=1e-12, atol=1e-9)
     nz = normals(r.elements, r.nodes)[:, 2]
-    assert np.all(nz > 0)                              # every child keeps the counter-clockwise winding
+    assert np.all(nz > 0)  # every child keeps the counter-clockwise winding
 
 
 @settings(max_examples=30, deadline=None)
@@ -417,7 +418,7 @@ def test_crash_sequence_axis_and_refusals():
     c = crash_sequence(m, steps=3, crush=0.2, axis="-z")
     back = np.argmin(m.nodes[:, 2])
     assert np.isclose(c.steps[-1, back, 2] - m.nodes[back, 2], 0.2 * np.ptp(m.nodes[:, 2]))
-    default = crash_sequence(m, steps=2, crush=0.1)            # car body coordinates: front at min x
+    default = crash_sequence(m, steps=2, crush=0.1)  # car body coordinates: front at min x
     left = np.argmin(m.nodes[:, 0])
     assert np.isclose(default.steps[-1, left, 0] - m.nodes[left, 0], 0.1 * np.ptp(m.nodes[:, 0]))
     with pytest.raises(MeshError):

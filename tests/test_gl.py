@@ -31,7 +31,8 @@ def ctx():
 
 
 def draw_quad(ctx, camera, corners, size=(64, 48), samples=0, depth_bits=24, depth=None):
-    """Draw the float64 quad ``corners`` (4, 3) in red on white; return the image and samples passed.
+    """Draw the float64 quad ``corners`` (4, 3) in red on white; return the image and samples
+    passed.
 
     ``depth``, a list, receives the depth image (single-sampled targets only).
     """
@@ -88,7 +89,8 @@ def test_project_matches_rasterised_corners(ctx):
 
 def test_near_far_enclose_sphere_tightly():
     for projection in ("orthographic", "perspective"):
-        cam = Camera.fit([0, 0, 0], 5.0, azimuth=45, elevation=30, projection=projection, margin=1.0)
+        cam = Camera.fit([0, 0, 0], 5.0, azimuth=45, elevation=30, projection=projection,
+                         margin=1.0)
         dist = np.linalg.norm(cam.eye - cam.target)
         assert np.isclose(cam.far - dist, 5.0)
         assert cam.near > 0 and np.isclose(dist - cam.near, 5.0)
@@ -130,7 +132,8 @@ def test_fit_box_frames_a_long_box_tightly():
 
 
 def test_far_origin_keeps_subpixel_precision(ctx):
-    # with world-space float32 upload, 1e7 offsets lose ~1 unit; relative upload keeps the edge exact
+    # with world-space float32 upload, 1e7 offsets lose ~1 unit; relative upload keeps the edge
+    # exact
     o = np.array([1e7, 1e7, 0.0])
     cam = Camera.fit(o, 1.0, margin=1.0)
     corners = o + np.array([[-0.5, -0.5, 0], [0.5, -0.5, 0], [0.5, 0.5, 0], [-0.5, 0.5, 0]])
@@ -154,7 +157,8 @@ def test_every_shader_ships_with_the_package():
 
     from workbench.gl.shaders import shader_source
 
-    shipped = {p.name for p in resources.files("workbench.glsl").iterdir() if p.name.endswith(".glsl")}
+    shipped = {p.name for p in resources.files("workbench.glsl").iterdir()
+               if p.name.endswith(".glsl")}
     checkout = Path(__file__).resolve().parents[1] / "glsl"
     if checkout.is_dir():
         assert shipped == {p.name for p in checkout.glob("*.glsl")}

@@ -282,8 +282,8 @@ def test_nearest_per_part_matches_brute_force(options, kind, leaf):
 def test_cutoff_is_inclusive():
     # two parallel unit squares exactly 1 apart
     pts = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
-    mesh = FEMesh(nodes=np.concatenate([pts, pts + [0, 0, 1]]), elements=[[0, 1, 2, 3], [4, 5, 6, 7]],
-                  parts=[1, 2])
+    mesh = FEMesh(nodes=np.concatenate([pts, pts + [0, 0, 1]]),
+                  elements=[[0, 1, 2, 3], [4, 5, 6, 7]], parts=[1, 2])
     for kind in KINDS:
         h = ElementHierarchy(mesh, kind=kind)
         ptr = np.arange(9)  # every point excludes its own part

@@ -357,7 +357,8 @@ ids = st.integers(-(2**40), 2**40)
 coordinates = st.floats(-1e6, 1e6, allow_nan=False).map(lambda v: float(f"{v:.7g}"))
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=40, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(data=st.data())
 def test_random_decks_read_back(tmp_path, data):
     n = data.draw(st.integers(3, 12))
@@ -368,7 +369,8 @@ def test_random_decks_read_back(tmp_path, data):
     free = data.draw(st.lists(st.booleans(), min_size=2 * n, max_size=2 * n))
     lines = ["*NODE"]
     for k, (nid, (x, y, z)) in enumerate(zip(node_ids, xyz)):
-        lines.append(f"{nid},{x!r},{y!r},{z!r}" if free[k] else f"{nid:8d}{x:16.7g}{y:16.7g}{z:16.7g}")
+        lines.append(f"{nid},{x!r},{y!r},{z!r}" if free[k]
+                     else f"{nid:8d}{x:16.7g}{y:16.7g}{z:16.7g}")
     m = data.draw(st.integers(1, 8))
     cells = data.draw(st.lists(st.lists(st.sampled_from(node_ids), min_size=4, max_size=4),
                                min_size=m, max_size=m))
@@ -576,8 +578,9 @@ def test_trimesh_stl_round_trip(tmp_path):
     assert mesh.is_triangle.all()
     lo, hi = mesh.bounds()
     assert np.allclose(lo, [-0.5, -1.0, -1.5]) and np.allclose(hi, [0.5, 1.0, 1.5])
-    area = 0.5 * np.linalg.norm(np.cross(mesh.nodes[mesh.elements[:, 1]] - mesh.nodes[mesh.elements[:, 0]],
-                                         mesh.nodes[mesh.elements[:, 2]] - mesh.nodes[mesh.elements[:, 0]]), axis=1)
+    area = 0.5 * np.linalg.norm(
+        np.cross(mesh.nodes[mesh.elements[:, 1]] - mesh.nodes[mesh.elements[:, 0]],
+                 mesh.nodes[mesh.elements[:, 2]] - mesh.nodes[mesh.elements[:, 0]]), axis=1)
     assert area.sum() == pytest.approx(box.area)
 
 
@@ -657,7 +660,8 @@ def test_underscores_in_numbers_are_refused(tmp_path, card, line):
     assert info.value.line == line
 
 
-@given(st.integers(-2**40, 2**40), st.sampled_from(["{:d}", "{:.1f}", "{:.15E}", "{:.0f}.", "{:+.2f}"]))
+@given(st.integers(-2**40, 2**40),
+       st.sampled_from(["{:d}", "{:.1f}", "{:.15E}", "{:.0f}.", "{:+.2f}"]))
 def test_integer_field_parser_takes_integral_values_in_any_notation(value, form):
     from workbench.scene.readers.cards import _convert
 
@@ -833,7 +837,8 @@ def test_include_uses_the_parameters_of_the_including_deck(tmp_path):
     assert [str(w.message) for w in record] == [
         f"{part}:6: *SECTION_SHELL: parameter 't' is not defined by *PARAMETER in this deck or "
         f"its includes: the thickness is missing"]
-    assert np.array_equal(alone.nodes, mesh.nodes) and np.isnan(alone.element_fields["thickness"]).all()
+    assert (np.array_equal(alone.nodes, mesh.nodes)
+            and np.isnan(alone.element_fields["thickness"]).all())
 
 
 def test_rendering_a_missing_thickness_draws_the_base_colour(tmp_path):
@@ -981,7 +986,8 @@ def test_d3plot_with_solids_reads_their_boundary_and_renders(tmp_path):
 
 
 # --------------------------------------------------------------------------- field parsers
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=60, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(data=st.data())
 def test_fixed_and_comma_node_cards_decode_every_value(tmp_path, data):
     """Random node ids and coordinates written in fixed columns (plain, exponent, Fortran ``D``,

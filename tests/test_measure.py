@@ -156,8 +156,9 @@ def test_derivation_cost_accounts_every_item_once():
     assert set(everything.items) == set(MESH_ITEMS)
     part = derive(mesh, {"triangles"}, Style())
     assert part.nbytes == everything.items["triangles"][1]
-    assert part.nbytes == mesh.triangulation.triangles.nbytes + mesh.triangulation.element_of.nbytes \
-        + mesh.triangulation.corners.nbytes
+    assert part.nbytes == (mesh.triangulation.triangles.nbytes
+                           + mesh.triangulation.element_of.nbytes
+                           + mesh.triangulation.corners.nbytes)
     assert everything.nbytes > part.nbytes
 
 

@@ -113,7 +113,8 @@ def test_colorscale_matches_its_texture():
     assert np.allclose(scale.evaluate(-2.0 + 8.0 * i / 255) * 255, lut[i])
     assert np.allclose(scale.evaluate([-10.0, 60.0]) * 255, lut[[0, 255]])
     # halfway between two texels: their mean
-    assert np.allclose(scale.evaluate(-2.0 + 8.0 * 10.5 / 255) * 255, (lut[10] + lut[11].astype(float)) / 2)
+    assert np.allclose(scale.evaluate(-2.0 + 8.0 * 10.5 / 255) * 255,
+                       (lut[10] + lut[11].astype(float)) / 2)
     bands = ColorScale("viridis", (0.0, 1.0), bands=4)
     got = bands.evaluate(np.linspace(0, 1, 400)) * 255
     assert len(np.unique(got, axis=0)) == 4
@@ -323,7 +324,8 @@ def test_flat_and_gouraud_on_a_fold(ctx):
     cam = camera(azimuth=20.0)
     base = np.array((0.75, 0.75, 0.78))
     # |n·l| of the two faces for an eye 20° towards +x: cos 65° (left) and cos 25° (right)
-    face = {f: base * (0.25 + 0.75 * np.cos(np.radians(a))) * 255 for f, a in (("L", 65), ("R", 25))}
+    face = {f: base * (0.25 + 0.75 * np.cos(np.radians(a))) * 255
+            for f, a in (("L", 65), ("R", 25))}
     flat, _ = render(ctx, "flat", mesh, cam)
     mask = covered(flat)
     assert len(colors(flat, mask)) == 2
@@ -389,7 +391,8 @@ def test_wireframe_draws_element_edges_not_diagonals(ctx, name):
     y_top, y_bottom = 1.0 - 16.5 * p, 1.0 - 48.5 * p
     mesh = grid(2, 1, x0, x2, y_bottom, y_top)
     kw = {"field": "x"} if name == "pixel_color" else {}
-    image, path = render(ctx, name, mesh, camera(), wireframe=True, wire_color=(1.0, 0.0, 0.0), **kw)
+    image, path = render(ctx, name, mesh, camera(), wireframe=True, wire_color=(1.0, 0.0, 0.0),
+                         **kw)
     wire = (image[..., 0] == 255) & (image[..., 1] == 0) & (image[..., 2] == 0)
     assert path.edges == 7
     for col in (16, 32, 48):

@@ -72,7 +72,8 @@ def test_every_reference_runs_at_our_triangle_count(result):
             if r.get("stopped_at") is not None:
                 assert r["stopped_at"] == r["triangles"] > r["target_triangles"]
             else:
-                assert r["triangles"] <= r["target_triangles"] + max(1, r["target_triangles"] // 100)
+                assert r["triangles"] <= (r["target_triangles"]
+                                          + max(1, r["target_triangles"] // 100))
 
 
 def test_locked_rows_keep_every_border_vertex(result):

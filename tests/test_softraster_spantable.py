@@ -202,7 +202,8 @@ def _no_meta(p):
     np.savez(p, lo=lo, hi=hi)
 
 
-@pytest.mark.parametrize("damage", [_truncate, _garbage, _wrong_shape, _flipped_byte, _wrong_content, _no_meta])
+@pytest.mark.parametrize("damage", [_truncate, _garbage, _wrong_shape, _flipped_byte,
+                                    _wrong_content, _no_meta])
 def test_damaged_cache_file_is_rebuilt(fresh, tmp_path, damage):
     good = span_table(5, cache_dir=tmp_path)
     ref_lo, ref_hi = np.array(good.lo), np.array(good.hi)

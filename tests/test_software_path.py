@@ -65,7 +65,8 @@ def test_software_image_matches_the_gl_image(ctx, panels, name, options, view):
 def test_software_coverage_of_the_es2008_scene_is_llvmpipes(ctx, sheets):
     camera = default_camera(sheets, SIZE, view=(0.0, 0.0), up="y")
     gl = measure(ctx, sheets, "position", camera=camera, size=SIZE, timed=False)
-    soft = measure(SOFTWARE, sheets, SoftwarePath("position"), camera=camera, size=SIZE, timed=False)
+    soft = measure(SOFTWARE, sheets, SoftwarePath("position"), camera=camera, size=SIZE,
+                   timed=False)
     if "llvmpipe" not in renderer(ctx):
         pytest.skip("pixel-exact coverage is llvmpipe's rule")
     assert np.array_equal(soft.image, gl.image)
@@ -82,7 +83,8 @@ def test_table_rule_deviates_only_along_edges(ctx, sheets):
 
 
 def test_measure_times_the_software_path(sheets):
-    result = measure(SOFTWARE, sheets, SoftwarePath("pixel_color", Style(field="distance", bands=8)),
+    result = measure(SOFTWARE, sheets,
+                     SoftwarePath("pixel_color", Style(field="distance", bands=8)),
                      size=SIZE, repeats=5, warmup=1)
     row = result.row
     assert row["renderer"].startswith("software rasterizer (half-space, 8 sub-pixel bits")

@@ -1,4 +1,5 @@
-"""Boundary faces of LS-DYNA solid meshes (workbench.scene.solids): exact sharing, outward winding."""
+"""Boundary faces of LS-DYNA solid meshes (workbench.scene.solids): exact sharing, outward
+winding."""
 
 from collections import Counter
 from itertools import permutations, product
@@ -122,7 +123,8 @@ def test_hex_block_boundary_is_outer_quads_outward(n, m, k):
     on = np.isclose(centre, lo) | np.isclose(centre, hi)
     assert on.sum(axis=1).min() == 1
     ext = hi - lo
-    assert np.isclose(area(nodes, elements), 2 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[0] * ext[2]))
+    assert np.isclose(area(nodes, elements),
+                      2 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[0] * ext[2]))
     assert as_set(elements, element_of) == ref_boundary(solids)
     FEMesh(nodes, elements, parts)  # drawable as is
 
@@ -136,7 +138,8 @@ def test_tet_block_boundary_is_outer_triangles(n, m, k):
     assert (elements[:, 3] == elements[:, 2]).all()
     assert len(elements) == 2 * 2 * (n * m + m * k + n * k)
     ext = nodes.max(0) - nodes.min(0)
-    assert np.isclose(area(nodes, elements), 2 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[0] * ext[2]))
+    assert np.isclose(area(nodes, elements),
+                      2 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[0] * ext[2]))
     assert np.isclose(enclosed_volume(nodes, elements), ext.prod())
     normal, centre = normals_centres(nodes, elements)
     assert (np.einsum("ij,ij->i", normal, centre - nodes.mean(0)) > 0).all()
@@ -181,7 +184,8 @@ def test_mixed_mesh():
 
 
 def hex_symmetries():
-    """The 48 re-numberings of one hex (24 rotations, 24 inverted): new row j = old corner sigma(j)."""
+    """The 48 re-numberings of one hex (24 rotations, 24 inverted): new row j = old corner
+    sigma(j)."""
     out = []
     for perm in permutations(range(3)):
         for flips in product((0, 1), repeat=3):
@@ -253,7 +257,8 @@ def test_solid_faces_fields_and_all_faces():
     assert np.bincount(sf.element).tolist() == [6, 5, 5, 4]
     assert sf.local.tolist() == [0, 1, 2, 3, 4, 5] + [0, 1, 2, 3, 4] * 2 + [0, 1, 2, 3]
     # local numbering: hex face 0 is n1 n4 n3 n2, face 5 is n5..n8
-    assert key(sf.faces[0]) == key(solids[0, :4]) and oriented(sf.faces[0]) == oriented(solids[0, [0, 3, 2, 1]])
+    assert (key(sf.faces[0]) == key(solids[0, :4])
+            and oriented(sf.faces[0]) == oriented(solids[0, [0, 3, 2, 1]]))
     assert key(sf.faces[5]) == key(solids[0, 4:])
     # penta face 1 is the triangle n1 n2 n5
     assert key(sf.faces[7]) == key(solids[1, [0, 1, 4]]) and sf.faces[7, 3] == sf.faces[7, 2]

@@ -79,7 +79,8 @@ def _navier_residual(field, material: Material, x, y, t) -> tuple[np.ndarray, np
     u_tt = d2(0, 0, dt) / dt**2
     u_xx = d2(h, 0, 0) / h**2
     u_yy = d2(0, h, 0) / h**2
-    u_xy = (u(x + h, y + h, t) - u(x + h, y - h, t) - u(x - h, y + h, t) + u(x - h, y - h, t)) / (4 * h * h)
+    u_xy = (u(x + h, y + h, t) - u(x + h, y - h, t) - u(x - h, y + h, t)
+            + u(x - h, y - h, t)) / (4 * h * h)
     grad_div = np.stack([u_xx[..., 0] + u_xy[..., 1], u_xy[..., 0] + u_yy[..., 1]], axis=-1)
     lap = u_xx + u_yy
     lhs = material.rho * u_tt
@@ -112,7 +113,8 @@ def test_velocity_and_gradient_agree_with_finite_differences(field):
 
     def d1(dx, dy, dtt, step):  # fourth-order central difference
         return (-u(x + 2 * dx, y + 2 * dy, t + 2 * dtt) + 8 * u(x + dx, y + dy, t + dtt)
-                - 8 * u(x - dx, y - dy, t - dtt) + u(x - 2 * dx, y - 2 * dy, t - 2 * dtt)) / (12 * step)  # fmt: skip
+                - 8 * u(x - dx, y - dy, t - dtt)
+                + u(x - 2 * dx, y - 2 * dy, t - 2 * dtt)) / (12 * step)  # fmt: skip
 
     v_fd = d1(0, 0, dt, dt)
     g_fd = np.stack([d1(h, 0, 0, h), d1(0, h, 0, h)], axis=-1)  # [..., i, j] = ∂u_i/∂x_j
@@ -122,7 +124,8 @@ def test_velocity_and_gradient_agree_with_finite_differences(field):
     assert np.abs(v - v_fd).max() <= 1e-6 * np.abs(v).max()
     assert np.abs(g - g_fd).max() <= 1e-6 * np.abs(g).max()
     np.testing.assert_allclose(field.speed(x, y, t), np.hypot(v[:, 0], v[:, 1]), rtol=1e-15)
-    np.testing.assert_allclose(field.strain_energy(x, y, t), strain_energy_density(g, field.material), rtol=1e-15)
+    np.testing.assert_allclose(field.strain_energy(x, y, t),
+                               strain_energy_density(g, field.material), rtol=1e-15)
 
 
 @pytest.mark.parametrize("field", FIELDS, ids=IDS)
@@ -139,7 +142,8 @@ def test_broadcasting_and_float64(field):
 
 @pytest.mark.parametrize("field", FIELDS, ids=IDS)
 def test_translation_by_origin(field):
-    """The field with origin o at x + o equals the field with origin 0 at x (o ≈ 10⁴ element sizes)."""
+    """The field with origin o at x + o equals the field with origin 0 at x (o ≈ 10⁴ element
+    sizes)."""
     rng = np.random.default_rng(RNG_SEED + 2)
     o = (12345.678, -9876.54321)
     moved = type(field)(**{**field.__dict__, "origin": o})
@@ -204,7 +208,8 @@ def test_radial_pulse_is_radially_symmetric():
                 u_ref = radial
             np.testing.assert_allclose(radial, u_ref, rtol=1e-10, atol=1e-14 * np.abs(u_ref).max())
             speed = f.speed(x, y, t)
-            np.testing.assert_allclose(speed, f.speed(f.centre[0] + r, f.centre[1], t), rtol=1e-10, atol=1e-18)
+            np.testing.assert_allclose(speed, f.speed(f.centre[0] + r, f.centre[1], t), rtol=1e-10,
+                                       atol=1e-18)
         # the pulse is a ring at r ≈ c (t + t0)
         peak_r = r[np.argmax(np.abs(u_ref))]
         assert abs(peak_r - f.material.p_wave_speed * (t + f.t0)) < 3.0 * f.a
@@ -225,7 +230,8 @@ def test_radial_pulse_is_finite_and_smooth_for_t_ge_0():
         assert jumps.max() <= 1.01 * np.abs(v[:, 0]).max() * dt + 1e-18
         # and the trapezoid rule over v reproduces the displacement change
         integral = np.sum(0.5 * (v[1:, 0] + v[:-1, 0])) * dt
-        assert integral == pytest.approx(u[-1, 0] - u[0, 0], abs=1e-6 * np.abs(u[:, 0]).max() + 1e-18)
+        assert integral == pytest.approx(u[-1, 0] - u[0, 0],
+                                         abs=1e-6 * np.abs(u[:, 0]).max() + 1e-18)
 
 
 def test_radial_pulse_refuses_bad_parameters_and_times():
@@ -253,14 +259,18 @@ def test_default_fields_have_strains_of_order_1e_3():
 def test_front_distance():
     f = PlaneWave(direction=(3.0, 4.0), x0=(1.0, 2.0))
     c = f.material.p_wave_speed
-    xy = np.array([[1.0 + 0.6 * c * 2.0, 2.0 + 0.8 * c * 2.0], [1.0 + 0.6 * (c * 2.0 + 7.0), 2.0 + 0.8 * (c * 2.0 + 7.0)]])
+    xy = np.array([[1.0 + 0.6 * c * 2.0, 2.0 + 0.8 * c * 2.0],
+                   [1.0 + 0.6 * (c * 2.0 + 7.0), 2.0 + 0.8 * (c * 2.0 + 7.0)]])
     np.testing.assert_allclose(f.front_distance(xy, 2.0), [0.0, 7.0], atol=1e-12)
     r = RadialPulse(centre=(1.0, 1.0))
     R = r.material.p_wave_speed * (3.0 + r.t0)
-    np.testing.assert_allclose(r.front_distance(np.array([[1.0 + R, 1.0], [1.0, 1.0 + R - 4.0], [1.0, 1.0]]), 3.0), [0.0, 4.0, R])
+    np.testing.assert_allclose(
+        r.front_distance(np.array([[1.0 + R, 1.0], [1.0, 1.0 + R - 4.0], [1.0, 1.0]]), 3.0),
+        [0.0, 4.0, R])
     w = ReflectingWave()
     c = w.material.p_wave_speed
-    np.testing.assert_allclose(w.front_distance(np.array([[w.s0 - c * 1.0, 0.0], [0.0, 0.0]]), 1.0), [0.0, w.s0 - c])
+    np.testing.assert_allclose(w.front_distance(np.array([[w.s0 - c * 1.0, 0.0], [0.0, 0.0]]), 1.0),
+                               [0.0, w.s0 - c])
     # the energy of the field is concentrated near the front
     for fld in (f, r, w):
         xs, ys = np.meshgrid(np.linspace(-80, 80, 321), np.linspace(-80, 80, 321))
@@ -276,9 +286,11 @@ def test_front_distance():
 def test_materials():
     assert STEEL.p_wave_speed == pytest.approx(math.sqrt(210 * 0.7 / (1.3 * 0.4) / 7.85), rel=1e-12)
     assert BAR.lam == 0.0 and BAR.mu == pytest.approx(105.0)
-    assert BAR.p_wave_speed == pytest.approx(math.sqrt(210.0 / 7.85), rel=1e-12)  # ≈ 5.17 mm/µs = km/s
-    for bad in ({"E": 0.0, "nu": 0.3, "rho": 1.0}, {"E": 1.0, "nu": 0.5, "rho": 1.0}, {"E": 1.0, "nu": -1.0, "rho": 1.0},
-                {"E": 1.0, "nu": 0.2, "rho": 0.0}, {"E": float("nan"), "nu": 0.2, "rho": 1.0}):  # fmt: skip
+    # ≈ 5.17 mm/µs = km/s
+    assert BAR.p_wave_speed == pytest.approx(math.sqrt(210.0 / 7.85), rel=1e-12)
+    for bad in ({"E": 0.0, "nu": 0.3, "rho": 1.0}, {"E": 1.0, "nu": 0.5, "rho": 1.0},
+                {"E": 1.0, "nu": -1.0, "rho": 1.0}, {"E": 1.0, "nu": 0.2, "rho": 0.0},
+                {"E": float("nan"), "nu": 0.2, "rho": 1.0}):  # fmt: skip
         with pytest.raises(ValueError):
             Material.from_young(**bad)
     with pytest.raises(ValueError):
@@ -296,7 +308,8 @@ def test_materials():
     st.floats(-0.9, 0.49),
 )
 def test_strain_energy_matches_plane_strain_stiffness(grad, E, nu):
-    """U from the Lamé form against ½ eᵀ C e with the plane-strain Voigt matrix (engineering shear)."""
+    """U from the Lamé form against ½ eᵀ C e with the plane-strain Voigt matrix (engineering
+    shear)."""
     m = Material.from_young(E, nu, 7.0)
     U = strain_energy_density(grad, m)
     eps = 0.5 * (grad + grad.T)
@@ -305,7 +318,8 @@ def test_strain_energy_matches_plane_strain_stiffness(grad, E, nu):
     C = k * np.array([[1 - nu, nu, 0], [nu, 1 - nu, 0], [0, 0, (1 - 2 * nu) / 2]])
     ref = 0.5 * e @ C @ e * 1e6
     assert U >= 0.0
-    assert U == pytest.approx(ref, rel=1e-9, abs=1e-9 * (E * np.abs(grad).max() ** 2 * 1e6) + 1e-300)
+    assert U == pytest.approx(ref, rel=1e-9,
+                              abs=1e-9 * (E * np.abs(grad).max() ** 2 * 1e6) + 1e-300)
     # rotation-free: a pure rotation (antisymmetric gradient) stores no energy
     assert strain_energy_density(np.array([[0.0, 1e-3], [-1e-3, 0.0]]), m) == 0.0
 
@@ -314,7 +328,8 @@ def test_strain_energy_of_the_bar_and_shapes():
     eps = np.array([1e-3, -2e-3, 5e-4])
     g = np.zeros((3, 2, 2))
     g[:, 0, 0] = eps
-    np.testing.assert_allclose(strain_energy_density(g, BAR), 0.5 * 210.0 * eps**2 * 1e6, rtol=1e-14)
+    np.testing.assert_allclose(strain_energy_density(g, BAR), 0.5 * 210.0 * eps**2 * 1e6,
+                               rtol=1e-14)
     assert strain_energy_density(g.astype(np.float32), BAR).dtype == np.float32
     with pytest.raises(ValueError, match=r"\(\.\.\., 2, 2\)"):
         strain_energy_density(np.zeros((3, 3)), BAR)

@@ -69,7 +69,8 @@ def max_slope(mesh: SpacetimeMesh) -> float:
 
 # --------------------------------------------------------------------------- space meshes
 @PROPERTY
-@given(nx=st.integers(1, 7), ny=st.integers(1, 7), jitter=st.floats(0.0, 0.349), seed=st.integers(0, 99))
+@given(nx=st.integers(1, 7), ny=st.integers(1, 7), jitter=st.floats(0.0, 0.349),
+       seed=st.integers(0, 99))
 def test_rect_triangulation_covers_the_rectangle(nx, ny, jitter, seed):
     p, t = rect_triangulation(nx, ny, size=(2.0, 0.5), origin=(-1.0, 3.0), jitter=jitter, seed=seed)
     assert p.shape == ((nx + 1) * (ny + 1), 2) and t.shape == (2 * nx * ny, 3)
@@ -258,7 +259,8 @@ def test_shared_facets_match_a_brute_force_count(build):
     else:
         p, s = rect_triangulation(5, 4, jitter=0.2, seed=3)
         m = (tent_pitch(p, s, 0.0, 0.3, 1.0) if build == "tent 2-D" else
-             front_refined(p, s, 0.4, 1.0, front_distance=ring_front, bands=4, width=0.05, levels=2))
+             front_refined(p, s, 0.4, 1.0, front_distance=ring_front, bands=4, width=0.05,
+                           levels=2))
     counts = face_counts(m)
     k = m.simplices.shape[1]
     expected = np.array([[counts[tuple(np.sort(np.delete(row, i)))] > 1 for i in range(k)]
@@ -303,7 +305,8 @@ def test_front_refined_volume_is_exact(bands, levels, width, seed):
 @given(bands=st.integers(1, 4), levels=st.integers(0, 3), n=st.integers(2, 8))
 def test_front_refined_1d(bands, levels, n):
     p, s = interval_mesh(n, length=1.0, jitter=0.2)
-    m = front_refined(p, s, 0.6, 1.0, front_distance=bar_front, bands=bands, levels=levels, width=0.05)
+    m = front_refined(p, s, 0.6, 1.0, front_distance=bar_front, bands=bands, levels=levels,
+                      width=0.05)
     vol = spacetime_volume(m)
     assert np.all(vol > 0) and np.isclose(vol.sum(), 0.6, rtol=1e-9)
     assert max_slope(m) <= 0.5 * (1 + 1e-9)

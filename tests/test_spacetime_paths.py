@@ -120,7 +120,8 @@ def test_bar_spacetime_triangles(ctx):
     corners = scene.corners
     centre = np.c_[scene.centre[:, 0], np.zeros(len(corners)), scene.centre[:, 1]]
     extent = np.c_[scene.extent[:, 0], np.ones(len(corners)), scene.extent[:, 1]]
-    bar = SpacetimeScene(corners, scene.element, scene.coeffs, centre, extent, BAR.lam, BAR.mu, t=None)
+    bar = SpacetimeScene(corners, scene.element, scene.coeffs, centre, extent, BAR.lam, BAR.mu,
+                         t=None)
     for shading in ("per_pixel", "per_vertex"):
         image, grid = _top(ctx, bar, shading)
         exact = _exact(bar, grid, lighting=False)

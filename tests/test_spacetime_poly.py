@@ -99,7 +99,9 @@ tets = hnp.arrays(np.float64, (4, 3), elements=coords)
 triangles = hnp.arrays(np.float64, (3, 2), elements=coords)
 # coefficients 0 or of magnitude 1e-6..1: tolerances scale with the largest, and subnormal
 # coefficients would only test the rounding of subnormals
-cubic_coeffs = hnp.arrays(np.float64, (20, 2), elements=st.one_of(st.just(0.0), st.floats(1e-6, 1.0), st.floats(-1.0, -1e-6)))
+cubic_coeffs = hnp.arrays(np.float64, (20, 2),
+                          elements=st.one_of(st.just(0.0), st.floats(1e-6, 1.0),
+                                             st.floats(-1.0, -1e-6)))
 
 
 # --------------------------------------------------------------------------- monomials
@@ -112,7 +114,8 @@ def test_exponents_are_the_papers_order():
 
 
 @PROPERTY
-@given(hnp.arrays(np.float64, (5, 3), elements=st.floats(-2.0, 2.0)), st.sampled_from([None, "x", "y", "t", "xt", "yt", "tx", "xx", "ttt"]))
+@given(hnp.arrays(np.float64, (5, 3), elements=st.floats(-2.0, 2.0)),
+       st.sampled_from([None, "x", "y", "t", "xt", "yt", "tx", "xx", "ttt"]))
 def test_monomials_against_brute_force(p, deriv):
     got = monomials(p, deriv)
     orders = [0, 0, 0] if deriv is None else [deriv.count(a) for a in "xyt"]
@@ -123,7 +126,8 @@ def test_monomials_against_brute_force(p, deriv):
                 if e[axis] < orders[axis]:
                     ref = 0.0
                     break
-                ref *= math.perm(int(e[axis]), orders[axis]) * p[k, axis] ** int(e[axis] - orders[axis])
+                ref *= (math.perm(int(e[axis]), orders[axis])
+                        * p[k, axis] ** int(e[axis] - orders[axis]))
             assert got[k, a] == pytest.approx(ref, rel=1e-13, abs=1e-13)
 
 
@@ -164,7 +168,8 @@ def test_fit_is_well_conditioned():
         assert max(fit_conditioning(d, 4)) < 1e3
     v = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 1, 1]])
     centre, extent = local_frames(v, np.array([[0, 1, 2, 3]]))
-    lat = np.array([(i, j, k, 4 - i - j - k) for i in range(5) for j in range(5 - i) for k in range(5 - i - j)]) / 4
+    lat = np.array([(i, j, k, 4 - i - j - k) for i in range(5) for j in range(5 - i)
+                    for k in range(5 - i - j)]) / 4
     assert len(lat) == 35
     assert np.linalg.cond(monomials(lat @ ((v - centre) / extent))) < 1e3
 
@@ -214,7 +219,8 @@ def test_fit_reproduces_cubics_on_spacetime_triangles(v, a):
     got = evaluate(coeffs, centre, extent, el, x, y, t)
     scale = np.abs(u(v[:, 0], 0.0, v[:, 1])).max() + np.abs(a).max()
     assert np.abs(got["displacement"] - u(x, y, t)).max() <= 1e-9 * scale
-    assert np.abs(got["velocity"] - monomials(np.stack([x, y, t], -1), "t") @ a).max() <= 1e-8 * scale
+    assert (np.abs(got["velocity"] - monomials(np.stack([x, y, t], -1), "t") @ a).max()
+            <= 1e-8 * scale)
     np.testing.assert_array_equal(got["grad_u"][:, :, 1], 0.0)  # nothing depends on y
 
 
@@ -223,10 +229,12 @@ def test_fit_is_independent_of_chunking_and_lattice_order():
     f = PlaneWave(direction=(1.0, 0.3))
     ref = fit_cubic(pts, simp, f.displacement)
     for chunk in (1, 7):  # the same up to the summation order inside BLAS
-        np.testing.assert_allclose(fit_cubic(pts, simp, f.displacement, chunk=chunk), ref, rtol=0, atol=1e-13 * np.abs(ref).max())
+        np.testing.assert_allclose(fit_cubic(pts, simp, f.displacement, chunk=chunk), ref, rtol=0,
+                                   atol=1e-13 * np.abs(ref).max())
     a = np.random.default_rng(2).normal(size=(20, 2))
     exact = fit_cubic(pts, simp, global_cubic(a), lattice=3)  # interpolation at 20 points
-    np.testing.assert_allclose(fit_cubic(pts, simp, global_cubic(a), lattice=6), exact, rtol=0, atol=1e-9 * np.abs(exact).max())
+    np.testing.assert_allclose(fit_cubic(pts, simp, global_cubic(a), lattice=6), exact, rtol=0,
+                               atol=1e-9 * np.abs(exact).max())
 
 
 # --------------------------------------------------------------------------- derivatives
@@ -250,8 +258,10 @@ def test_evaluate_derivatives_match_the_closed_form_of_a_cubic(v, a):
     assert np.abs(got["velocity"] - vel).max() <= 1e-9 * scale
     assert np.abs(got["grad_u"] - grad).max() <= 1e-9 * scale
     np.testing.assert_allclose(got["speed"], speed, rtol=0, atol=1e-9 * scale)
-    assert np.abs(got["grad_speed"] - grad_speed).max() <= 1e-9 * scale * (1.0 + np.abs(dv).max() / speed.min())
-    np.testing.assert_allclose(got["U"], strain_energy_density(grad, STEEL), rtol=0, atol=1e-8 * scale**2 * 1e8)
+    assert (np.abs(got["grad_speed"] - grad_speed).max()
+            <= 1e-9 * scale * (1.0 + np.abs(dv).max() / speed.min()))
+    np.testing.assert_allclose(got["U"], strain_energy_density(grad, STEEL), rtol=0,
+                               atol=1e-8 * scale**2 * 1e8)
 
 
 def test_evaluate_derivatives_match_finite_differences_of_the_fit():
@@ -286,7 +296,8 @@ def test_evaluate_derivatives_match_finite_differences_of_the_fit():
 
 
 # --------------------------------------------------------------------------- convergence
-@pytest.mark.parametrize("field", [PlaneWave(direction=(1.0, 0.5)), RadialPulse(), ReflectingWave(s0=3.0)], ids=["plane", "radial", "reflecting"])
+@pytest.mark.parametrize("field", [PlaneWave(direction=(1.0, 0.5)), RadialPulse(),
+                                   ReflectingWave(s0=3.0)], ids=["plane", "radial", "reflecting"])
 def test_fitted_fields_converge_at_cubic_rates(field):
     """Halving the element size divides the RMS error (at random points inside the elements) of U
     and |v| — first derivatives, O(h³) — by ~8 and of u, O(h⁴), by ~16; a quadratic fit would
@@ -301,8 +312,10 @@ def test_fitted_fields_converge_at_cubic_rates(field):
         centre, extent = local_frames(pts, simp)
         el, x, y, t = inside_points(pts, simp, 3000, rng)
         r = evaluate(coeffs, centre, extent, el, x, y, t, field.material)
-        exact = {"U": field.strain_energy(x, y, t), "speed": field.speed(x, y, t), "displacement": field.displacement(x, y, t)}
-        errors.append([np.sqrt(np.mean((r[k] - v) ** 2)) / np.abs(v).max() for k, v in exact.items()])
+        exact = {"U": field.strain_energy(x, y, t), "speed": field.speed(x, y, t),
+                 "displacement": field.displacement(x, y, t)}
+        errors.append([np.sqrt(np.mean((r[k] - v) ** 2)) / np.abs(v).max()
+                       for k, v in exact.items()])
     coarse, fine = np.array(errors)
     assert coarse[0] < 0.02 and coarse[1] < 0.02  # in the asymptotic range already
     ratio = coarse / fine
@@ -315,7 +328,8 @@ FAR = 1.0e4  # element sizes (the elements here are 1 mm)
 
 
 def _near_and_far(shift: float):
-    """A front-crossing block of 1 mm elements, and the same block and field moved by ``shift`` mm."""
+    """A front-crossing block of 1 mm elements, and the same block and field moved by ``shift``
+    mm."""
     f0 = PlaneWave(direction=(1.0, 0.5))
     c = f0.material.p_wave_speed
     pts, simp = kuhn_grid(8, (8.0, 8.0, 8.0 / c), (-4.0, -4.0, 0.0))
@@ -346,11 +360,13 @@ def _float32_errors(shift: float) -> dict:
     el, x, y, t = inside_points(pts1, simp, 3000, np.random.default_rng(7))
     ref = evaluate(coeffs, centre, extent, el, x, y, t, STEEL)
     out = {}
-    for name, fn, kw in (("global", evaluate_float32_global, {}), ("local", evaluate_float32_local, {"origin": o}),
+    for name, fn, kw in (("global", evaluate_float32_global, {}),
+                         ("local", evaluate_float32_local, {"origin": o}),
                          ("local-default", evaluate_float32_local, {})):  # fmt: skip
         r = fn(coeffs, centre, extent, el, x, y, t, STEEL, **kw)
         assert r["U"].dtype == np.float32 and r["speed"].dtype == np.float32
-        out[name] = max(np.abs(r[k].astype(np.float64) - ref[k]).max() / np.abs(ref[k]).max() for k in ("U", "speed"))
+        out[name] = max(np.abs(r[k].astype(np.float64) - ref[k]).max() / np.abs(ref[k]).max()
+                        for k in ("U", "speed"))
     return out
 
 
@@ -380,7 +396,8 @@ def test_zero_velocity_gives_zero_speed_gradient_and_an_upright_normal():
     np.testing.assert_array_equal(r["velocity"], 0.0)
     np.testing.assert_array_equal(r["speed"], 0.0)
     np.testing.assert_array_equal(r["grad_speed"], 0.0)
-    np.testing.assert_array_equal(height_normal(r["grad_speed"], 100.0), np.tile([0.0, 0.0, 1.0], (5, 1)))
+    np.testing.assert_array_equal(height_normal(r["grad_speed"], 100.0),
+                                  np.tile([0.0, 0.0, 1.0], (5, 1)))
     assert np.all(r["U"][[0, 1, 3]] > 0) and np.all(r["U"][[2, 4]] == 0)
     g32 = evaluate_float32_global(coeffs, centre, extent, el, 0.0, 0.0, 0.3, BAR)
     assert np.all(np.isfinite(g32["U"])) and np.all(g32["speed"] == 0)

@@ -1,4 +1,5 @@
-"""The real car model far from the origin renders like the car at home, and renders repeat exactly."""
+"""The real car model far from the origin renders like the car at home, and renders repeat
+exactly."""
 
 import numpy as np
 import pytest

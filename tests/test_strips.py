@@ -37,7 +37,8 @@ def kind_of(e) -> str:
 
 
 def as_rows(elements) -> list[tuple[int, int, int, int]]:
-    rows = [tuple(int(x) for x in row) for row in np.asarray(elements).reshape(-1, np.shape(elements)[-1])]
+    rows = [tuple(int(x) for x in row)
+            for row in np.asarray(elements).reshape(-1, np.shape(elements)[-1])]
     return [r + (r[2],) if len(r) == 3 else r for r in rows]
 
 
@@ -124,7 +125,8 @@ def reference_strips(elements, cutoff: int = 1) -> dict:
                 active[i] = False
         if not found:
             break
-        passes += 1  # passes that found (and so accepted) a band; the final empty one is not counted
+        # passes that found (and so accepted) a band; the final empty one is not counted
+        passes += 1
         found.sort(key=len, reverse=True)  # stable: ties keep discovery order
         for b in found:
             if all(active[q] for q, _ in b):
@@ -167,7 +169,8 @@ def strips_of(result) -> tuple[list[list[int]], list[list[int]]]:
 
 def is_rotation(seq, target) -> bool:
     seq, target = list(seq), list(target)
-    return len(seq) == len(target) and any(seq == target[i:] + target[:i] for i in range(len(target)))
+    return len(seq) == len(target) and any(seq == target[i:] + target[:i]
+                                           for i in range(len(target)))
 
 
 def canonical(tri) -> tuple:
@@ -268,7 +271,8 @@ def check_invariants(elements, result, cutoff: int) -> None:
 
     # triangle list: exactly as specified, and each quad covered by its two ears
     tl = result.triangle_list()
-    assert tl.dtype == np.int32 and tl.shape == (2 * (n_quads_in_strips + len(result.leftover)) + n_tris, 3)
+    assert tl.dtype == np.int32 and tl.shape == (
+        2 * (n_quads_in_strips + len(result.leftover)) + n_tris, 3)
     expected = []
     for verts in vs:
         for k in range((len(verts) - 2) // 2):
@@ -298,7 +302,8 @@ def check_invariants(elements, result, cutoff: int) -> None:
     if len(ri):
         assert ri[0] != RESTART and ri[-1] != RESTART
         assert not ((ri[1:] == RESTART) & (ri[:-1] == RESTART)).any()
-    assert int((ri != RESTART).sum()) == len(result.vertices) + 4 * len(result.leftover) + 3 * n_tris
+    assert int((ri != RESTART).sum()) == (len(result.vertices) + 4 * len(result.leftover)
+                                          + 3 * n_tris)
     drawn = unstrip(ri, RESTART)
     assert len(drawn) == len(tl)
     for got, want in zip(drawn, tl.tolist()):
@@ -344,7 +349,8 @@ def structured_meshes(draw, max_side: int = 10) -> np.ndarray:
                                               max_size=4)).items():
         p, q, r = [elements[i][(drop + 1 + k) % 4] for k in range(3)]
         elements[i] = [[p, p, q, r], [p, q, q, r], [p, q, r, r], [p, q, r, p]][at]
-    for i, rot in draw(st.dictionaries(st.integers(0, m - 1), st.integers(1, 3), max_size=m)).items():
+    for i, rot in draw(st.dictionaries(st.integers(0, m - 1), st.integers(1, 3),
+                                       max_size=m)).items():
         elements[i] = elements[i][rot:] + elements[i][:rot]
     for i in draw(st.sets(st.integers(0, m - 1), max_size=m // 4)):
         elements[i] = elements[i][::-1]
@@ -359,12 +365,13 @@ def structured_meshes(draw, max_side: int = 10) -> np.ndarray:
         x, y = fresh(2)
         elements.append([v, u, x, x] if tri else [v, u, x, y])
     # duplicates, possibly rotated or reversed
-    for i, rot, rev in draw(st.lists(st.tuples(st.integers(0, m - 1), st.integers(0, 3), st.booleans()),
-                                     max_size=3)):
+    for i, rot, rev in draw(st.lists(st.tuples(st.integers(0, m - 1), st.integers(0, 3),
+                                               st.booleans()), max_size=3)):
         e = elements[i][rot:] + elements[i][:rot]
         elements.append(e[::-1] if rev else e)
     # degenerate elements on existing nodes
-    for i, pattern in draw(st.lists(st.tuples(st.integers(0, m - 1), st.integers(0, 5)), max_size=4)):
+    for i, pattern in draw(st.lists(st.tuples(st.integers(0, m - 1), st.integers(0, 5)),
+                                    max_size=4)):
         a, b, c, d = elements[i]
         elements.append([[a, b, a, d], [a, b, c, b], [a, b, a, b], [a, a, a, a],
                          [a, a, b, b], [a, b, b, a]][pattern])
@@ -460,7 +467,8 @@ def test_row_shorter_than_cutoff_is_left_over():
     result = quad_strips(np.array(grid(3, 1)), cutoff=4)
     assert result.n_strips == 0 and result.leftover.tolist() == [0, 1, 2]
     assert result.vertex_count == 12 and result.mean_triangles_per_strip == 0.0
-    assert result.restart_indices().tolist() == [0, 1, 4, 5, RESTART, 1, 2, 5, 6, RESTART, 2, 3, 6, 7]
+    assert result.restart_indices().tolist() == [0, 1, 4, 5, RESTART, 1, 2, 5, 6, RESTART,
+                                                 2, 3, 6, 7]
 
 
 @pytest.mark.parametrize("m, n", [(2, 1), (5, 3), (4, 4), (9, 2)])
@@ -563,7 +571,8 @@ def test_car_deck(car):
     assert strips_of(result) == (ref["vertices"], ref["quads"])
     assert result.passes == ref["passes"]
     # fewer vertices than drawing each element on its own (4 per quad, 3 per triangle)
-    assert result.vertex_count < 4 * (len(result.quads) + len(result.leftover)) + 3 * len(result.triangles)
+    assert result.vertex_count < (4 * (len(result.quads) + len(result.leftover))
+                                  + 3 * len(result.triangles))
 
 
 # --------------------------------------------------------------------------- tri_strips

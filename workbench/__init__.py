@@ -1,3 +1,4 @@
-"""workbench: comparable OpenGL render paths for finite-element visualization, measured side by side."""
+"""workbench: comparable OpenGL render paths for finite-element visualization, measured side by
+side."""
 
 __version__ = "0.1.0"

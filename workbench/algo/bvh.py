@@ -219,9 +219,9 @@ class TriangleBVH:
         indices and (P, 3) float64 closest points, exact in float64. ``hint`` (P,) optional
         triangle indices (-1 for none) to start each search from: a near triangle makes the
         search prune from the start, any triangle gives the same result (without hints, each
-        search starts from the previous point's triangle). Points at ``max_distance`` or
-        farther from every triangle get distance inf, triangle -1 and NaN closest points. Refused: bad shapes, non-finite points, a hint outside the triangles, a
-        negative or NaN ``max_distance``.
+        search starts from the previous point's triangle). Points at ``max_distance`` or farther
+        from every triangle get distance inf, triangle -1 and NaN closest points. Refused: bad
+        shapes, non-finite points, a hint outside the triangles, a negative or NaN ``max_distance``.
         """
         p = np.asarray(points, dtype=np.float64)
         if p.ndim != 2 or p.shape[1] != 3:

@@ -399,7 +399,8 @@ def auto_plane(object_points, assembly_points, view_dir, *, reject_deg: float = 
         if best is None or o < best_offset - 1e-12 * max(1.0, abs(best_offset)):
             best, best_offset = n, o
     if best is None:
-        raise ValueError(f"every candidate normal lies within {reject} degrees of the view direction")
+        raise ValueError(f"every candidate normal lies within {reject} degrees of the view "
+                         "direction")
     return SplitPlane(centre, best)
 
 
@@ -417,7 +418,8 @@ def manual_plane(spec, object_points) -> SplitPlane:
         try:
             normal = np.asarray(spec, dtype=np.float64)
         except (TypeError, ValueError):
-            raise ValueError(f"unknown split plane {spec!r}: expected 'x', 'y', 'z' or (a, b, c)") from None
+            raise ValueError(f"unknown split plane {spec!r}: expected 'x', 'y', 'z' or "
+                             "(a, b, c)") from None
         if normal.shape != (3,):
             raise ValueError(f"unknown split plane {spec!r}: expected 'x', 'y', 'z' or (a, b, c)")
     return SplitPlane(_centre(obj), normal)

@@ -114,10 +114,11 @@ class Camera:
             half_fov = np.radians(fov_deg) / 2.0
             narrow = half_fov if aspect >= 1.0 else np.arctan(np.tan(half_fov) * aspect)
             distance = r / np.sin(narrow)
-        near = max(distance - r, 1e-4 * (distance + r)) if projection == "perspective" else distance - r
-        return cls(origin=origin, eye=center - origin + distance * direction, target=center - origin,
-                   up=up, projection=projection, half_height=half_height, fov_deg=fov_deg,
-                   aspect=aspect, near=near, far=distance + r)
+        near = (max(distance - r, 1e-4 * (distance + r)) if projection == "perspective"
+                else distance - r)
+        return cls(origin=origin, eye=center - origin + distance * direction,
+                   target=center - origin, up=up, projection=projection, half_height=half_height,
+                   fov_deg=fov_deg, aspect=aspect, near=near, far=distance + r)
 
     @classmethod
     def fit_box(cls, lo: ArrayLike, hi: ArrayLike, **kwargs: Any) -> Camera:

@@ -24,14 +24,15 @@ def create_context(require: int = 330) -> moderngl.Context:
         ctx = moderngl.create_standalone_context(require=require, backend="egl")
     except Exception as exc:  # moderngl raises plain Exception for a missing libEGL or driver
         raise GLUnavailable(
-            f"no headless OpenGL {require // 100}.{require % 100 // 10} context through EGL ({exc}); "
-            f"on Debian/Ubuntu install: apt-get install {EGL_PACKAGES}"
+            f"no headless OpenGL {require // 100}.{require % 100 // 10} context through EGL "
+            f"({exc}); on Debian/Ubuntu install: apt-get install {EGL_PACKAGES}"
         ) from exc
     return ctx
 
 
 def renderer(ctx: moderngl.Context) -> str:
-    """The renderer string recorded in every measurement row (e.g. 'llvmpipe (LLVM 15.0.6, 256 bits)')."""
+    """The renderer string recorded in every measurement row (e.g.
+    'llvmpipe (LLVM 15.0.6, 256 bits)')."""
     return str(ctx.info["GL_RENDERER"])
 
 

@@ -1,4 +1,5 @@
-"""Offscreen framebuffers: RGBA8 colour, 24-bit or 32-bit float depth, optional MSAA, read back to numpy."""
+"""Offscreen framebuffers: RGBA8 colour, 24-bit or 32-bit float depth, optional MSAA, read back to
+numpy."""
 
 from __future__ import annotations
 
@@ -77,8 +78,8 @@ class Framebuffer:
         color = ctx.renderbuffer(self.size, 4, samples=self.samples)
         self._float_depth = None
         if depth_bits == 24:
-            self.fbo = ctx.framebuffer(color_attachments=[color],
-                                       depth_attachment=ctx.depth_renderbuffer(self.size, samples=self.samples))
+            depth = ctx.depth_renderbuffer(self.size, samples=self.samples)
+            self.fbo = ctx.framebuffer(color_attachments=[color], depth_attachment=depth)
         else:
             self.fbo = self._float_depth_framebuffer(color)
         self._resolve = None
@@ -89,16 +90,18 @@ class Framebuffer:
         GL = raw_gl()
         self._float_depth = GL.glGenRenderbuffers(1)
         GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, self._float_depth)
-        GL.glRenderbufferStorageMultisample(GL.GL_RENDERBUFFER, self.samples, GL.GL_DEPTH_COMPONENT32F,
-                                            *self.size)
+        GL.glRenderbufferStorageMultisample(GL.GL_RENDERBUFFER, self.samples,
+                                            GL.GL_DEPTH_COMPONENT32F, *self.size)
         glo = GL.glGenFramebuffers(1)
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, glo)
-        GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, GL.GL_RENDERBUFFER, color.glo)
+        GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, GL.GL_RENDERBUFFER,
+                                     color.glo)
         GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_DEPTH_ATTACHMENT, GL.GL_RENDERBUFFER,
                                      self._float_depth)
         status = GL.glCheckFramebufferStatus(GL.GL_FRAMEBUFFER)
         if status != GL.GL_FRAMEBUFFER_COMPLETE:
-            raise ValueError(f"32-bit float depth framebuffer incomplete (status 0x{int(status):x})")
+            raise ValueError("32-bit float depth framebuffer incomplete "
+                             f"(status 0x{int(status):x})")
         self._color = color
         return self.ctx.detect_framebuffer(int(glo))
 

@@ -14,7 +14,8 @@ _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$', re.MULTILINE)
 
 @cache
 def shader_source(name: str) -> str:
-    """The text of ``glsl/<name>`` with ``#include "file"`` lines expanded (one level deep per file)."""
+    """The text of ``glsl/<name>`` with ``#include "file"`` lines expanded (one level deep per
+    file)."""
     path = resources.files("workbench.glsl") / name
     if not path.is_file():
         raise FileNotFoundError(f"shader {name!r} not found in the workbench glsl folder")
@@ -35,9 +36,12 @@ def _with_defines(source: str, defines: Mapping[str, object] | None) -> str:
 def load_program(ctx: moderngl.Context, vertex: str, fragment: str | None = None,
                  geometry: str | None = None,
                  defines: Mapping[str, object] | None = None) -> moderngl.Program:
-    """A program from shader files in ``glsl/``, with ``#define key value`` lines after ``#version``."""
+    """A program from shader files in ``glsl/``, with ``#define key value`` lines after
+    ``#version``."""
     return ctx.program(
         vertex_shader=_with_defines(shader_source(vertex), defines),
-        fragment_shader=None if fragment is None else _with_defines(shader_source(fragment), defines),
-        geometry_shader=None if geometry is None else _with_defines(shader_source(geometry), defines),
+        fragment_shader=(None if fragment is None
+                         else _with_defines(shader_source(fragment), defines)),
+        geometry_shader=(None if geometry is None
+                         else _with_defines(shader_source(geometry), defines)),
     )

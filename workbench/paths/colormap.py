@@ -48,8 +48,8 @@ def _lut(name: str) -> np.ndarray:
     try:
         cmap = matplotlib.colormaps[name]
     except KeyError:
-        raise ValueError(f"unknown colormap {name!r}; any name in matplotlib.colormaps is accepted, "
-                         f"e.g. viridis, plasma, jet, coolwarm") from None
+        raise ValueError(f"unknown colormap {name!r}; any name in matplotlib.colormaps is "
+                         f"accepted, e.g. viridis, plasma, jet, coolwarm") from None
     # integer input indexes the resampled table directly (no rounding of float positions)
     table = cmap.resampled(LUT_SIZE)(np.arange(LUT_SIZE), bytes=True)
     table.setflags(write=False)

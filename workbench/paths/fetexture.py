@@ -144,7 +144,8 @@ class FETexturePath(GLPath):
         integer = data.dtype != np.uint8
         dtype = {np.dtype(np.uint8): "f1", np.dtype(np.uint16): "u2",
                  np.dtype(np.uint32): "u4"}[data.dtype]
-        tex = self._keep(ctx.texture((width, height), channels, np.ascontiguousarray(data).tobytes(),
+        tex = self._keep(ctx.texture((width, height), channels,
+                                     np.ascontiguousarray(data).tobytes(),
                                      dtype=dtype, alignment=1))
         nearest = (moderngl.NEAREST, moderngl.NEAREST)
         tex.filter = nearest if integer else (moderngl.LINEAR, moderngl.LINEAR)

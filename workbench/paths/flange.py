@@ -2,10 +2,10 @@
 and the geometry farther than a threshold hidden by an RGBα 1-D texture and the alpha test.
 
 The distance is the derived item ``part_distances``
-(:func:`workbench.algo.part_distance.flange_distances`: exact, float64, to the nearest element of any
-part the node does not belong to, up to the distance of interest ``cutoff``), installed on the
-mesh as the node field ``"part_distance"`` and drawn per pixel like ``pixel_color`` (Gouraud
-light, the scalar interpolated and looked up per fragment):
+(:func:`workbench.algo.part_distance.flange_distances`: exact, float64, to the nearest element of
+any part the node does not belong to, up to the distance of interest ``cutoff``), installed on the
+mesh as the node field ``"part_distance"`` and drawn per pixel like ``pixel_color`` (Gouraud light,
+the scalar interpolated and looked up per fragment):
 
 * ``show="flanges"`` (the default): colours over ``[0, 2·threshold]`` with every texel above
   ``threshold`` transparent, so a fragment whose interpolated distance exceeds the threshold is

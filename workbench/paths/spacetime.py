@@ -95,14 +95,16 @@ class SpacetimeStyle:
         if self.shading not in SHADINGS:
             raise ValueError(f"shading must be one of {SHADINGS}, got {self.shading!r}")
         if self.edge_overdraw not in OVERDRAWS:
-            raise ValueError(f"edge_overdraw must be one of {OVERDRAWS}, got {self.edge_overdraw!r}")
+            raise ValueError(f"edge_overdraw must be one of {OVERDRAWS}, "
+                             f"got {self.edge_overdraw!r}")
         if self.element_store not in ELEMENT_STORES:
             raise ValueError(f"element_store must be one of {ELEMENT_STORES}, "
                              f"got {self.element_store!r}")
         if not (np.isfinite(self.U_max) and self.U_max > 0):
             raise ValueError(f"U_max must be positive and finite, got {self.U_max}")
         if not (np.isfinite(self.height_scale) and self.height_scale >= 0):
-            raise ValueError(f"height_scale must be non-negative and finite, got {self.height_scale}")
+            raise ValueError("height_scale must be non-negative and finite, got "
+                             f"{self.height_scale}")
 
 
 def top_camera(grid: PixelGrid, z_range: tuple[float, float] = (-1.0, 1.0),
@@ -112,12 +114,14 @@ def top_camera(grid: PixelGrid, z_range: tuple[float, float] = (-1.0, 1.0),
     back are the grid's centres, so the exact image and the rendered one match pixel for pixel.
     ``z_range`` (mm) must enclose the heights drawn; ``origin`` (3,) defaults to the grid centre
     at z = 0."""
-    centre = np.array([grid.left + grid.dx * grid.width / 2, grid.top - grid.dy * grid.height / 2, 0.0])
+    centre = np.array([grid.left + grid.dx * grid.width / 2,
+                       grid.top - grid.dy * grid.height / 2, 0.0])
     origin = centre.copy() if origin is None else np.asarray(origin, np.float64)
     lo, hi = float(z_range[0]), float(z_range[1])
     depth = max(hi - lo, 1e-6)
     eye = centre - origin + np.array([0.0, 0.0, hi + depth])
-    return Camera(origin=origin, eye=eye, target=eye - np.array([0.0, 0.0, 1.0]), up=np.array([0.0, 1.0, 0.0]),
+    return Camera(origin=origin, eye=eye, target=eye - np.array([0.0, 0.0, 1.0]),
+                  up=np.array([0.0, 1.0, 0.0]),
                   projection="orthographic", half_height=grid.dy * grid.height / 2,
                   aspect=(grid.dx * grid.width) / (grid.dy * grid.height),
                   near=0.5 * depth, far=2.5 * depth)
@@ -125,9 +129,10 @@ def top_camera(grid: PixelGrid, z_range: tuple[float, float] = (-1.0, 1.0),
 
 class SpacetimePath(GLPath):
     """The shared implementation of the two registered spacetime paths (``spacetime_vertex``,
-    ``spacetime_pixel``; :func:`spacetime_path` picks one by ``style.shading``), prepared for one scene: a
-    :class:`~workbench.algo.spacetime.scene.SpacetimeScene` (a slice, or the bar's spacetime), built
-    by the caller. The scene is one configuration, so ``set_step`` accepts only step 0.
+    ``spacetime_pixel``; :func:`spacetime_path` picks one by ``style.shading``), prepared for one
+    scene: a :class:`~workbench.algo.spacetime.scene.SpacetimeScene` (a slice, or the bar's
+    spacetime), built by the caller. The scene is one configuration, so ``set_step`` accepts only
+    step 0.
 
     After :meth:`prepare`: ``polygons``, ``triangles``, ``lines`` (shared edges overdrawn) and
     ``skirts`` drawn, ``elements`` (element records uploaded), ``bytes_uploaded``.
@@ -266,7 +271,8 @@ class SpacetimePath(GLPath):
         return pairs[keep].astype(np.int32)
 
     def _programs(self) -> list:
-        return [p for p in (self._program, self._line_program, self._skirt_program) if p is not None]
+        return [p for p in (self._program, self._line_program, self._skirt_program)
+                if p is not None]
 
     def _uniform_values(self, scene: SpacetimeScene) -> dict:
         """The scene and style uniforms by name, the same for every program of the path."""
@@ -309,7 +315,8 @@ class SpacetimePath(GLPath):
         rows = -(-n // ELEMENTS_PER_ROW)
         max_size = int(ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
         if rows > max_size:
-            raise ValueError(f"{n} elements need {rows} texture rows; this renderer allows {max_size}")
+            raise ValueError(f"{n} elements need {rows} texture rows; this renderer allows "
+                             f"{max_size}")
         data = np.zeros((rows * ELEMENTS_PER_ROW, ELEMENT_TEXELS, 4), np.float32)
         data[:n] = records
         width = ELEMENTS_PER_ROW * ELEMENT_TEXELS
@@ -327,7 +334,8 @@ class SpacetimePath(GLPath):
         return 0
 
     def draw(self) -> None:
-        """Draw into the bound framebuffer: the fill, then the edge lines and skirts if asked for."""
+        """Draw into the bound framebuffer: the fill, then the edge lines and skirts if asked
+        for."""
         ctx = self.ctx
         ctx.enable_only(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="

@@ -13,11 +13,11 @@ Outputs in ``figures/fig_pixel_exact/``:
   tetrahedra, polygons, per-frame slicing time, then for each path (per vertex, per pixel)
   without edge overdraw, with the paper's line overdraw ("over"), with lines behind the fill
   ("behind") and with lines and skirts behind it ("skirts"), element records in a buffer
-  texture, and once more without overdraw from the paper's 2-D texture rectangle ("texture"): the time to upload
-  the slice (``prepare_ms``, program linking included), GPU and wall ms per frame, max and
-  mean colour error against the exact image (1/255), the share of covered pixels over 1/255 —
-  all of them, and those whose centre is more than 0.01 px from an element edge (closer, the
-  rasteriser's sub-pixel precision may pick the neighbouring element) with their max error —
+  texture, and once more without overdraw from the paper's 2-D texture rectangle ("texture"): the
+  time to upload the slice (``prepare_ms``, program linking included), GPU and wall ms per frame,
+  max and mean colour error against the exact image (1/255), the share of covered pixels over
+  1/255 — all of them, and those whose centre is more than 0.01 px from an element edge (closer,
+  the rasteriser's sub-pixel precision may pick the neighbouring element) with their max error —
   and crack pixels (background enclosed by the surface) in an oblique perspective view;
 * ``slicing.md`` — incremental slicing of a spacetime mesh of ~10⁶ tetrahedra (10⁵ quick) as t
   advances, with and without the domain-boundary edges, against slicing every tetrahedron from

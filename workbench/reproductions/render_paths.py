@@ -75,12 +75,14 @@ def path_configs(step: int, field: str, element_field: str | None, value_range, 
     yield "pixel bands", "pixel_color", banded, 0, None
     yield "vertex bands", "vertex_color", banded, 0, "pixel bands"
     yield "pixel bands + wire", "pixel_color", replace(banded, wireframe=True), 0, None
-    yield "pixel transfer (hide low 30 %)", "pixel_color", replace(smooth, hide_range=(lo, lo + 0.3 * (hi - lo))), 0, None
+    yield ("pixel transfer (hide low 30 %)", "pixel_color",
+           replace(smooth, hide_range=(lo, lo + 0.3 * (hi - lo))), 0, None)
     yield "pixel bands + clip", "pixel_color", replace(banded, clip_planes=(clip_plane,)), 0, None
     if element_field is not None:
         yield "element flat", "element_color", replace(plain, field=element_field), 0, None
     if step > 0:
-        yield "pixel bands, deformation x3", "pixel_color", replace(banded, magnification=3.0), 0, None
+        yield ("pixel bands, deformation x3", "pixel_color", replace(banded, magnification=3.0),
+               0, None)
     # pyrender always draws with 4x multisampling: these rows are its like-for-like peers
     yield "gouraud, 4x MSAA", "gouraud", plain, 4, None
     yield "pixel bands, 4x MSAA", "pixel_color", banded, 4, None
@@ -178,8 +180,8 @@ def save_figures(exp: ExperimentContext, label: str, images: dict, ref_image: np
                     ["workbench gouraud, 4x MSAA", f"pyrender (SSIM {ssim:.3f})"])
 
 
-@experiment("render_paths", "first render paths on the car and the es2008 semicylinders: time against "
-                            "error, pyrender and a bare draw beside them")
+@experiment("render_paths", "first render paths on the car and the es2008 semicylinders: time "
+                            "against error, pyrender and a bare draw beside them")
 def run(exp: ExperimentContext) -> list[dict]:
     rows: list[dict] = []
     targets: list[dict] = []

@@ -95,7 +95,8 @@ def smooth_closed_mesh() -> Model | None:
         return None
     m = trimesh.load(path, force="mesh", process=True)
     f = np.asarray(m.faces, np.int64)
-    return Model("bunny (closed)", np.asarray(m.vertices, np.float64), f, np.zeros(len(f), np.int32))
+    return Model("bunny (closed)", np.asarray(m.vertices, np.float64), f,
+                 np.zeros(len(f), np.int32))
 
 
 def models(exp: ExperimentContext, car: FEMesh | None) -> Iterator[Model]:

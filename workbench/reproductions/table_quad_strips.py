@@ -1,4 +1,5 @@
-"""crash2000 Table 1: quad strips by bandification against triangle strips, and what strips are worth.
+"""crash2000 Table 1: quad strips by bandification against triangle strips, and what strips are
+worth.
 
 **Stripping table** (``table.md``), in the paper's columns: #quads, #verts = 4n (triangles count
 as degenerate quads, as in the paper), then for meshoptimizer's triangle strips (of the mesh's
@@ -148,7 +149,8 @@ def save_cutoff_figure(path: Path, rows: list[dict]) -> None:
         line, = ax_v.plot(cut, [r["verts_pct"] for r in sel], "o-", label=f"{label}: quad strips")
         ax_v.axhline(sel[0]["meshopt_verts_pct"], color=line.get_color(), ls="--",
                      label=f"{label}: meshoptimizer triangle strips")
-        ax_s.plot(cut, [r["strips"] for r in sel], "o-", color=line.get_color(), label=f"{label}: strips")
+        ax_s.plot(cut, [r["strips"] for r in sel], "o-", color=line.get_color(),
+                  label=f"{label}: strips")
         ax_s.plot(cut, [r["leftover_quads"] for r in sel], "x:", color=line.get_color(),
                   label=f"{label}: leftover quads")
     for ax in (ax_v, ax_s):
@@ -263,6 +265,7 @@ def run(exp: ExperimentContext) -> list[dict]:
         stem = case.label.replace(" ", "_")
         save_image_grid(exp.file(f"{stem}_wire.png"),
                         [images["list + line-overdraw wire"], images["quad_wire (single pass)"]],
-                        ["Gouraud + line-overdraw wire frame", "quad_wire: one pass from quad strips"])
+                        ["Gouraud + line-overdraw wire frame",
+                         "quad_wire: one pass from quad strips"])
     exp.table(draws, "draw", "Drawing the largest meshes stripped and unstripped (Gouraud shading)")
     return rows

@@ -81,15 +81,18 @@ class GouraudSplit:
 
 
 @numba.njit(cache=True, nogil=True)
-def _split_normals(elements, coords, corner_element, corner_vertex, corner_sign, n_vertices, zero_rel):
+def _split_normals(elements, coords, corner_element, corner_vertex, corner_sign, n_vertices,
+                   zero_rel):
     """Compiled :meth:`GouraudSplit.normals`: the numpy formulation of ``_diagonal_cross`` and
     ``_normalise`` summed per vertex in one pass (same arithmetic, same zero rules)."""
     m = elements.shape[0]
     area = np.zeros((m, 3))
     for i in range(m):
         a, b, c, d = elements[i, 0], elements[i, 1], elements[i, 2], elements[i, 3]
-        d1x, d1y, d1z = coords[c, 0] - coords[a, 0], coords[c, 1] - coords[a, 1], coords[c, 2] - coords[a, 2]
-        d2x, d2y, d2z = coords[d, 0] - coords[b, 0], coords[d, 1] - coords[b, 1], coords[d, 2] - coords[b, 2]
+        d1x, d1y, d1z = (coords[c, 0] - coords[a, 0], coords[c, 1] - coords[a, 1],
+                         coords[c, 2] - coords[a, 2])
+        d2x, d2y, d2z = (coords[d, 0] - coords[b, 0], coords[d, 1] - coords[b, 1],
+                         coords[d, 2] - coords[b, 2])
         nx = d1y * d2z - d1z * d2y
         ny = d1z * d2x - d1x * d2z
         nz = d1x * d2y - d1y * d2x
@@ -110,7 +113,8 @@ def _split_normals(elements, coords, corner_element, corner_vertex, corner_sign,
     for v in range(n_vertices):
         length = np.sqrt(total[v, 0] ** 2 + total[v, 1] ** 2 + total[v, 2] ** 2)
         if length > zero_rel * magnitude[v] and length > 0:
-            out[v, 0], out[v, 1], out[v, 2] = total[v, 0] / length, total[v, 1] / length, total[v, 2] / length
+            out[v, 0], out[v, 1], out[v, 2] = (total[v, 0] / length, total[v, 1] / length,
+                                               total[v, 2] / length)
     return out
 
 
@@ -140,13 +144,13 @@ def gouraud_split(elements: ArrayLike, coords_list: np.ndarray | Sequence[ArrayL
     elements agree when they traverse the shared edge in opposite directions. A flipped element
     is therefore not split from its neighbours, while a fold-back beyond 90 degrees (a hem) still
     is -- which |cos| of unoriented normals would get wrong (it merges a hem, and with it a
-    crease angle of 90 degrees or more splits nothing). For :meth:`GouraudSplit.normals`, every element gets a sign that
-    orients its smooth patch (elements joined by smooth links) consistently, in the orientation
-    of the patch's area majority in the first coordinate set (by element count where that is
-    undecided), fixed for all time steps; so flipped elements add to, not cancel, their
-    neighbours' normals. Where a patch cannot be oriented as a whole (a Moebius band, some
-    non-manifold joints), each vertex's group is oriented on its own the same way, and a group
-    whose links contradict each other keeps its elements as wound.
+    crease angle of 90 degrees or more splits nothing). For :meth:`GouraudSplit.normals`, every
+    element gets a sign that orients its smooth patch (elements joined by smooth links)
+    consistently, in the orientation of the patch's area majority in the first coordinate set (by
+    element count where that is undecided), fixed for all time steps; so flipped elements add to,
+    not cancel, their neighbours' normals. Where a patch cannot be oriented as a whole (a Moebius
+    band, some non-manifold joints), each vertex's group is oriented on its own the same way, and a
+    group whose links contradict each other keeps its elements as wound.
 
     ``triangulation`` must be :func:`triangulate` of these elements; its triangles are re-pointed
     to vertices in the same order. Refuses bad elements, coordinates that are not finite (N, 3)
@@ -179,7 +183,8 @@ def gouraud_split(elements: ArrayLike, coords_list: np.ndarray | Sequence[ArrayL
         cos = np.where(agree, cos, -cos)
         smooth &= has_normal[f] & has_normal[g] & (cos >= cos_limit)
 
-    group, group_sign = _corner_groups(e, good, cid, lo_corners[smooth], hi_corners[smooth], agree[smooth])
+    group, group_sign = _corner_groups(e, good, cid, lo_corners[smooth], hi_corners[smooth],
+                                       agree[smooth])
     vert, vertex_node = _number_vertices(e, group)
 
     # per distinct corner of a non-degenerate element: element, vertex, orientation sign
@@ -249,7 +254,8 @@ def _corner_groups(e: np.ndarray, good: np.ndarray, cid: np.ndarray, lo_corners:
     s = np.concatenate([agree, agree])
     src = np.concatenate([a, a + n_ids])
     dst = np.concatenate([np.where(s, b, b + n_ids), np.where(s, b + n_ids, b)])
-    graph = coo_matrix((np.ones(len(src), np.int8), (src, dst)), shape=(2 * n_ids, 2 * n_ids)).tocsr()
+    graph = coo_matrix((np.ones(len(src), np.int8), (src, dst)),
+                       shape=(2 * n_ids, 2 * n_ids)).tocsr()
     n_labels, labels = connected_components(graph, directed=False)
     as_wound, flipped = labels[cid], labels[cid + n_ids]
     group = np.minimum(as_wound, flipped).astype(np.int64)
@@ -349,7 +355,8 @@ def _check_triangulation(triangulation, e: np.ndarray) -> tuple[np.ndarray, np.n
     return elem, corner
 
 
-def _degenerate_groups(e: np.ndarray, good: np.ndarray, group: np.ndarray, n_labels: int) -> np.ndarray:
+def _degenerate_groups(e: np.ndarray, good: np.ndarray, group: np.ndarray,
+                       n_labels: int) -> np.ndarray:
     """Group labels for the corners of degenerate elements.
 
     A corner joins the group of its node's first non-degenerate corner; nodes referenced by

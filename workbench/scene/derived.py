@@ -68,7 +68,8 @@ def as_elements(elements: ArrayLike) -> np.ndarray:
         lo, hi = int(e.min()), int(e.max())
         if lo < 0:
             bad = np.flatnonzero((e < 0).any(axis=1))
-            raise ValueError(f"{len(bad)} elements have negative node indices, first {bad[:5].tolist()}")
+            raise ValueError(f"{len(bad)} elements have negative node indices, "
+                             f"first {bad[:5].tolist()}")
         if hi > np.iinfo(np.int32).max:
             raise ValueError(f"node index {hi} does not fit int32")
     if e.shape[1] == 3:
@@ -87,7 +88,8 @@ def as_coords(coords: ArrayLike, elements: np.ndarray, what: str = "coords") -> 
     if c.ndim != 2 or c.shape[1] != 3:
         raise ValueError(f"{what} must be (N, 3), got shape {c.shape}")
     if elements.size and int(elements.max()) >= len(c):
-        raise ValueError(f"elements reference node {int(elements.max())} but {what} has {len(c)} nodes")
+        raise ValueError(f"elements reference node {int(elements.max())} but {what} has "
+                         f"{len(c)} nodes")
     if not np.isfinite(c).all():
         bad = np.flatnonzero(~np.isfinite(c).all(axis=1))
         raise ValueError(f"{what}: non-finite coordinates at nodes {bad[:5].tolist()}")
@@ -157,7 +159,8 @@ def _normalise(v: np.ndarray, magnitude: np.ndarray) -> np.ndarray:
 
 def _bincount3(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
     """(n, 3) sums of the rows of ``values`` grouped by ``index``."""
-    return np.stack([np.bincount(index, weights=values[:, k], minlength=n) for k in range(3)], axis=1)
+    return np.stack([np.bincount(index, weights=values[:, k], minlength=n) for k in range(3)],
+                    axis=1)
 
 
 # --------------------------------------------------------------------------- triangulation
@@ -276,5 +279,6 @@ def node_normals(elements: ArrayLike, coords: ArrayLike) -> np.ndarray:
     rows, cols = np.nonzero(canon == np.arange(4, dtype=np.int8))
     nodes = e[rows, cols]
     total = _bincount3(nodes, w[rows], len(c))
-    magnitude = np.bincount(nodes, weights=np.sqrt(np.einsum("ij,ij->i", w, w))[rows], minlength=len(c))
+    magnitude = np.bincount(nodes, weights=np.sqrt(np.einsum("ij,ij->i", w, w))[rows],
+                            minlength=len(c))
     return _normalise(total, magnitude)

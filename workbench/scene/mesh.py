@@ -82,7 +82,8 @@ class FEMesh:
             self.parts = np.zeros(len(self.elements), np.int32)
         self.parts = np.ascontiguousarray(self.parts, dtype=np.int32)
         if self.parts.shape != (len(self.elements),):
-            raise MeshError(f"{self.name}: parts must be ({len(self.elements)},), got {self.parts.shape}")
+            raise MeshError(f"{self.name}: parts must be ({len(self.elements)},), "
+                            f"got {self.parts.shape}")
         if self.steps is not None:
             self.steps = np.ascontiguousarray(self.steps, dtype=np.float64)
             if self.steps.ndim != 3 or self.steps.shape[1:] != self.nodes.shape:
@@ -154,7 +155,8 @@ class FEMesh:
         """Sorted indices of the nodes referenced by at least one element."""
         return np.unique(self.elements)
 
-    def bounds(self, step: int | None = None, all_steps: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    def bounds(self, step: int | None = None,
+               all_steps: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) float64 corners of the axis-aligned box of the referenced nodes."""
         used = self.used_nodes()
         if all_steps and self.steps is not None:
@@ -163,7 +165,8 @@ class FEMesh:
             pts = self.coordinates(step)[used]
         return pts.min(axis=0), pts.max(axis=0)
 
-    def bounding_sphere(self, step: int | None = None, all_steps: bool = False) -> tuple[np.ndarray, float]:
+    def bounding_sphere(self, step: int | None = None,
+                        all_steps: bool = False) -> tuple[np.ndarray, float]:
         """(centre, radius) of the sphere around the bounding box of the referenced nodes."""
         lo, hi = self.bounds(step, all_steps)
         return (lo + hi) / 2.0, float(np.linalg.norm(hi - lo) / 2.0)
@@ -256,4 +259,5 @@ class FEMesh:
 
     def __repr__(self) -> str:
         return (f"FEMesh({self.name!r}: {self.n_nodes} nodes, {self.n_elements} elements "
-                f"({self.n_quads} quads), {len(np.unique(self.parts))} parts, {self.n_steps} steps)")
+                f"({self.n_quads} quads), {len(np.unique(self.parts))} parts, "
+                f"{self.n_steps} steps)")

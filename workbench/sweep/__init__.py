@@ -4,7 +4,8 @@ A config::
 
     name = "bands_vertex_pixel"     # default: the file's stem
     repeats = 7                     # timed draws per point (>= 5; --quick lowers it to 5)
-    reference = "pixel_color"       # optional: the path whose image gives the image-difference columns
+    reference = "pixel_color"       # optional: the path whose image gives the
+                                    # image-difference columns
     timed = true                    # false: every point draws once, untimed (error-only)
     metric = "mean_diff_255"        # optional: the error plotted in pareto.png
 

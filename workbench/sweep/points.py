@@ -146,7 +146,8 @@ def simplified_scene(mesh, point: Point):
     if point.simplifier == NO_SIMPLIFIER:  # drawn as it is, quads included
         triangles = mesh.n_elements + mesh.n_quads
         return mesh, dict(triangles_before=triangles, triangles_after=triangles, simplify_s=0.0,
-                          hausdorff_lower_mm=0.0, hausdorff_mm=0.0, hausdorff_pct_diag=0.0, hausdorff_s=0.0)
+                          hausdorff_lower_mm=0.0, hausdorff_mm=0.0, hausdorff_pct_diag=0.0,
+                          hausdorff_s=0.0)
     tri = mesh.triangulation
     v, f = mesh.nodes, tri.triangles.astype(np.int64)
     used = v[np.unique(f)]
@@ -193,8 +194,8 @@ def _reference_image(ctx, point: Point, scene, camera, measured):
 def measured_columns(point: Point, ctx) -> dict:
     """The columns of a point drawn on ``ctx``: :func:`measure`'s row (its ``scene`` renamed
     ``scene_name``; ``lock_wait_ms`` is how long the timed draw waited for the host's draw
-    lock), the simplification columns, and the image differences (:meth:`ImageDiff.as_row`: max and mean
-    absolute difference in 1/255, share of pixels differing, PSNR in dB, SSIM) against the
+    lock), the simplification columns, and the image differences (:meth:`ImageDiff.as_row`: max and
+    mean absolute difference in 1/255, share of pixels differing, PSNR in dB, SSIM) against the
     reference image."""
     from ..experiment.cluster import draw_lock
     from ..experiment.compare import compare_images

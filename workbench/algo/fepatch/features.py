@@ -3,9 +3,9 @@
 Rose & Ertl cut each FE component along its feature lines into patches and then split every
 patch into nearly planar subpatches. This module computes, GL-free and in float64:
 
-* :func:`feature_edges` -- the unique element edges (as :func:`workbench.scene.derived.unique_edges`)
-  with a kind each: outer boundary (G0), angular edge (G1) or closing edge that completes a G1
-  line which ends in the middle of a surface;
+* :func:`feature_edges` -- the unique element edges (as
+  :func:`workbench.scene.derived.unique_edges`) with a kind each: outer boundary (G0), angular edge
+  (G1) or closing edge that completes a G1 line which ends in the middle of a surface;
 * :func:`patches` -- connected components of elements joined across non-feature edges;
 * :func:`planar_subpatches` -- region growing inside each patch; every subpatch keeps all its
   nodes within a distance ``d`` of the least-squares plane through them.
@@ -103,7 +103,8 @@ def _check_angle(alpha_g1_deg) -> float:
     return alpha
 
 
-def feature_edges(elements, coords, alpha_g1_deg: float = 12.0, *, close_lines: bool = True) -> FeatureEdges:
+def feature_edges(elements, coords, alpha_g1_deg: float = 12.0, *,
+                  close_lines: bool = True) -> FeatureEdges:
     """Classify every unique element edge as smooth, G0, G1 or closing (fe2003 §3.1).
 
     * **G0** -- an edge with exactly one adjacent element side (outer boundary).
@@ -172,7 +173,8 @@ def feature_edges(elements, coords, alpha_g1_deg: float = 12.0, *, close_lines: 
 
 def _close_lines(edges: np.ndarray, kind: np.ndarray, angle: np.ndarray, coords: np.ndarray,
                  alpha: float) -> None:
-    """Mark CLOSING edges in ``kind`` (in place) from every dangling end; see :func:`feature_edges`."""
+    """Mark CLOSING edges in ``kind`` (in place) from every dangling end; see
+    :func:`feature_edges`."""
     n_nodes = len(coords)
     lo, hi = edges[:, 0].astype(np.int64), edges[:, 1].astype(np.int64)
     both = np.concatenate([lo, hi])
@@ -215,7 +217,8 @@ def _close_lines(edges: np.ndarray, kind: np.ndarray, angle: np.ndarray, coords:
         while True:
             s, t = start[current], start[current + 1]
             cand_edges, cand_nodes = nb_edge[s:t], nb_node[s:t]
-            usable = (kind[cand_edges] == SMOOTH) & ~in_line[cand_nodes] & (follow[cand_edges] > half)
+            usable = ((kind[cand_edges] == SMOOTH) & ~in_line[cand_nodes]
+                      & (follow[cand_edges] > half))
             if not usable.any():
                 break
             best = np.flatnonzero(usable)[np.argmax(follow[cand_edges[usable]])]
@@ -276,7 +279,8 @@ def _feature_edge_array(feature, edges: np.ndarray) -> np.ndarray:
     if f.size == 0:
         return np.zeros(len(edges), bool)
     if f.ndim != 2 or f.shape[1] != 2 or f.dtype.kind not in "iu":
-        raise ValueError(f"feature edges must be a FeatureEdges or (K, 2) node pairs, got {f.shape} {f.dtype}")
+        raise ValueError("feature edges must be a FeatureEdges or (K, 2) node pairs, got "
+                         f"{f.shape} {f.dtype}")
     f = np.sort(f.astype(np.int64), axis=1)
     keys = (f[:, 0] << 32) | f[:, 1]
     table = _edge_keys(edges)
@@ -348,13 +352,15 @@ def element_adjacency(elements, labels=None):
     src = np.concatenate(src) if src else np.zeros(0, np.int64)
     dst = np.concatenate(dst) if dst else np.zeros(0, np.int64)
     keep = src != dst
-    graph = coo_matrix((np.ones(int(keep.sum()), np.int8), (src[keep], dst[keep])), shape=(m, m)).tocsr()
+    graph = coo_matrix((np.ones(int(keep.sum()), np.int8), (src[keep], dst[keep])),
+                       shape=(m, m)).tocsr()
     graph.sum_duplicates()
     return graph.indptr, graph.indices
 
 
 def planar_subpatches(elements, coords, patch_labels, d: float) -> np.ndarray:
-    """(M,) int64 subpatch label per element: least-squares planar pieces of each patch (fe2003 §3.2).
+    """(M,) int64 subpatch label per element: least-squares planar pieces of each patch
+    (fe2003 §3.2).
 
     Patches are processed in order of first element; within a patch, subpatches are grown one
     after the other:

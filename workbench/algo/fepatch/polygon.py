@@ -219,7 +219,8 @@ def _check_simple(pts: np.ndarray, loops: list[np.ndarray]) -> None:
             k = int(np.flatnonzero(hit)[0])
             raise ValueError(
                 "boundary edges cross or touch: "
-                f"({int(a_idx[i[k]])}, {int(b_idx[i[k]])}) and ({int(a_idx[j[k]])}, {int(b_idx[j[k]])})"
+                f"({int(a_idx[i[k]])}, {int(b_idx[i[k]])}) and "
+                f"({int(a_idx[j[k]])}, {int(b_idx[j[k]])})"
             )
 
     # With no edges crossing, one point per hole decides containment.

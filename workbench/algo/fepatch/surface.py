@@ -10,11 +10,11 @@ Texture conventions (shared with the shaders):
 
 * ``uv`` is in texel units: texel (row i, column j) has its centre at (j + ½, i + ½); the GL
   texture coordinate is ``uv / (W, H)`` with row 0 of the arrays uploaded first.
-* ``normal_map`` (H/k, W/k, 2) uint8, k a positive integer (the normal map may be coarser than
-  the wire map; both are sampled at ``uv / (W, H)``, the wire map's size), holds two components of the unit normal in model coordinates,
-  ``q = round((c + 1)·127.5)``, see :mod:`workbench.algo.fepatch.normalmap`; the vertex's
-  ``normal_axis`` says which component was dropped (0, 1, 2) and is restored as the positive
-  square root.
+* ``normal_map`` (H/k, W/k, 2) uint8, k a positive integer (the normal map may be coarser than the
+  wire map; both are sampled at ``uv / (W, H)``, the wire map's size), holds two components of the
+  unit normal in model coordinates, ``q = round((c + 1)·127.5)``, see
+  :mod:`workbench.algo.fepatch.normalmap`; the vertex's ``normal_axis`` says which component was
+  dropped (0, 1, 2) and is restored as the positive square root.
 * ``wire_map`` (H, W, 4) uint8 holds signed distances in texels, positive inside the outlining
   element: byte ``b`` stands for ``(b − 127.5)/127.5 · wire_range``. Elements of checkerboard
   colour 0 write the channel pair (G, B), colour 1 the pair (R, A); in each pair the first channel

@@ -31,11 +31,11 @@ Pixels follow :mod:`.rule` (llvmpipe's: 8 sub-pixel bits, pixel centres, top-lef
 its row order). The span table needs 0 sub-pixel bits (vertices on pixel centres): that
 choice, ``RasterOptions(generator="table", subpixel_bits=0)``, is the paper's renderer and
 deviates from GL's coverage by the snapping; the half-space generator runs with any bits.
-Only orthographic projections are drawn (the paper's; attributes are interpolated linearly in
-the image). A vertex more than 2^21 pixels outside the image (2^29 fixed-point units, where
-the exact integer edge functions would overflow) counts as unplaced and its triangles are
-dropped, where GL would clip them: with a camera fitted to the scene no vertex is that far. Refused with ValueError: a perspective projection, a table generator with
-sub-pixel bits, arrays of the wrong shapes.
+Only orthographic projections are drawn (the paper's; attributes are interpolated linearly in the
+image). A vertex more than 2^21 pixels outside the image (2^29 fixed-point units, where the exact
+integer edge functions would overflow) counts as unplaced and its triangles are dropped, where GL
+would clip them: with a camera fitted to the scene no vertex is that far. Refused with ValueError: a
+perspective projection, a table generator with sub-pixel bits, arrays of the wrong shapes.
 """
 
 from __future__ import annotations

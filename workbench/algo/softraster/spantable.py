@@ -248,7 +248,8 @@ def span_table(size: int, cache: bool = True, cache_dir=None) -> SpanTable:
     return table
 
 
-def table_spans(table: SpanTable, tx1: int, ty1: int, tx2: int, ty2: int) -> list[tuple[int, int, int]]:
+def table_spans(table: SpanTable, tx1: int, ty1: int, tx2: int,
+                ty2: int) -> list[tuple[int, int, int]]:
     """``(ty, first tx, last tx)`` of every non-empty scan line of the triangle with offsets
     ``(tx1, ty1)``, ``(tx2, ty2)`` (pixels, relative to v0, image orientation), top row first;
     offsets outside ``[−S, S − 1]`` are refused."""

@@ -84,7 +84,8 @@ def colour_error(image, exact: ExactImage) -> dict:
     """
     img = np.asarray(image)
     if img.shape[:2] != exact.covered.shape:
-        raise ValueError(f"image {img.shape[:2]} and exact image {exact.covered.shape} differ in size")
+        raise ValueError(f"image {img.shape[:2]} and exact image {exact.covered.shape} differ in "
+                         "size")
     err = np.abs(img[..., :3].astype(np.float64) - 255.0 * exact.rgb).max(axis=2)[exact.covered]
     n = int(exact.covered.sum())
     if n == 0:
@@ -95,8 +96,8 @@ def colour_error(image, exact: ExactImage) -> dict:
 
 
 def element_boundary(labels: np.ndarray) -> np.ndarray:
-    """(H, W) bool: pixels whose 4-neighbourhood holds another label (element index, −1 for none) — where
-    a rasteriser may legitimately pick the neighbour's element."""
+    """(H, W) bool: pixels whose 4-neighbourhood holds another label (element index, −1 for
+    none) — where a rasteriser may legitimately pick the neighbour's element."""
     p = np.pad(labels, 1, mode="edge")
     centre = p[1:-1, 1:-1]
     return ((p[:-2, 1:-1] != centre) | (p[2:, 1:-1] != centre)

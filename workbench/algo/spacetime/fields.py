@@ -136,7 +136,8 @@ def strain_energy_density(grad_u, material: Material) -> np.ndarray:
 
 def _broadcast(x, y, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     x, y, t = np.broadcast_arrays(
-        np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64), np.asarray(t, dtype=np.float64)
+        np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64),
+        np.asarray(t, dtype=np.float64)
     )
     return x, y, t
 
@@ -389,4 +390,5 @@ class RadialPulse(ElasticField):
         return g
 
     def _front_distance(self, x, y, t):
-        return np.abs(np.hypot(x - self.centre[0], y - self.centre[1]) - self.material.p_wave_speed * (t + self.t0))
+        return np.abs(np.hypot(x - self.centre[0], y - self.centre[1])
+                      - self.material.p_wave_speed * (t + self.t0))

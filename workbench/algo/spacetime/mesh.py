@@ -242,7 +242,8 @@ def refine(points, simplices, mask) -> tuple[np.ndarray, np.ndarray]:
     mask = np.asarray(mask, dtype=bool)
     if mask.shape != (len(simplices),):
         raise ValueError(f"mask must have shape ({len(simplices)},), got {mask.shape}")
-    if simplices.ndim != 2 or simplices.shape[1] not in (2, 3) or points.shape[1] != simplices.shape[1] - 1:
+    if (simplices.ndim != 2 or simplices.shape[1] not in (2, 3)
+            or points.shape[1] != simplices.shape[1] - 1):
         raise ValueError("refine takes segments (K, 2) over (N, 1) points or triangles (K, 3) "
                          f"over (N, 2) points; got {simplices.shape} over {points.shape}")
     if simplices.shape[1] == 2:
@@ -288,9 +289,11 @@ def _validate_space(space_points, space_simplices) -> tuple[np.ndarray, np.ndarr
     pts = np.asarray(space_points, dtype=np.float64)
     sim = np.asarray(space_simplices)
     if pts.ndim != 2 or pts.shape[1] not in (1, 2) or len(pts) == 0:
-        raise ValueError(f"space points must be a non-empty (N, D) array with D = 1 or 2, got {pts.shape}")
+        raise ValueError("space points must be a non-empty (N, D) array with D = 1 or 2, got "
+                         f"{pts.shape}")
     if sim.ndim != 2 or sim.shape[1] != pts.shape[1] + 1 or len(sim) == 0:
-        raise ValueError(f"space simplices must be a non-empty (K, {pts.shape[1] + 1}) array, got {sim.shape}")
+        raise ValueError(f"space simplices must be a non-empty (K, {pts.shape[1] + 1}) array, "
+                         f"got {sim.shape}")
     if not np.issubdtype(sim.dtype, np.integer):
         raise ValueError("space simplices must be integer indices")
     if sim.min() < 0 or sim.max() >= len(pts):
@@ -423,17 +426,17 @@ def front_refined(space_points, space_simplices, t_end: float, wave_speed: float
                   safety: float = 0.5, rng_seed: int = 0) -> SpacetimeMesh:
     """Tent-pitched spacetime mesh refined along a moving wave front, band by band (Fig. 2).
 
-    [t_start, t_end] is split into `bands` equal bands, at np.linspace(t_start, t_end, bands + 1). In each band the *base* space mesh is
-    refined `levels` times (`refine`): a simplex is marked when `front_distance(c, t)` at its
-    centroid c is below `width` plus its own size (longest edge) for any of 5 times spread over
-    the band; `front_distance(points (N, D), t) -> (N,)` is the distance to the wave front in
-    length units. Each band is then tent-pitched from its flat start front to its flat end
-    front; the next band starts on that end front, its points merged with the previous band's
-    end points where the spatial positions coincide exactly. Where the refined region moves
-    between bands, the simplices below and above a band boundary do not share faces: the mesh
-    is non-conforming there, as in the paper. With `front_distance=None` no refinement is done
-    and the mesh is conforming. D = 1 (segments) is refined by splitting at midpoints.
-    Refuses bands < 1, levels < 0, width < 0 and the bad inputs of `tent_pitch` (ValueError).
+    [t_start, t_end] is split into `bands` equal bands, at np.linspace(t_start, t_end, bands + 1).
+    In each band the *base* space mesh is refined `levels` times (`refine`): a simplex is marked
+    when `front_distance(c, t)` at its centroid c is below `width` plus its own size (longest edge)
+    for any of 5 times spread over the band; `front_distance(points (N, D), t) -> (N,)` is the
+    distance to the wave front in length units. Each band is then tent-pitched from its flat start
+    front to its flat end front; the next band starts on that end front, its points merged with the
+    previous band's end points where the spatial positions coincide exactly. Where the refined
+    region moves between bands, the simplices below and above a band boundary do not share faces:
+    the mesh is non-conforming there, as in the paper. With `front_distance=None` no refinement is
+    done and the mesh is conforming. D = 1 (segments) is refined by splitting at midpoints. Refuses
+    bands < 1, levels < 0, width < 0 and the bad inputs of `tent_pitch` (ValueError).
     """
     pts0, sim0 = _validate_space(space_points, space_simplices)
     bands, levels = int(bands), int(levels)
@@ -463,7 +466,8 @@ def front_refined(space_points, space_simplices, t_end: float, wave_speed: float
                 for t in np.linspace(t0, t1, 5):
                     d = np.asarray(front_distance(centroid, float(t)), dtype=np.float64)
                     if d.shape != (len(sim),):
-                        raise ValueError(f"front_distance must return shape ({len(sim)},), got {d.shape}")
+                        raise ValueError(f"front_distance must return shape ({len(sim)},), "
+                                         f"got {d.shape}")
                     mark |= d < reach
                 if not mark.any():
                     break

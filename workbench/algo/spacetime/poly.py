@@ -109,7 +109,8 @@ def _orders(derivative: str | None) -> np.ndarray:
     if derivative is None:
         return np.zeros(3, np.int64)
     if not isinstance(derivative, str) or len(derivative) > 3 or set(derivative) - set("xyt"):
-        raise ValueError(f"derivative must be None or up to three of 'x', 'y', 't' (e.g. 'xt'), got {derivative!r}")
+        raise ValueError("derivative must be None or up to three of 'x', 'y', 't' (e.g. 'xt'), "
+                         f"got {derivative!r}")
     return np.array([derivative.count(a) for a in "xyt"], np.int64)
 
 
@@ -130,11 +131,13 @@ def monomials(p, derivative: str | None = None) -> np.ndarray:
 def _check_mesh(points, simplices) -> tuple[np.ndarray, np.ndarray, int]:
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] not in (2, 3):
-        raise ValueError(f"points must have shape (P, 2) for (x, t) or (P, 3) for (x, y, t), got {pts.shape}")
+        raise ValueError("points must have shape (P, 2) for (x, t) or (P, 3) for (x, y, t), got "
+                         f"{pts.shape}")
     d = pts.shape[1]
     simp = np.asarray(simplices)
     if simp.ndim != 2 or simp.shape[1] != d + 1:
-        raise ValueError(f"simplices must have shape (M, {d + 1}) for points with {d} columns, got {simp.shape}")
+        raise ValueError(f"simplices must have shape (M, {d + 1}) for points with {d} columns, "
+                         f"got {simp.shape}")
     if not np.issubdtype(simp.dtype, np.integer):
         raise ValueError(f"simplices must be integer indices, got dtype {simp.dtype}")
     if simp.size and (simp.min() < 0 or simp.max() >= len(pts)):
@@ -180,7 +183,8 @@ def _lattice(d: int, n: int) -> np.ndarray:
 
 @lru_cache(maxsize=8)
 def _fit_operators(d: int, n: int):
-    """Fixed matrices of the fit in spacetime dimension d (2: (x, t), 3: (x, y, t)) at lattice order n.
+    """Fixed matrices of the fit in spacetime dimension d (2: (x, t), 3: (x, y, t)) at lattice
+    order n.
 
     The least-squares cubic through the lattice samples does not depend on how the cubic space is
     parametrised, so it is solved once on the reference simplex (barycentric ξ, well conditioned)
@@ -232,7 +236,8 @@ MIN_LOCAL_VOLUME = 1e-6
 of the unit cube are refused by ``fit_cubic``: the cubic fit on such slivers is meaningless."""
 
 
-def fit_cubic(points, simplices, displacement, *, lattice: int = 4, chunk: int = 50_000) -> np.ndarray:
+def fit_cubic(points, simplices, displacement, *, lattice: int = 4,
+              chunk: int = 50_000) -> np.ndarray:
     """Least-squares complete cubic per element of ``displacement(x, y, t) -> (..., 2)`` (mm),
     sampled at the order-``lattice`` barycentric lattice of each simplex (35 points for a
     tetrahedron at order 4, 15 for a triangle).
@@ -250,7 +255,8 @@ def fit_cubic(points, simplices, displacement, *, lattice: int = 4, chunk: int =
     """
     pts, simp, d = _check_mesh(points, simplices)
     if isinstance(lattice, bool) or int(lattice) != lattice or lattice < 3:
-        raise ValueError(f"lattice must be an integer >= 3 (a cubic needs the order-3 lattice), got {lattice!r}")
+        raise ValueError("lattice must be an integer >= 3 (a cubic needs the order-3 lattice), "
+                         f"got {lattice!r}")
     if isinstance(chunk, bool) or int(chunk) != chunk or chunk < 1:
         raise ValueError(f"chunk must be a positive integer, got {chunk!r}")
     if not callable(displacement):
@@ -274,10 +280,12 @@ def fit_cubic(points, simplices, displacement, *, lattice: int = 4, chunk: int =
             cols = [cols[0], np.zeros_like(cols[0]), cols[1]]
         u = np.asarray(displacement(*cols), dtype=np.float64)
         if u.shape != (n_lat, m, 2):
-            raise ValueError(f"displacement returned shape {u.shape} for inputs of shape {(n_lat, m)}, expected {(n_lat, m, 2)}")
+            raise ValueError(f"displacement returned shape {u.shape} for inputs of shape "
+                             f"{(n_lat, m)}, expected {(n_lat, m, 2)}")
         if not np.all(np.isfinite(u)):
             raise ValueError("displacement returned non-finite values")
-        r = (p_ref @ u.reshape(n_lat, 2 * m)).reshape(n_mono, m, 2)  # reference-monomial coefficients
+        # reference-monomial coefficients
+        r = (p_ref @ u.reshape(n_lat, 2 * m)).reshape(n_mono, m, 2)
         c = centre[e][:, axes]
         wl = extent[e][:, axes]
         vl = (v - c[:, None, :]) / wl[:, None, :]  # local vertices
@@ -286,7 +294,8 @@ def fit_cubic(points, simplices, displacement, *, lattice: int = 4, chunk: int =
         small = np.abs(det) * fact < MIN_LOCAL_VOLUME
         if np.any(small):
             bad = int(np.flatnonzero(small)[0])
-            raise ValueError(f"simplex {s + bad} is degenerate (local volume {abs(det[bad]) * fact:.3g})")
+            raise ValueError(f"simplex {s + bad} is degenerate "
+                             f"(local volume {abs(det[bad]) * fact:.3g})")
         rel = [q[:, j, None] - vl[None, :, 0, j] for j in range(d)]  # (n_q, m) each
         xi = [sum(inv[None, :, i, j] * rel[j] for j in range(d)) - 1.0 / (d + 1) for i in range(d)]
         rc = np.ascontiguousarray(np.moveaxis(r, 2, 0))  # (2, n_mono, m)
@@ -309,12 +318,14 @@ def _check_eval(coeffs, centre, extent, element, x, y, t):
     ce = np.asarray(centre, dtype=np.float64)
     ex = np.asarray(extent, dtype=np.float64)
     if ce.shape != (len(c), 3) or ex.shape != (len(c), 3):
-        raise ValueError(f"centre and extent must have shape ({len(c)}, 3), got {ce.shape} and {ex.shape}")
+        raise ValueError(f"centre and extent must have shape ({len(c)}, 3), got {ce.shape} and "
+                         f"{ex.shape}")
     if np.any(ex <= 0.0):
         raise ValueError("extent must be > 0")
     el = np.asarray(element)
     if el.ndim != 1 or not np.issubdtype(el.dtype, np.integer):
-        raise ValueError(f"element must be a 1-D integer array, got shape {el.shape} dtype {el.dtype}")
+        raise ValueError(f"element must be a 1-D integer array, got shape {el.shape} "
+                         f"dtype {el.dtype}")
     if el.size and (el.min() < 0 or el.max() >= len(c)):
         raise ValueError(f"element index outside 0..{len(c) - 1}")
     xyt = [np.asarray(a, dtype=np.float64) for a in (x, y, t)]
@@ -340,7 +351,8 @@ def _derived(c: np.ndarray, p: np.ndarray, w: np.ndarray, material: Material | N
     moving = speed > 0
     grad_speed = np.zeros((len(p), 2), dtype=p.dtype)
     grad_speed[moving] = np.einsum("ki,kij->kj", v[moving], dv[moving]) / speed[moving, None]
-    out = {"displacement": u, "velocity": v, "grad_u": grad, "speed": speed, "grad_speed": grad_speed}
+    out = {"displacement": u, "velocity": v, "grad_u": grad, "speed": speed,
+           "grad_speed": grad_speed}
     if material is not None:
         out["U"] = strain_energy_density(grad, material)
     return out
@@ -361,7 +373,8 @@ def evaluate(coeffs, centre, extent, element, x, y, t, material: Material | None
     return _derived(c[el], p, ex[el], material)
 
 
-def evaluate_float32(coeffs, centre, extent, element, x, y, t, material: Material, origin=None) -> dict:
+def evaluate_float32(coeffs, centre, extent, element, x, y, t, material: Material,
+                     origin=None) -> dict:
     """"U" (kJ/m³) and "speed" (mm/µs) computed entirely in float32, as a GPU would.
 
     ``origin`` None: the global coordinates and element centres are rounded to float32 and the
@@ -374,7 +387,8 @@ def evaluate_float32(coeffs, centre, extent, element, x, y, t, material: Materia
     if origin is not None:
         o = np.asarray(origin, dtype=np.float64).ravel()
         if o.shape not in ((2,), (3,)) or not np.all(np.isfinite(o)):
-            raise ValueError(f"origin must be 2 (x, y) or 3 (x, y, t) finite numbers, got {origin!r}")
+            raise ValueError("origin must be 2 (x, y) or 3 (x, y, t) finite numbers, got "
+                             f"{origin!r}")
         o = np.concatenate([o, [0.0]]) if len(o) == 2 else o
         xyt = xyt - o
         ce = ce - o
@@ -390,7 +404,8 @@ def evaluate_float32_global(coeffs, centre, extent, element, x, y, t, material: 
     return evaluate_float32(coeffs, centre, extent, element, x, y, t, material, origin=None)
 
 
-def evaluate_float32_local(coeffs, centre, extent, element, x, y, t, material: Material, origin=None) -> dict:
+def evaluate_float32_local(coeffs, centre, extent, element, x, y, t, material: Material,
+                           origin=None) -> dict:
     """``evaluate_float32`` on float32 coordinates relative to a float64 scene ``origin``
     ((x, y) or (x, y, t)); None takes the centre of the bounding box of all element centres
     (spatial part). Returns float32 "U" (kJ/m³) and "speed" (mm/µs), shape (K,)."""

@@ -29,8 +29,10 @@ class PixelGrid:
 
     def __post_init__(self) -> None:
         if not (self.width > 0 and self.height > 0):
-            raise ValueError(f"pixel grid must have a positive size, got {self.width}×{self.height}")
-        if not (self.dx > 0 and self.dy > 0 and np.isfinite([self.left, self.top, self.dx, self.dy]).all()):
+            raise ValueError("pixel grid must have a positive size, got "
+                             f"{self.width}×{self.height}")
+        if not (self.dx > 0 and self.dy > 0
+                and np.isfinite([self.left, self.top, self.dx, self.dy]).all()):
             raise ValueError(f"pixel sizes must be positive and coordinates finite: {self}")
 
     @classmethod

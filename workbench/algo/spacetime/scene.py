@@ -73,7 +73,8 @@ class SpacetimeScene:
         if P == 0:
             raise ValueError("nothing to draw: the scene has no polygons")
         M = len(self.coeffs)
-        if self.coeffs.shape != (M, 20, 2) or self.centre.shape != (M, 3) or self.extent.shape != (M, 3):
+        if (self.coeffs.shape != (M, 20, 2) or self.centre.shape != (M, 3)
+                or self.extent.shape != (M, 3)):
             raise ValueError("coeffs must be (M, 20, 2), centre and extent (M, 3)")
         if self.element.min() < 0 or self.element.max() >= M:
             raise ValueError(f"element indices must lie in [0, {M})")

@@ -11,7 +11,8 @@ arithmetic that matters:
 * **height field** — ``z = height_scale·|v|`` (mm, with |v| in mm/µs); its exact normal is
   ``normalize(−h ∂|v|/∂x, −h ∂|v|/∂y, 1)``, and ``(0, 0, 1)`` where the gradient vanishes;
 * **Phong lighting** with diffuse and specular reflectances that are multiples of the colour
-  (the paper's choice): ``rgb = c·(AMBIENT + DIFFUSE·max(n·l, 0) + SPECULAR·max(r·e, 0)^SHININESS)``,
+  (the paper's choice):
+  ``rgb = c·(AMBIENT + DIFFUSE·max(n·l, 0) + SPECULAR·max(r·e, 0)^SHININESS)``,
   ``r = 2(n·l)n − l`` the reflected light, ``l`` the fixed unit light direction ``LIGHT`` and
   ``e`` the unit direction towards the eye (``(0, 0, 1)`` for the top view the exact images
   use), clamped to [0, 1] per channel.

@@ -1,6 +1,8 @@
-"""Synthetic FE scenes of the papers' kinds and sizes: pure numpy, float64, returning :class:`FEMesh`.
+"""Synthetic FE scenes of the papers' kinds and sizes: pure numpy, float64, returning
+:class:`FEMesh`.
 
-- :func:`semicylinders` — the es2008 benchmark: stacked semi-cylindrical sheets with a distance field.
+- :func:`semicylinders` — the es2008 benchmark: stacked semi-cylindrical sheets with a distance
+  field.
 - :func:`stamped_panel`, :func:`stamped_panels` — quad-dominant stamped sheet-metal parts (beads,
   flanges, holes, a few per cent triangles) of any size, e.g. the crash2000 Table 1 model sizes.
 - :func:`refine` — conforming k×k refinement of any FE shell mesh (fields and time steps follow);

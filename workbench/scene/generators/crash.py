@@ -58,7 +58,8 @@ def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str
     strain = _plastic_strain(mesh.elements, nodes, coords)
     node_fields = {key: (np.broadcast_to(v[0], (steps,) + v.shape[1:]).copy() if v.ndim == 2 else v)
                    for key, v in mesh.node_fields.items()}
-    element_fields = {key: (np.broadcast_to(v[0], (steps,) + v.shape[1:]).copy() if v.ndim == 2 else v)
+    element_fields = {key: (np.broadcast_to(v[0], (steps,) + v.shape[1:]).copy() if v.ndim == 2
+                            else v)
                       for key, v in mesh.element_fields.items()}
     node_fields["displacement"] = displacement
     element_fields["plastic_strain"] = strain
@@ -99,14 +100,16 @@ def _crushed_coordinates(mesh: FEMesh, a_idx: int, a: np.ndarray, steps: int, cr
     moving = np.zeros(len(nodes), bool)
     moving[mesh.elements[~np.isin(mesh.parts, np.asarray(still_parts, np.int64))].ravel()] = True
     if not moving.any():
-        raise MeshError(f"{mesh.name}: every part is in still_parts {tuple(still_parts)}; nothing to crush")
+        raise MeshError(f"{mesh.name}: every part is in still_parts {tuple(still_parts)}; "
+                        "nothing to crush")
     used = np.flatnonzero(moving)
     along = nodes @ a
     front, back = along[used].max(), along[used].min()
     extent = front - back
     if not extent > 0:
         raise MeshError(f"{mesh.name}: no extent along {axis!r} to crush")
-    lam = 0.08 * extent if fold_wavelength is None else _positive_float(fold_wavelength, "fold_wavelength")
+    lam = (0.08 * extent if fold_wavelength is None
+           else _positive_float(fold_wavelength, "fold_wavelength"))
     depth = np.maximum(front - along, 0.0)
 
     # lateral direction: the node normal with its axial part removed (a fixed perpendicular axis

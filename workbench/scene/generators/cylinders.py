@@ -10,7 +10,8 @@ from .common import _positive_float, _positive_int
 
 def semicylinders(sheets: int = 8, n: int = 250, radius: float = 100.0, spacing: float = 10.0,
                   height: float | None = None) -> FEMesh:
-    """The es2008 benchmark scene: ``sheets`` semi-cylindrical sheets of n×n quads, one behind the other.
+    """The es2008 benchmark scene: ``sheets`` semi-cylindrical sheets of n×n quads, one behind
+    the other.
 
     The paper (Kawai et al., section 3) gives only: 8 semi-cylindrical sheets placed in depth order,
     each a 250 by 250 grid, 1 M triangles in total, a scalar proportional to the distance from the

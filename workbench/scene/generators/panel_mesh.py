@@ -16,7 +16,8 @@ from .panel_plan import _PanelPlan, _segment_distance
 
 def _cell_elements(ii: np.ndarray, jj: np.ndarray, missing: np.ndarray, stride: int) -> np.ndarray:
     """(len(ii), 4) elements of grid cells (i, j), node (i, j) = j * stride + i; a cell with
-    ``missing`` corner c (0..3 counter-clockwise from (i, j)) becomes the triangle of the other three."""
+    ``missing`` corner c (0..3 counter-clockwise from (i, j)) becomes the triangle of the other
+    three."""
     base = jj.astype(np.int64) * stride + ii
     quads = np.stack([base, base + 1, base + stride + 1, base + stride], axis=1)
     tri = missing >= 0
@@ -112,7 +113,8 @@ def _cut_holes(plan: _PanelPlan, keep: np.ndarray, xs, ys, sx, sy, in_xf,
     for cx, cy, r in plan.holes:
         keep &= ~(top_cell & ((xc[None, :] - cx) ** 2 + (yc[:, None] - cy) ** 2 < r * r))
         node_in |= top_node & ((xs[None, :] - cx) ** 2 + (ys[:, None] - cy) ** 2 < r * r)
-    corner_in = np.stack([node_in[:-1, :-1], node_in[:-1, 1:], node_in[1:, 1:], node_in[1:, :-1]], axis=-1)
+    corner_in = np.stack([node_in[:-1, :-1], node_in[:-1, 1:], node_in[1:, 1:], node_in[1:, :-1]],
+                         axis=-1)
     missing = np.where(corner_in.sum(axis=-1) == 1, np.argmax(corner_in, axis=-1), -1)  # (ny, nx)
     return keep, missing
 
@@ -164,7 +166,8 @@ def _split_quads(quads: np.ndarray, share: float, seed: int) -> np.ndarray:
         first = np.where(diag[:, None], q[:, [0, 1, 3, 3]], q[:, [0, 1, 2, 2]])
         second = np.where(diag[:, None], q[:, [1, 2, 3, 3]], q[:, [0, 2, 3, 3]])
         out = np.repeat(quads, np.where(split, 2, 1), axis=0)
-        pos = np.flatnonzero(split) + np.arange(n_split)  # index in `out` of each split's first child
+        # index in `out` of each split's first child
+        pos = np.flatnonzero(split) + np.arange(n_split)
         out[pos] = first
         out[pos + 1] = second
         quads = out
@@ -210,10 +213,12 @@ def _build_panel(plan: _PanelPlan, nf: dict[str, int], ntx: int, nty: int):
     dev_x = np.where(X <= 0.0, -sx[None, :], np.where(X >= L, L + sx[None, :], X))
     dev_y = np.where(Y <= 0.0, -sy[:, None], np.where(Y >= W, W + sy[:, None], Y))
     bend = np.zeros_like(X)
-    for side, coord, edge in (("x-", dev_x, 0.0), ("x+", dev_x, L), ("y-", dev_y, 0.0), ("y+", dev_y, W)):
+    for side, coord, edge in (("x-", dev_x, 0.0), ("x+", dev_x, L), ("y-", dev_y, 0.0),
+                              ("y+", dev_y, W)):
         if plan.flanges.get(side, 0.0) > 0:
             bend = np.maximum(bend, np.exp(-(((coord - edge) / 8.0) ** 2)))
-    thickness = plan.thickness * (1.0 - 0.10 * bead - 0.03 * np.clip(crown_shape, 0, None) - 0.06 * bend)
+    thickness = plan.thickness * (1.0 - 0.10 * bead - 0.03 * np.clip(crown_shape, 0, None)
+                                  - 0.06 * bend)
 
     ox, oy, oz = plan.origin
     nodes = np.stack([X + ox, Y + oy, z + oz], axis=-1).reshape(-1, 3)

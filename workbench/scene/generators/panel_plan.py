@@ -90,14 +90,16 @@ def _draw_features(plan: _PanelPlan, rng: np.random.Generator, n_beads: int, n_h
                 for hx, hy, hr in holes
             )
             if clear:
-                beads.append((float(x0), float(y0), float(x1), float(y1), float(half), float(height)))
+                beads.append((float(x0), float(y0), float(x1), float(y1), float(half),
+                              float(height)))
                 break
     plan.holes = holes
     plan.beads = beads
 
 
 def _grid_counts(plan: _PanelPlan, hx: float, hy: float) -> tuple[dict[str, int], int, int]:
-    """Flange element counts per side and top-face element counts along x and y for spacings hx, hy."""
+    """Flange element counts per side and top-face element counts along x and y for spacings
+    hx, hy."""
     nf = {s: (max(1, int(round(d / (hx if s[0] == "x" else hy)))) if d > 0 else 0)
           for s, d in plan.flanges.items()}
     for s in _SIDES:
@@ -105,8 +107,9 @@ def _grid_counts(plan: _PanelPlan, hx: float, hy: float) -> tuple[dict[str, int]
     return nf, max(2, int(round(plan.length / hx))), max(2, int(round(plan.width / hy)))
 
 
-def _draw_plan(rng: np.random.Generator, length: float, width: float, flange_depths: dict[str, float],
-               triangle_share: float, seed: int, origin=(0.0, 0.0, 0.0)) -> _PanelPlan:
+def _draw_plan(rng: np.random.Generator, length: float, width: float,
+               flange_depths: dict[str, float], triangle_share: float, seed: int,
+               origin=(0.0, 0.0, 0.0)) -> _PanelPlan:
     return _PanelPlan(
         length=length, width=width, flanges=dict(flange_depths),
         crown=float(rng.uniform(0.03, 0.07) * min(length, width)),

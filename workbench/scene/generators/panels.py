@@ -83,9 +83,9 @@ def stamped_panels(target_quads: int, parts: int | None = None, seed: int = 0, *
     on all four sides, 1–3 beads, 1–3 holes, nominal thickness 0.7–2 mm) are laid out in rows
     on the xy plane (z up), meshed with one element size chosen so that the quad count lands
     within about 0.5 % of ``target_quads`` (single element rows of single parts close the last
-    gap on small models, where one row is a step of a few per cent). Neighbouring parts face each other
-    with parallel flanges ``gap`` mm apart (default 1.5 mm: the "potential flanges" of crash2000,
-    distance ≤ 2 mm). Parts share no nodes (independently meshed components).
+    gap on small models, where one row is a step of a few per cent). Neighbouring parts face each
+    other with parallel flanges ``gap`` mm apart (default 1.5 mm: the "potential flanges" of
+    crash2000, distance ≤ 2 mm). Parts share no nodes (independently meshed components).
 
     ``parts`` defaults to about one part per 3 000 quads (at least 2, at most 256), which gives
     element sizes of 5–10 mm as in car crash models. Part id = part index. Fields as in

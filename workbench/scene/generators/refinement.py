@@ -52,7 +52,8 @@ def _quad_children(eq: np.ndarray, q_edge: np.ndarray, q_fwd: np.ndarray, k: int
     """(nq, k*k, 4) children of the quads ``eq``, whose interior nodes are numbered from
     ``quad_base`` on, (k-1)² per quad."""
     nq, n_inner = len(eq), (k - 1) ** 2
-    # quads: local grid G[j, i] at (s, t) = (i/k, j/k); corners e0 (0,0), e1 (1,0), e2 (1,1), e3 (0,1)
+    # quads: local grid G[j, i] at (s, t) = (i/k, j/k);
+    # corners e0 (0,0), e1 (1,0), e2 (1,1), e3 (0,1)
     G = np.empty((nq, k + 1, k + 1), np.int64)
     if nq:
         rq = np.arange(nq)
@@ -60,8 +61,10 @@ def _quad_children(eq: np.ndarray, q_edge: np.ndarray, q_fwd: np.ndarray, k: int
         if k > 1:
             G[:, 0, 1:k] = _edge_nodes(q_edge, q_fwd, 0, k, n_nodes)  # e0 -> e1 along s
             G[:, 1:k, k] = _edge_nodes(q_edge, q_fwd, 1, k, n_nodes)  # e1 -> e2 along t
-            G[:, k, 1:k] = _edge_nodes(q_edge, q_fwd, 2, k, n_nodes)[:, ::-1]  # e2 -> e3 runs against s
-            G[:, 1:k, 0] = _edge_nodes(q_edge, q_fwd, 3, k, n_nodes)[:, ::-1]  # e3 -> e0 runs against t
+            # e2 -> e3 runs against s
+            G[:, k, 1:k] = _edge_nodes(q_edge, q_fwd, 2, k, n_nodes)[:, ::-1]
+            # e3 -> e0 runs against t
+            G[:, 1:k, 0] = _edge_nodes(q_edge, q_fwd, 3, k, n_nodes)[:, ::-1]
             G[:, 1:k, 1:k] = (quad_base + rq[:, None] * n_inner
                               + np.arange(n_inner)[None, :]).reshape(nq, k - 1, k - 1)
     ii, jj = np.meshgrid(np.arange(k), np.arange(k))      # child (j, i), row-major in j
@@ -90,8 +93,10 @@ def _triangle_children(et: np.ndarray, t_edge: np.ndarray, t_fwd: np.ndarray, k:
         H[:, 0, 0], H[:, 0, k], H[:, k, 0] = et[:, 0], et[:, 1], et[:, 2]
         if k > 1:
             H[:, 0, 1:k] = _edge_nodes(t_edge, t_fwd, 0, k, n_nodes)  # e0 -> e1 along i
-            H[:, m, k - m] = _edge_nodes(t_edge, t_fwd, 1, k, n_nodes)  # e1 -> e2: (i, j) = (k - m, m)
-            H[:, 1:k, 0] = _edge_nodes(t_edge, t_fwd, 2, k, n_nodes)[:, ::-1]  # e2 -> e0 runs against j
+            # e1 -> e2: (i, j) = (k - m, m)
+            H[:, m, k - m] = _edge_nodes(t_edge, t_fwd, 1, k, n_nodes)
+            # e2 -> e0 runs against j
+            H[:, 1:k, 0] = _edge_nodes(t_edge, t_fwd, 2, k, n_nodes)[:, ::-1]
             if n_inner:
                 H[:, jin, iin] = (tri_base + np.arange(nt)[:, None] * n_inner
                                   + np.arange(n_inner)[None, :])
@@ -119,7 +124,8 @@ class _Refinement:
         # unique edges, each with k-1 nodes numbered from its smaller node id
         nq, nt = len(quads), len(tris)
         a = np.concatenate([eq.ravel(), et[:, :3].ravel()])
-        b = np.concatenate([np.roll(eq, -1, axis=1).ravel(), np.roll(et[:, :3], -1, axis=1).ravel()])
+        b = np.concatenate([np.roll(eq, -1, axis=1).ravel(),
+                            np.roll(et[:, :3], -1, axis=1).ravel()])
         lo, hi = np.minimum(a, b), np.maximum(a, b)
         ukeys, inverse = np.unique(lo * np.int64(n_nodes) + hi, return_inverse=True)
         self.edge_lo, self.edge_hi = ukeys // n_nodes, ukeys % n_nodes
@@ -193,13 +199,15 @@ def displaced(mesh: FEMesh, amplitude: float = 10.0, wavelength: float = 1200.0)
     wavelength = _positive_float(wavelength, "wavelength")
     x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
     nodes = mesh.nodes.copy()
-    nodes[:, 2] += amplitude * np.sin(2 * np.pi * x / wavelength) * np.cos(2 * np.pi * y / wavelength)
+    nodes[:, 2] += (amplitude * np.sin(2 * np.pi * x / wavelength)
+                    * np.cos(2 * np.pi * y / wavelength))
     return FEMesh(nodes, mesh.elements, parts=mesh.parts, name=f"{mesh.name} displaced",
                   part_names=dict(mesh.part_names))
 
 
 def refine(mesh: FEMesh, k: int) -> FEMesh:
-    """Conforming k×k refinement: every quad into k² quads (bilinear), every triangle into k² triangles.
+    """Conforming k×k refinement: every quad into k² quads (bilinear), every triangle into k²
+    triangles.
 
     New node positions are the parent's bilinear map (quads) or barycentric map (triangles) at
     parameters i/k; nodes on an element edge are shared by all elements using that edge, so a
