@@ -66,6 +66,7 @@ def client():
         cluster = LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
                                dashboard_address=None, silence_logs=logging.CRITICAL)
     client = Client(cluster)
+    client.wait_for_workers(2, timeout=120)  # started processes register in their own time
     yield client
     client.close()
     cluster.close()
