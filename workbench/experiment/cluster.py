@@ -22,9 +22,14 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import dask
 from distributed import Client, LocalCluster, Lock, WorkerPlugin, get_worker
+
+if TYPE_CHECKING:
+    import moderngl
+    from distributed import Worker
 
 PLUGIN_NAME = "workbench-gl"
 CONNECT_TIMEOUT_S = 30
@@ -46,9 +51,9 @@ class GLContextPlugin(WorkerPlugin):
     def __init__(self, imports: tuple[str, ...] = ()) -> None:
         self.renderer: str | None = None
         self.imports = tuple(imports)
-        self._contexts: dict[int, object] = {}
+        self._contexts: dict[int, moderngl.Context] = {}
 
-    async def setup(self, worker) -> None:
+    async def setup(self, worker: Worker) -> None:
         _import_in_main_thread()
         executor = worker.executors.get("default")
         await asyncio.get_running_loop().run_in_executor(executor, self._start)
@@ -66,7 +71,7 @@ class GLContextPlugin(WorkerPlugin):
         for module in self.imports:
             importlib.import_module(module)
 
-    def context(self):
+    def context(self) -> moderngl.Context:
         """The moderngl context of the calling thread, created on first use."""
         thread = threading.get_ident()
         ctx = self._contexts.get(thread)
@@ -79,7 +84,7 @@ class GLContextPlugin(WorkerPlugin):
                 self.renderer = renderer(ctx)
         return ctx
 
-    def teardown(self, worker) -> None:
+    def teardown(self, worker: Worker) -> None:
         self._contexts.clear()  # the process exits with its contexts; releasing needs their threads
 
 
@@ -96,7 +101,7 @@ def _import_in_main_thread() -> None:
         pass
 
 
-def worker_context():
+def worker_context() -> moderngl.Context:
     """The GL context of the worker running the calling task (RuntimeError elsewhere)."""
     try:
         plugin = get_worker().plugins[PLUGIN_NAME]

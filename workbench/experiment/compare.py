@@ -7,8 +7,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 SSIM_WINDOW = 7  # scikit-image's default window; smaller images are refused
 
@@ -46,7 +50,7 @@ def _check_image(image, name: str) -> np.ndarray:
     return image
 
 
-def difference_map(a, b) -> np.ndarray:
+def difference_map(a: ArrayLike, b: ArrayLike) -> np.ndarray:
     """(H, W) uint8: the largest absolute channel difference of each pixel, in 1/255."""
     a, b = _check_image(a, "a"), _check_image(b, "b")
     if a.shape != b.shape:
@@ -54,7 +58,7 @@ def difference_map(a, b) -> np.ndarray:
     return np.abs(a.astype(np.int16) - b.astype(np.int16)).max(axis=2).astype(np.uint8)
 
 
-def compare_images(a, b, mask=None) -> ImageDiff:
+def compare_images(a: ArrayLike, b: ArrayLike, mask: ArrayLike | None = None) -> ImageDiff:
     """Compare image ``b`` with reference ``a`` (same shape, uint8, 3 or 4 channels).
 
     With a boolean (H, W) ``mask`` every statistic covers only the masked pixels (SSIM: the mean
@@ -95,7 +99,8 @@ def compare_images(a, b, mask=None) -> ImageDiff:
                      ssim=ssim)
 
 
-def compare_drawn(image, reference, background=(1.0, 1.0, 1.0, 1.0)) -> ImageDiff:
+def compare_drawn(image: ArrayLike, reference: ArrayLike,
+                  background: ArrayLike = (1.0, 1.0, 1.0, 1.0)) -> ImageDiff:
     """:func:`compare_images` of ``image`` against ``reference`` over the pixels either draws
     (differs from ``background``, as in :func:`coverage`): a background both leave empty does
     not count towards the statistics."""
@@ -103,7 +108,7 @@ def compare_drawn(image, reference, background=(1.0, 1.0, 1.0, 1.0)) -> ImageDif
     return compare_images(reference, image, mask=mask)
 
 
-def difference_image(a, b, gain: int = 8) -> np.ndarray:
+def difference_image(a: ArrayLike, b: ArrayLike, gain: int = 8) -> np.ndarray:
     """(H, W, 4) uint8 opaque grey picture of how ``a`` and ``b`` differ in RGB: white where
     they agree, darker by ``gain`` grey levels per 1/255 of the largest channel difference
     (black from 255 / ``gain`` on)."""
@@ -129,7 +134,8 @@ def _background_bytes(background) -> np.ndarray:
     raise TypeError(f"background must be numeric, got {background!r}")
 
 
-def coverage(image, background=(1.0, 1.0, 1.0, 1.0), tolerance: int = 0) -> np.ndarray:
+def coverage(image: ArrayLike, background: ArrayLike = (1.0, 1.0, 1.0, 1.0),
+             tolerance: int = 0) -> np.ndarray:
     """(H, W) bool: pixels whose colour differs from ``background`` by more than ``tolerance``.
 
     ``background`` has 3 (RGB compared) or 4 (RGBA compared) components: floats in [0, 1] as
@@ -144,13 +150,14 @@ def coverage(image, background=(1.0, 1.0, 1.0, 1.0), tolerance: int = 0) -> np.n
     return (diff > tolerance).any(axis=2)
 
 
-def wire_pixels(image, wire_color) -> np.ndarray:
+def wire_pixels(image: ArrayLike, wire_color: ArrayLike) -> np.ndarray:
     """(H, W) bool: pixels of exactly ``wire_color`` (RGB in [0, 1]), the wire frame's pixels."""
     colour = np.round(np.asarray(wire_color, np.float64) * 255).astype(np.uint8)
     return (_check_image(image, "image")[..., :3] == colour).all(axis=-1)
 
 
-def wire_agreement(image, reference, wire_color) -> dict:
+def wire_agreement(image: ArrayLike, reference: ArrayLike,
+                   wire_color: ArrayLike) -> dict[str, int | float]:
     """How the wire pixels of ``image`` agree with those of ``reference`` (a line-overdraw
     image), with a tolerance of one pixel (3 × 3 dilation, scikit-image):
 
@@ -173,7 +180,7 @@ def wire_agreement(image, reference, wire_color) -> dict:
                 wire_exact_overlap=float((a & b).sum() / max((a | b).sum(), 1)))
 
 
-def crack_pixels(image, background=(1.0, 1.0, 1.0, 1.0)) -> np.ndarray:
+def crack_pixels(image: ArrayLike, background: ArrayLike = (1.0, 1.0, 1.0, 1.0)) -> np.ndarray:
     """(H, W) bool: background pixels enclosed by drawn ones — cracks seen through a surface
     that should be closed (st2005 §4.3), e.g. between elements whose heights disagree.
 

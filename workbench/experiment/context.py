@@ -19,9 +19,20 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from ..data import shared_file
 from .tables import write_table
+
+if TYPE_CHECKING:
+    import moderngl
+
+    from ..paths.backends import Backend
+    from ..paths.base import RenderPath
+    from ..scene.protocol import Scene
+    from .measure import Measurement
+
+T = TypeVar("T")
 
 SIZES = ("full", "quick", "tiny")
 FULL_REPEATS, QUICK_REPEATS = 9, 5
@@ -33,7 +44,7 @@ class Case:
     column, with an optional ``kind`` (say "paper size", "car part")."""
 
     label: str
-    scene: object
+    scene: Scene
     kind: str = ""
 
 
@@ -62,9 +73,10 @@ class ExperimentContext:
 
     @property
     def tiny(self) -> bool:
+        """Whether this is the smallest run ("tiny")."""
         return self.size == "tiny"
 
-    def pick(self, full, quick, tiny=None):
+    def pick(self, full: T, quick: T, tiny: T | None = None) -> T:
         """The value for this run's size: ``full``, ``quick``, or ``tiny`` (default ``quick``)."""
         if self.size == "full":
             return full
@@ -88,7 +100,7 @@ class ExperimentContext:
         """The path of output file ``name`` inside the run's folder."""
         return self.out_dir / name
 
-    def table(self, rows: Sequence[dict], name: str, title: str,
+    def table(self, rows: Sequence[dict[str, Any]], name: str, title: str,
               columns: Sequence[str] | None = None) -> None:
         """Write ``rows`` as ``<name>.csv`` and ``<name>.md`` (titled) into the run's folder."""
         write_table(rows, self.out_dir, name, columns=columns, title=title)
@@ -104,7 +116,7 @@ class ExperimentContext:
                      f"data folder)")
         return path
 
-    def builtin(self, name: str, what: str | None = None):
+    def builtin(self, name: str, what: str | None = None) -> Scene | None:
         """The built-in scene ``name`` (at this run's size where it has one); None, said and
         recorded, where its shared data is absent."""
         from ..scene.builtin import builtin_scene
@@ -118,7 +130,7 @@ class ExperimentContext:
             return None
 
     @cached_property
-    def gl(self):
+    def gl(self) -> moderngl.Context:
         """The run's headless GL context, created on first use."""
         from ..gl import create_context
 
@@ -131,7 +143,9 @@ class ExperimentContext:
 
         return renderer(self.gl)
 
-    def measure(self, scene, path, style=None, *, backend=None, **options):
+    def measure(self, scene: Scene, path: str | RenderPath, style: object | None = None, *,
+                backend: moderngl.Context | Backend | None = None,
+                **options: Any) -> Measurement:
         """:func:`~workbench.experiment.measure.measure` on ``backend`` (default the run's GL
         context) with this run's repeats unless ``repeats`` is given."""
         from .measure import measure

@@ -52,8 +52,14 @@ import os
 import time
 from dataclasses import dataclass, field
 from numbers import Real
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from ..scene.mesh import FEMesh
 
 __all__ = ["TOOLS", "TRIMESH_SAMPLE", "RefResult", "available_tools", "compare_with_exact",
            "own_part_groups", "reference_part_distances"]
@@ -125,7 +131,7 @@ def available_tools() -> tuple[str, ...]:
 
 
 # ------------------------------------------------------------------------- own parts
-def own_part_groups(mesh) -> list[tuple[np.ndarray, np.ndarray]]:
+def own_part_groups(mesh: FEMesh) -> list[tuple[np.ndarray, np.ndarray]]:
     """Nodes grouped by their own parts: ``[(parts, nodes), ...]``, ``parts`` the sorted part ids
     of every element using the nodes (empty for nodes no element uses), ``nodes`` sorted node
     indices. Groups come sorted by their part tuples."""
@@ -316,7 +322,7 @@ def _check_step(mesh, step) -> int:
     return int(step)
 
 
-def reference_part_distances(tool: str, mesh, cutoff: float, *, step: int = 0,
+def reference_part_distances(tool: str, mesh: FEMesh, cutoff: float, *, step: int = 0,
                              local_origin: bool = True, sample: int | None = None,
                              seed: int = 0) -> RefResult:
     """Every node's distance to the nearest element of another part by reference ``tool`` (one
@@ -416,7 +422,8 @@ def reference_part_distances(tool: str, mesh, cutoff: float, *, step: int = 0,
 
 
 # ------------------------------------------------------------------------- accuracy
-def compare_with_exact(exact, ref, *, tolerance: float = 1e-6) -> dict:
+def compare_with_exact(exact: ArrayLike, ref: ArrayLike | RefResult, *,
+                       tolerance: float = 1e-6) -> dict[str, Any]:
     """A reference tool's distances against the exact ones, node by node.
 
     ``exact`` (N,) and ``ref`` (N,) (or a :class:`RefResult`) in model units, ``inf`` above the

@@ -12,8 +12,16 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    import moderngl
+
+    from ..gl import Camera
+    from ..paths.exploded import ExplodedPath
+    from ..scene.mesh import FEMesh
 
 BAR_PX = 3  # height of the frame progress bar
 
@@ -30,9 +38,11 @@ class ExplodeAnimation:
     o_max: float
 
 
-def explode_animation(ctx, scene, path, camera, size: tuple[int, int], count: int, *,
+def explode_animation(ctx: moderngl.Context, scene: FEMesh, path: ExplodedPath, camera: Camera,
+                      size: tuple[int, int], count: int, *,
                       steps: Iterable[int] | None = None,
-                      on_frame: Callable | None = None) -> ExplodeAnimation:
+                      on_frame: Callable[[int, float, float, ExplodedPath], object] | None = None,
+                      ) -> ExplodeAnimation:
     """``count`` frames of the exploded path ``path`` (unprepared) animating ``scene`` on the
     GL context ``ctx``, seen by ``camera``, ``size`` (W, H) pixels each.
 

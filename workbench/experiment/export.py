@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -9,7 +10,8 @@ import numpy as np
 from .tables import atomic_write_bytes, atomic_write_text
 
 
-def write_surface(path, vertices: np.ndarray, triangles: np.ndarray) -> Path:
+def write_surface(path: str | os.PathLike[str], vertices: np.ndarray,
+                  triangles: np.ndarray) -> Path:
     """Write the triangles ``triangles`` (T × 3 indices into ``vertices``, N × 3) to ``path``
     in the format its suffix names (``.ply``, the default without one, ``.obj``, ``.stl`` and
     the other formats trimesh exports); only the vertices the triangles use are written,

@@ -10,12 +10,18 @@ file is written atomically.
 from __future__ import annotations
 
 import io
+import os
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .tables import atomic_write_bytes
+
+if TYPE_CHECKING:
+    from matplotlib.colors import Colormap
+    from numpy.typing import ArrayLike
 
 DPI = 100
 MARGIN = 10  # pixels around panels
@@ -38,7 +44,7 @@ def _rgba(image: np.ndarray) -> np.ndarray:
     return np.concatenate([image, np.full(image.shape[:2] + (1,), 255, np.uint8)], axis=2)
 
 
-def save_png(path, image) -> Path:
+def save_png(path: str | os.PathLike[str], image: ArrayLike) -> Path:
     """Write a uint8 (H, W, 3|4) image, row 0 at the top, as an RGBA PNG (atomically)."""
     from PIL import Image
 
@@ -48,7 +54,7 @@ def save_png(path, image) -> Path:
     return atomic_write_bytes(path, buffer.getvalue())
 
 
-def with_progress_bar(image, done: int, total: int, height: int = 3) -> np.ndarray:
+def with_progress_bar(image: ArrayLike, done: int, total: int, height: int = 3) -> np.ndarray:
     """(H, W, 3) uint8 copy of ``image`` with a bar along its bottom ``height`` rows, dark over
     the share ``done / total`` of the width: it marks an animation's frames apart (GIF writers
     merge identical consecutive frames)."""
@@ -59,7 +65,8 @@ def with_progress_bar(image, done: int, total: int, height: int = 3) -> np.ndarr
     return frame
 
 
-def save_animation(path, frames: Sequence, duration_ms: int = 100) -> Path:
+def save_animation(path: str | os.PathLike[str], frames: Sequence[ArrayLike],
+                   duration_ms: int = 100) -> Path:
     """Write uint8 (H, W, 3|4) ``frames`` (all of one size) atomically: an animated GIF (one
     frame every ``duration_ms``, looping) for a ``.gif`` path, else the frames side by side as a
     PNG strip. Refuses no frames and frames of different sizes."""
@@ -155,8 +162,10 @@ def _enlarge(image: np.ndarray, scale: int) -> np.ndarray:
     return image if scale == 1 else np.repeat(np.repeat(image, scale, axis=0), scale, axis=1)
 
 
-def save_field_figure(path, image, *, value_range, colormap, label: str, units: str,
-                      title: str | None = None, bands: int = 0, log: bool = False) -> Path:
+def save_field_figure(path: str | os.PathLike[str], image: ArrayLike, *,
+                      value_range: tuple[float, float], colormap: str | Colormap | ArrayLike,
+                      label: str, units: str, title: str | None = None, bands: int = 0,
+                      log: bool = False) -> Path:
     """A rendered field image with a colour bar ``label [units]``; returns the path.
 
     ``value_range`` = (low, high) is the field range the render mapped onto ``colormap`` (a
@@ -187,7 +196,8 @@ def save_field_figure(path, image, *, value_range, colormap, label: str, units: 
     return _write_figure(fig, path)
 
 
-def save_image_grid(path, images: Sequence, titles: Sequence[str], *, columns: int | None = None,
+def save_image_grid(path: str | os.PathLike[str], images: Sequence[ArrayLike],
+                    titles: Sequence[str], *, columns: int | None = None,
                     colormap: str = "magma", scalar_label: str = "|difference| [1/255]") -> Path:
     """Images side by side, each under its title; returns the path.
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,7 +24,13 @@ from ..paths.base import RenderPath
 from ..paths.registry import DEFAULT_PATHS, path_class
 from ..paths.style import style_summary
 from ..scene.needs import Derivation, derive, derived_items, needed_items
-from .timing import MIN_REPEATS, time_draw
+from .timing import MIN_REPEATS, Timing, time_draw
+
+if TYPE_CHECKING:
+    import moderngl
+
+    from ..paths.backends import Backend
+    from ..scene.protocol import Scene
 
 WHITE = (1.0, 1.0, 1.0, 1.0)
 UNTIMED = ("gpu_ms", "gpu_ms_min", "gpu_ms_max", "wall_ms", "wall_ms_min", "wall_ms_max",
@@ -37,14 +44,15 @@ class Measurement:
     :class:`~workbench.experiment.timing.Timing`, None untimed) and ``path`` (released; its
     counters — triangles, bytes, ``scale`` — stay readable)."""
 
-    row: dict
+    row: dict[str, Any]
     image: np.ndarray
-    timing: object
+    timing: Timing | None
     path: RenderPath
 
 
-def default_camera(scene, size: tuple[int, int], view: tuple[float, float] = (30.0, 25.0),
-                   projection: str = "orthographic", up: str = "z", style=None) -> Camera:
+def default_camera(scene: Scene, size: tuple[int, int],
+                   view: tuple[float, float] = (30.0, 25.0), projection: str = "orthographic",
+                   up: str = "z", style: object | None = None) -> Camera:
     """A camera showing all of ``scene`` at ``size`` (W, H): the default camera of the family
     of paths that draws scenes of its kind (:meth:`RenderPath.default_camera`) — for an FE mesh
     or a textured surface :meth:`Camera.fit_box` at azimuth/elevation ``view`` (degrees) over
@@ -56,10 +64,12 @@ def default_camera(scene, size: tuple[int, int], view: tuple[float, float] = (30
                                  style=style)
 
 
-def measure(backend, scene, path, style=None, camera: Camera | None = None,
+def measure(backend: moderngl.Context | Backend, scene: Scene, path: str | RenderPath,
+            style: object | None = None, camera: Camera | None = None,
             size: tuple[int, int] = (800, 600), repeats: int = 7, *, warmup: int = 2,
-            samples: int = 0, step: int | None = None, background=WHITE,
-            timed: bool = True, probe: Callable[[RenderPath], dict] | None = None) -> Measurement:
+            samples: int = 0, step: int | None = None,
+            background: tuple[float, float, float, float] = WHITE, timed: bool = True,
+            probe: Callable[[RenderPath], dict[str, Any]] | None = None) -> Measurement:
     """Measure ``path`` (a registry name, made with ``style``, or an unprepared
     :class:`RenderPath`) drawing ``scene`` (an FE mesh, a spacetime scene or a textured
     surface) on ``backend`` (a GL context, or a backend of :mod:`workbench.paths.backends`:

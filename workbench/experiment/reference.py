@@ -26,11 +26,18 @@ import ctypes
 import math
 import time
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..gl.context import raw_gl
 from .timing import Timing, check_counts
+
+if TYPE_CHECKING:
+    import pyrender
+    from numpy.typing import ArrayLike
+
+    from ..gl import Camera
 
 AMBIENT, DIFFUSE = 0.25, 0.75  # the workbench paths' lighting model
 GAMMA = 2.2  # pyrender's output encoding
@@ -115,8 +122,10 @@ class PyrenderReference:
 
     name = "pyrender"
 
-    def __init__(self, vertices, triangles, normals, camera, size, *, colors=None,
-                 base_color=None, background=(1.0, 1.0, 1.0, 1.0)) -> None:
+    def __init__(self, vertices: ArrayLike, triangles: ArrayLike, normals: ArrayLike,
+                 camera: Camera, size: tuple[int, int], *, colors: ArrayLike | None = None,
+                 base_color: ArrayLike | None = None,
+                 background: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0)) -> None:
         if colors is not None and base_color is not None:
             raise ValueError("give per-vertex colors or one base_color, not both")
         vertices = np.asarray(vertices, np.float64)
@@ -185,7 +194,7 @@ class PyrenderReference:
             self.renderer_name = self._GL.glGetString(self._GL.GL_RENDERER).decode()
 
     @staticmethod
-    def pyrender_camera(camera):
+    def pyrender_camera(camera: Camera) -> pyrender.Camera:
         """The pyrender camera with ``camera``'s projection (same matrix, see the tests)."""
         pyrender, _, _ = _load()
         if camera.projection == "orthographic":
@@ -265,7 +274,7 @@ class PyrenderReference:
     def __enter__(self) -> PyrenderReference:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.release()
 
     def __del__(self) -> None:

@@ -97,8 +97,8 @@ def get_experiment(name: str) -> Experiment:
         raise KeyError(f"unknown experiment {name!r}; known: {known}{hint}") from None
 
 
-def run_experiment(name: str, figures_root: Path = Path("figures"), quick: bool = False,
-                   progress: Progress | None = None,
+def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figures"),
+                   quick: bool = False, progress: Progress | None = None,
                    size: str | None = None) -> tuple[list[dict], Path]:
     """Run experiment ``name`` into ``figures_root/<name>/`` and write its table there.
 

@@ -34,9 +34,14 @@ from __future__ import annotations
 
 import contextlib
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["Simplified", "SIMPLIFIERS", "PART_SIMPLIFIERS", "simplify_with", "simplify_per_part",
            "part_border_vertices", "pymeshlab_hausdorff", "igl_hausdorff", "open3d_distances"]
@@ -214,7 +219,7 @@ PART_SIMPLIFIERS = {
 }
 
 
-def part_border_vertices(triangles, parts) -> np.ndarray:
+def part_border_vertices(triangles: ArrayLike, parts: ArrayLike) -> np.ndarray:
     """Sorted ids of the vertices on a border of some part: on an edge with one triangle of
     that part (triangles (K, 3) int, parts (K,) labels)."""
     t = np.asarray(triangles, np.int64)
@@ -225,7 +230,8 @@ def part_border_vertices(triangles, parts) -> np.ndarray:
     return np.unique(rows[counts == 1, 1:])
 
 
-def simplify_with(method: str, vertices, triangles, target_triangles: int) -> Simplified:
+def simplify_with(method: str, vertices: ArrayLike, triangles: ArrayLike,
+                  target_triangles: int) -> Simplified:
     """Simplify with reference ``method`` (a key of :data:`SIMPLIFIERS`) towards
     ``target_triangles``; failures and empty outputs are reported in ``failure``."""
     try:
@@ -247,7 +253,8 @@ def simplify_with(method: str, vertices, triangles, target_triangles: int) -> Si
     return Simplified(method, u, g, seconds, shares, failure)
 
 
-def simplify_per_part(method: str, vertices, triangles, parts, targets: dict) -> Simplified:
+def simplify_per_part(method: str, vertices: ArrayLike, triangles: ArrayLike, parts: ArrayLike,
+                      targets: Mapping[int, int]) -> Simplified:
     """Simplify each part on its own with reference ``method`` (a key of
     :data:`PART_SIMPLIFIERS`), part ``label`` towards ``targets[label]`` triangles, under that
     tool's border constraint; the output is the parts' results together (``parts`` labels its
@@ -295,7 +302,8 @@ def simplify_per_part(method: str, vertices, triangles, parts, targets: dict) ->
                       "per part", borders, np.concatenate(out_p))
 
 
-def pymeshlab_hausdorff(va, fa, vb, fb, samples: int) -> dict:
+def pymeshlab_hausdorff(va: ArrayLike, fa: ArrayLike, vb: ArrayLike, fb: ArrayLike,
+                        samples: int) -> dict[str, float]:
     """pymeshlab's one-sided sampled Hausdorff from mesh A to mesh B with ``samples`` samples
     (vertices, edges and faces of A): ``max``, ``mean``, ``rms`` in model units and ``seconds``."""
     import pymeshlab
@@ -312,7 +320,8 @@ def pymeshlab_hausdorff(va, fa, vb, fb, samples: int) -> dict:
                 seconds=time.perf_counter() - start)
 
 
-def igl_hausdorff(va, fa, vb, fb) -> dict:
+def igl_hausdorff(va: ArrayLike, fa: ArrayLike, vb: ArrayLike,
+                  fb: ArrayLike) -> dict[str, float]:
     """libigl's ``hausdorff`` (symmetric, as documented) and its seconds."""
     import igl
 
@@ -322,7 +331,7 @@ def igl_hausdorff(va, fa, vb, fb) -> dict:
     return dict(value=float(value), seconds=time.perf_counter() - start)
 
 
-def open3d_distances(points, vb, fb) -> dict:
+def open3d_distances(points: ArrayLike, vb: ArrayLike, fb: ArrayLike) -> dict[str, Any]:
     """open3d's ``RaycastingScene.compute_distance`` (float32) from ``points`` to mesh B: the
     distances (float64 copy), their max, and seconds (scene build included)."""
     import open3d as o3d

@@ -27,6 +27,7 @@ import time
 import uuid
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from dask.sizeof import sizeof
@@ -43,6 +44,12 @@ from ..algo.softraster.composite import (
 )
 from ..algo.softraster.frame import Frame
 
+if TYPE_CHECKING:
+    from ..algo.softraster import RasterOptions
+    from ..gl import Camera
+    from ..paths.software import SoftwarePath
+    from ..paths.style import Style
+
 METHODS = ("tree", "swap")
 KEY_PREFIX = "sortlast"
 
@@ -57,13 +64,13 @@ class SoftwareDomains:
 
     scene: str
     path: str
-    style: object
-    camera: object
-    size: tuple
-    options: object = None
+    style: Style | None
+    camera: Camera
+    size: tuple[int, int]
+    options: RasterOptions | None = None
     quick: bool = False
 
-    def prepared(self):
+    def prepared(self) -> SoftwarePath:
         """The prepared :class:`~workbench.paths.software.SoftwarePath` of this process."""
         key = (self.scene, self.path, repr(self.style), repr(self.camera), tuple(self.size),
                repr(self.options), self.quick)

@@ -15,6 +15,7 @@ from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from numbers import Integral, Real
 from pathlib import Path
+from typing import IO, Any
 
 import numpy as np
 
@@ -28,7 +29,8 @@ def _umask() -> int:
 
 
 @contextmanager
-def atomic_open(path, mode: str = "w", **kwargs) -> Iterator:
+def atomic_open(path: str | os.PathLike[str], mode: str = "w",
+                **kwargs: Any) -> Iterator[IO[Any]]:
     """Open a temporary file beside ``path`` for writing; move it onto ``path`` on success.
 
     On an exception the temporary file is removed and ``path`` is left as it was.
@@ -53,14 +55,14 @@ def atomic_open(path, mode: str = "w", **kwargs) -> Iterator:
         raise
 
 
-def atomic_write_text(path, text: str) -> Path:
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
     """Write ``text`` (UTF-8) to ``path`` atomically; returns the path."""
     with atomic_open(path, "w", encoding="utf-8", newline="") as handle:
         handle.write(text)
     return Path(path)
 
 
-def atomic_write_bytes(path, data: bytes) -> Path:
+def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
     """Write ``data`` to ``path`` atomically; returns the path."""
     with atomic_open(path, "wb") as handle:
         handle.write(data)
@@ -72,7 +74,7 @@ def _plain(value):
     return value.item() if isinstance(value, np.generic) else value
 
 
-def table_columns(rows: Iterable[dict]) -> list[str]:
+def table_columns(rows: Iterable[dict[str, Any]]) -> list[str]:
     """The union of the rows' keys in first-seen order."""
     columns: dict[str, None] = {}
     for row in rows:
@@ -107,7 +109,7 @@ def format_number(value: float, digits: int = SIGNIFICANT_DIGITS) -> str:
     return f"{value:.{max(0, digits - 1 - magnitude)}f}"
 
 
-def format_value(value) -> str:
+def format_value(value: object) -> str:
     """One Markdown cell: numbers formatted readably, None empty, ``|`` escaped."""
     value = _plain(value)
     if value is None:
@@ -126,7 +128,7 @@ def _is_number(value) -> bool:
     return isinstance(value, Real) and not isinstance(value, bool)
 
 
-def markdown_table(rows: Sequence[dict], columns: Sequence[str] | None = None,
+def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[str] | None = None,
                    title: str | None = None) -> str:
     """An aligned Markdown pipe table (numeric columns right-aligned), with an optional heading."""
     rows = _check_rows(rows)
@@ -157,7 +159,8 @@ def _csv_value(value):
     return "" if value is None else value
 
 
-def write_table(rows: Sequence[dict], directory, name: str = "table",
+def write_table(rows: Sequence[dict[str, Any]], directory: str | os.PathLike[str],
+                name: str = "table",
                 columns: Sequence[str] | None = None,
                 title: str | None = None) -> tuple[Path, Path]:
     """Write ``rows`` as ``<directory>/<name>.csv`` and ``<name>.md``; returns both paths.
@@ -200,7 +203,7 @@ def _parse(text: str):
         return text
 
 
-def read_table(csv_path) -> list[dict]:
+def read_table(csv_path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     """Rows of a table written by :func:`write_table`.
 
     Empty cells come back as None, ``True``/``False`` as bools, cells that parse as int or float

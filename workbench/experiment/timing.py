@@ -13,9 +13,16 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from statistics import median
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..paths.backends import as_backend
+
+if TYPE_CHECKING:
+    import moderngl
+
+    from ..gl import Framebuffer
+    from ..paths.backends import Backend
+    from ..paths.software import SoftwareTarget
 
 MIN_REPEATS = 5
 
@@ -77,8 +84,10 @@ class Timing:
         return {prefix + name: getattr(self, name) for name in names}
 
 
-def time_draw(backend, fb, draw: Callable[[], Any], warmup: int = 2, repeat: int = 7,
-              readback_repeat: int | None = None, background=(1.0, 1.0, 1.0, 1.0)) -> Timing:
+def time_draw(backend: moderngl.Context | Backend, fb: Framebuffer | SoftwareTarget,
+              draw: Callable[[], Any], warmup: int = 2, repeat: int = 7,
+              readback_repeat: int | None = None,
+              background: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0)) -> Timing:
     """Time ``draw()`` into framebuffer ``fb`` on ``backend`` (a GL context, or a backend of
     :mod:`workbench.paths.backends`): GPU, wall and read-back milliseconds.
 
