@@ -6,6 +6,8 @@
 * ``car``, ``car_deck``, ``d3plot_file``: the shared LS-DYNA car deck (as a fresh mesh, and as
   a file) and the shared d3plot, skipped with the reason where the shared data is absent; a
   test using one is marked ``shared_data``.
+* ``experiment_run``: ``experiment_run(name, size)`` runs a registered experiment once per
+  session at ``size`` ("tiny", or "quick" for the slow tests) and returns ``(rows, out_dir)``.
 * Markers: ``slow`` (end-to-end experiment runs and cluster sweeps; ``pytest`` leaves them out,
   ``pytest -m "slow or not slow"`` runs everything), ``gl``, ``shared_data``.
 """
@@ -69,3 +71,22 @@ def car(car_deck):
     from workbench.scene.builtin import fresh_scene
 
     return fresh_scene("car")
+
+
+@pytest.fixture(scope="session")
+def experiment_run(tmp_path_factory):
+    """``run(name, size) -> (rows, out_dir)``: experiment ``name`` at ``size``, run once per
+    session into a folder of its own (its tables and figures stay for every test that reads
+    them)."""
+    from workbench.experiment.registry import discover, run_experiment
+
+    done = {}
+
+    def run(name: str, size: str):
+        if (name, size) not in done:
+            discover()
+            root = tmp_path_factory.mktemp(f"{name}-{size}")
+            done[name, size] = run_experiment(name, figures_root=root, size=size)
+        return done[name, size]
+
+    return run

@@ -3,7 +3,6 @@ what its tables show in its quick form (slow)."""
 
 import pytest
 
-from workbench.experiment.registry import discover, run_experiment
 from workbench.experiment.tables import read_table
 
 NAME = "table_bvh_distance"
@@ -27,16 +26,13 @@ FIGURES = ("fig9_distance.png", "fig9_flanges.png", "connectivity.png")
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory):
-    discover()
-    return run_experiment(NAME, figures_root=tmp_path_factory.mktemp("figures"), size="tiny")
+def tiny(experiment_run):
+    return experiment_run(NAME, "tiny")
 
 
 @pytest.fixture(scope="module")
-def result(tmp_path_factory):
-    discover()
-    root = tmp_path_factory.mktemp("figures")
-    return run_experiment(NAME, figures_root=root, quick=True)
+def result(experiment_run):
+    return experiment_run(NAME, "quick")
 
 
 def check_hierarchies(rows, models: int) -> None:

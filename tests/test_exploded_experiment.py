@@ -32,13 +32,13 @@ def _run(root, size):
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory):
-    return _run(tmp_path_factory.mktemp("figures"), "tiny")
+def tiny(experiment_run):
+    return experiment_run("fig_exploded", "tiny")
 
 
 @pytest.fixture(scope="module")
-def result(tmp_path_factory):
-    return _run(tmp_path_factory.mktemp("figures"), "quick")
+def result(experiment_run):
+    return experiment_run("fig_exploded", "quick")
 
 
 def _box(rows):

@@ -7,7 +7,6 @@ import csv
 import pytest
 
 from workbench.algo.fepatch.pipeline import PARAMETER_SETS
-from workbench.experiment.registry import discover, run_experiment
 from workbench.experiment.tables import read_table
 
 ERRORS = ["d_mm", "hausdorff_mm", "hausdorff_lower_mm", "hausdorff_pct_diag", "hausdorff_s",
@@ -43,17 +42,13 @@ TABLES = {
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory):
-    discover()
-    root = tmp_path_factory.mktemp("figures")
-    return run_experiment("table_fe_texture_wireframe", figures_root=root, size="tiny")
+def tiny(experiment_run):
+    return experiment_run("table_fe_texture_wireframe", "tiny")
 
 
 @pytest.fixture(scope="module")
-def quick(tmp_path_factory):
-    discover()
-    root = tmp_path_factory.mktemp("figures")
-    return run_experiment("table_fe_texture_wireframe", figures_root=root, quick=True)
+def quick(experiment_run):
+    return experiment_run("table_fe_texture_wireframe", "quick")
 
 
 @pytest.fixture(params=["tiny", pytest.param("quick", marks=pytest.mark.slow)])

@@ -3,7 +3,6 @@ the tiny size, and what its tables show in its quick form (slow)."""
 
 import pytest
 
-from workbench.experiment.registry import discover, run_experiment
 from workbench.experiment.tables import read_table
 
 NAME = "fig_pixel_exact"
@@ -32,17 +31,13 @@ FIGURES = ("fig3_bar", "fig5_slice", "fig5_crop", "fig5_colorbar", "fig4_cracks"
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory):
-    discover()
-    return run_experiment(NAME, figures_root=tmp_path_factory.mktemp("figures"), size="tiny")
+def tiny(experiment_run):
+    return experiment_run(NAME, "tiny")
 
 
 @pytest.fixture(scope="module")
-def result(tmp_path_factory):
-    discover()
-    root = tmp_path_factory.mktemp("figures")
-    rows, out_dir = run_experiment(NAME, figures_root=root, quick=True)
-    return rows, out_dir
+def result(experiment_run):
+    return experiment_run(NAME, "quick")
 
 
 def check_tables_and_figures(out_dir, min_png_bytes: int) -> None:

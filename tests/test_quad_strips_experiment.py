@@ -6,7 +6,6 @@ Every test on ``result`` runs at the tiny size (seconds) and, marked slow, on th
 
 import pytest
 
-from workbench.experiment.registry import discover, run_experiment
 from workbench.experiment.tables import read_table
 
 # per size: the paper sizes stripped, the car meshes named, the refinement k of the largest
@@ -19,11 +18,8 @@ DRAWN_PANELS = {"tiny": "panels_2215_wire.png", "quick": "panels_51473_wire.png"
 
 
 @pytest.fixture(scope="module", params=["tiny", pytest.param("quick", marks=pytest.mark.slow)])
-def result(request, tmp_path_factory):
-    discover()
-    root = tmp_path_factory.mktemp(f"figures_{request.param}")
-    rows, out_dir = run_experiment("table_quad_strips", figures_root=root, size=request.param)
-    return request.param, rows, out_dir
+def result(request, experiment_run):
+    return request.param, *experiment_run("table_quad_strips", request.param)
 
 
 def test_paper_sizes_are_stripped_better_than_triangle_strips(result):

@@ -15,18 +15,9 @@ SEMICYLINDERS = {"tiny": "semicylinders n=4", "quick": "semicylinders n=64"}
 
 
 @pytest.fixture(scope="module")
-def runs(car_deck, tmp_path_factory):
-    """size → (size, rows, out_dir), each size run once per module."""
-    done = {}
-
-    def run(size):
-        if size not in done:
-            discover()
-            root = tmp_path_factory.mktemp(f"figures_{size}")
-            done[size] = (size, *run_experiment("render_paths", figures_root=root, size=size))
-        return done[size]
-
-    return run
+def runs(car_deck, experiment_run):
+    """size → (size, rows, out_dir), each size run once per session."""
+    return lambda size: (size, *experiment_run("render_paths", size))
 
 
 @pytest.fixture(scope="module", params=["tiny", pytest.param("quick", marks=pytest.mark.slow)])

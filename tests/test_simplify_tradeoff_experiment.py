@@ -8,23 +8,13 @@ import numpy as np
 import pytest
 
 from workbench.experiment.context import ExperimentContext
-from workbench.experiment.registry import discover, run_experiment
 from workbench.experiment.tables import read_table
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    """size → (size, rows, out_dir), each size run once per module."""
-    done = {}
-
-    def run(size):
-        if size not in done:
-            discover()
-            root = tmp_path_factory.mktemp(f"figures_{size}")
-            done[size] = (size, *run_experiment("simplify_tradeoff", figures_root=root, size=size))
-        return done[size]
-
-    return run
+def runs(experiment_run):
+    """size → (size, rows, out_dir), each size run once per session."""
+    return lambda size: (size, *experiment_run("simplify_tradeoff", size))
 
 
 @pytest.fixture(scope="module", params=["tiny", pytest.param("quick", marks=pytest.mark.slow)])

@@ -6,7 +6,6 @@ import re
 import pytest
 
 from workbench.algo.softraster import STEPS
-from workbench.experiment.registry import discover, run_experiment
 from workbench.experiment.tables import read_table
 
 NAME = "table_software_raster"
@@ -33,16 +32,13 @@ SCENE_LABEL = re.compile(r"^(benchmark|large) 8x\d+x\d+ ")
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory):
-    discover()
-    return run_experiment(NAME, figures_root=tmp_path_factory.mktemp("figures"), size="tiny")
+def tiny(experiment_run):
+    return experiment_run(NAME, "tiny")
 
 
 @pytest.fixture(scope="module")
-def result(tmp_path_factory):
-    discover()
-    root = tmp_path_factory.mktemp("figures")
-    return run_experiment(NAME, figures_root=root, quick=True)
+def result(experiment_run):
+    return experiment_run(NAME, "quick")
 
 
 def check_software_rows(rows, differing_pct_gl_rule: float | None) -> None:
