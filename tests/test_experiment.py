@@ -1,5 +1,6 @@
 """Measurement harness: image error, tables, timing, registry, figures, pyrender reference."""
 
+import ctypes
 import math
 import tempfile
 from dataclasses import dataclass
@@ -34,6 +35,7 @@ from workbench.experiment.figures import MIN_PANEL_HEIGHT
 from workbench.experiment.measure import measure
 from workbench.experiment.registry import clean_dead_runs
 from workbench.gl import Camera, Framebuffer, create_context
+from workbench.gl.context import egl, keeping_current
 from workbench.paths import RenderPath
 
 # the workbench paths' lighting: colour · (0.25 + 0.75 |n·l|), headlight along the view direction
@@ -359,6 +361,49 @@ def test_run_experiment_writes_table(tmp_path):
     assert read_table(out_dir / "table.csv") == [{"case": "a", "ms": 1.5, "extra": None},
                                                  {"case": "b", "ms": 2.5, "extra": 3}]
     assert (out_dir / "table.md").read_text().startswith("# dummy-harness-check")
+
+
+@pytest.mark.gl
+def test_run_experiment_releases_its_gl_context(tmp_path):
+    EGL = egl()
+
+    def current():
+        return ctypes.cast(EGL.eglGetCurrentContext(), ctypes.c_void_p).value
+
+    with keeping_current() as restore:  # the other tests' context is current again afterwards
+        ctx = create_context()  # the caller's context, current when the runs start
+        restore.display = EGL.eglGetCurrentDisplay()
+        before = current()
+        made = []
+
+
+        @experiment("dummy-gl-release", "draws nothing, makes a GL context")
+        def run(exp):
+            made.append(exp.gl)
+            assert exp.renderer and current() != before
+            return [{"case": "a"}]
+
+        @experiment("dummy-gl-fails", "makes a GL context, then fails")
+        def fail(exp):
+            made.append(exp.gl)
+            raise RuntimeError("broken experiment")
+
+        try:
+            run_experiment("dummy-gl-release", tmp_path, size="tiny")
+            assert current() == before
+            with pytest.raises(RuntimeError, match="broken experiment"):
+                run_experiment("dummy-gl-fails", tmp_path, size="tiny")
+            # the caller's context is current again and still draws
+            assert current() == before
+            fb = ctx.simple_framebuffer((2, 2))
+            fb.use()
+            ctx.clear(0.0, 1.0, 0.0, 1.0)
+            assert fb.read(components=4)[:4] == b"\x00\xff\x00\xff"
+        finally:
+            del EXPERIMENTS["dummy-gl-release"], EXPERIMENTS["dummy-gl-fails"]
+            ctx.release()
+    # released when each run ended, whether it returned rows or failed
+    assert [type(c.mglo).__name__ for c in made] == ["InvalidObject", "InvalidObject"]
 
 
 def test_discover_imports_every_module(tmp_path, monkeypatch):

@@ -16,6 +16,7 @@ further tables go through :meth:`ExperimentContext.table`, figures into
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -59,6 +60,7 @@ class ExperimentContext:
     size: str = "full"
     progress: Callable[[str], None] | None = None
     skipped: list[str] = field(default_factory=list)
+    _gl_scope: ExitStack | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         if self.size not in SIZES:
@@ -131,10 +133,31 @@ class ExperimentContext:
 
     @cached_property
     def gl(self) -> moderngl.Context:
-        """The run's headless GL context, created on first use."""
-        from ..gl import create_context
+        """The run's headless GL context, created on first use (and current from then on)."""
+        from ..gl.context import create_context, egl, keeping_current
 
-        return create_context()
+        scope = ExitStack()
+        restore = scope.enter_context(keeping_current())
+        try:
+            ctx = create_context()
+        except BaseException:
+            scope.close()
+            raise
+        restore.display = egl().eglGetCurrentDisplay()
+        self._gl_scope = scope
+        return ctx
+
+    def close(self) -> None:
+        """Release the run's GL context, if one was made, with every GL object still in it,
+        and make current again the context that was current before it (none if none was).
+        The registry calls this when the run ends, so that one process running several
+        experiments holds one context at a time."""
+        ctx = self.__dict__.pop("gl", None)
+        if ctx is not None:
+            ctx.release()
+            if self._gl_scope is not None:
+                self._gl_scope.close()
+                self._gl_scope = None
 
     @property
     def renderer(self) -> str:

@@ -25,12 +25,11 @@ from __future__ import annotations
 import ctypes
 import math
 import time
-from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..gl.context import raw_gl
+from ..gl.context import keeping_current, raw_gl
 from .timing import Timing, check_counts
 
 if TYPE_CHECKING:
@@ -58,35 +57,6 @@ def _load():
     from OpenGL import EGL
 
     return pyrender, EGL, GL
-
-
-class _Restore:
-    """Where to leave no context current if none was current on entry (pyrender's display)."""
-
-    display = None
-
-
-@contextmanager
-def _keeping_current(EGL, own_display=None):
-    """Make the EGL context that is current on entry current again on exit.
-
-    If none was current, make none current on ``own_display`` (settable on the yielded object).
-    """
-    display = EGL.eglGetCurrentDisplay()
-    draw = EGL.eglGetCurrentSurface(EGL.EGL_DRAW)
-    read = EGL.eglGetCurrentSurface(EGL.EGL_READ)
-    context = EGL.eglGetCurrentContext()
-    restore = _Restore()
-    restore.display = own_display
-    try:
-        yield restore
-    finally:
-        if context:
-            if not EGL.eglMakeCurrent(display, draw, read, context):
-                raise RuntimeError("could not make the previous EGL context current again")
-        elif restore.display is not None:
-            EGL.eglMakeCurrent(restore.display, EGL.EGL_NO_SURFACE, EGL.EGL_NO_SURFACE,
-                               EGL.EGL_NO_CONTEXT)
 
 
 def _colours(colors, count: int) -> np.ndarray:
@@ -185,7 +155,7 @@ class PyrenderReference:
         self._scene = scene
         self._flags = pyrender.RenderFlags.RGBA
         self._offscreen_flags = pyrender.RenderFlags.RGBA | pyrender.RenderFlags.OFFSCREEN
-        with _keeping_current(self._EGL) as restore:
+        with keeping_current() as restore:
             self._offscreen = pyrender.OffscreenRenderer(width, height)
             # pyrender's own delete() terminates the EGL display shared with moderngl
             self._offscreen.delete = lambda: None
@@ -211,7 +181,7 @@ class PyrenderReference:
     def render(self) -> np.ndarray:
         """(H, W, 4) uint8 RGBA, row 0 at the top; the caller's EGL context stays current."""
         self._check_alive()
-        with _keeping_current(self._EGL, self._restore_display):
+        with keeping_current(self._restore_display):
             color, _depth = self._offscreen.render(self._scene, flags=self._flags)
         return np.array(color, np.uint8)
 
@@ -224,7 +194,7 @@ class PyrenderReference:
         self._check_alive()
         GL = self._GL
         wall, gpu, readback = [], [], []
-        with _keeping_current(self._EGL, self._restore_display):
+        with keeping_current(self._restore_display):
             self._platform.make_current()
             try:
                 query = int(GL.glGenQueries(1)[0])
@@ -261,7 +231,7 @@ class PyrenderReference:
         self._offscreen = None
         EGL, platform = self._EGL, self._platform
         renderer = offscreen._renderer
-        with _keeping_current(EGL, self._restore_display):
+        with keeping_current(self._restore_display):
             platform.make_current()
             renderer.delete()
         EGL.eglDestroyContext(platform._egl_display, platform._egl_context)

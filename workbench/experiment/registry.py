@@ -123,8 +123,12 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     clean_dead_runs(root, exp.name)
     staging = Path(tempfile.mkdtemp(dir=root, prefix=f".{exp.name}.",
                                     suffix=f".{os.getpid()}.partial"))
+    context = ExperimentContext(exp.name, staging, size, progress)
     try:
-        rows = exp.function(ExperimentContext(exp.name, staging, size, progress))
+        try:
+            rows = exp.function(context)
+        finally:
+            context.close()
         if rows is None:
             raise TypeError(f"experiment {name!r} returned None instead of a list of rows")
         rows = list(rows)

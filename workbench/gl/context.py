@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from types import ModuleType
 
 import moderngl
@@ -53,3 +55,45 @@ def raw_gl() -> ModuleType:
     from OpenGL import GL
 
     return GL
+
+
+def egl() -> ModuleType:
+    """PyOpenGL's ``EGL`` module (PyOpenGL bound through EGL as in :func:`raw_gl`)."""
+    raw_gl()
+    from OpenGL import EGL
+
+    return EGL
+
+
+class _Restore:
+    """Where to leave no context current if none was current on entry (settable)."""
+
+    display = None
+
+
+@contextmanager
+def keeping_current(own_display=None) -> Iterator[_Restore]:
+    """Make the EGL context that is current on entry current again on exit.
+
+    moderngl draws in whichever context is current, so code that makes another context current
+    (pyrender's, or a context made and released for one run) must hand the caller's back. If
+    none was current on entry, make none current on ``own_display`` (settable on the yielded
+    object) so that a released context does not stay current. RuntimeError when the previous
+    context cannot be made current again.
+    """
+    EGL = egl()
+    display = EGL.eglGetCurrentDisplay()
+    draw = EGL.eglGetCurrentSurface(EGL.EGL_DRAW)
+    read = EGL.eglGetCurrentSurface(EGL.EGL_READ)
+    context = EGL.eglGetCurrentContext()
+    restore = _Restore()
+    restore.display = own_display
+    try:
+        yield restore
+    finally:
+        if context:
+            if not EGL.eglMakeCurrent(display, draw, read, context):
+                raise RuntimeError("could not make the previous EGL context current again")
+        elif restore.display is not None:
+            EGL.eglMakeCurrent(restore.display, EGL.EGL_NO_SURFACE, EGL.EGL_NO_SURFACE,
+                               EGL.EGL_NO_CONTEXT)
