@@ -609,3 +609,20 @@ def test_bad_input_is_refused_with_a_reason():
         gouraud_split(quads[::-1].copy(), [nodes], 30.0, t)
     with pytest.raises(ValueError, match="normals|coords"):
         gouraud_split(quads, [nodes], 30.0, t).normals(nodes[:2])
+
+
+def test_mesh_steps_and_coordinates_are_checked_in_one_place():
+    nodes = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+    steps = np.stack([nodes, nodes + 1.0, nodes])
+    steps[2, 3] = np.nan
+    mesh = FEMesh(nodes, np.array([[0, 1, 2, 3]]), steps=steps, name="plate")
+    assert [mesh.step_index(s) for s in (0, np.int64(1), 2)] == [0, 1, 2]
+    for bad in (True, 1.0, 1.5, "1", None, math.nan):
+        with pytest.raises(ValueError, match="reference_step must be an integer step"):
+            mesh.step_index(bad, "reference_step")
+    for bad in (-1, 3):
+        with pytest.raises(ValueError, match=f"step {bad} out of range: plate has steps 0..2"):
+            mesh.step_index(bad)
+    assert np.array_equal(mesh.finite_coordinates(1), nodes + 1.0)
+    with pytest.raises(ValueError, match=r"non-finite coordinates at step 2, nodes \[3\] \(1 in"):
+        mesh.finite_coordinates(2)

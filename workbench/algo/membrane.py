@@ -71,24 +71,6 @@ def _check_material(young: float, poisson: float) -> tuple[float, float]:
     return young, poisson
 
 
-def _check_step(mesh: FEMesh, step, what: str) -> int:
-    if isinstance(step, (bool, np.bool_)) or int(step) != step:
-        raise ValueError(f"{what} must be an integer step, got {step!r}")
-    step = int(step)
-    if not 0 <= step < mesh.n_steps:
-        raise ValueError(f"{what} {step} out of range: {mesh.name} has steps 0..{mesh.n_steps - 1}")
-    return step
-
-
-def _coords(mesh: FEMesh, step: int) -> np.ndarray:
-    x = mesh.coordinates(step)
-    if not np.isfinite(x).all():
-        bad = np.flatnonzero(~np.isfinite(x).all(axis=1))
-        raise ValueError(f"{mesh.name}: non-finite coordinates at step {step}, nodes "
-                         f"{bad[:5].tolist()} ({len(bad)} in all)")
-    return x
-
-
 def _edges(x: np.ndarray, elements: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(2, M, 3) edge vectors x₁ − x₀ and x₂ − x₀ of the elements' two triangles."""
     a1 = np.stack([x[elements[:, t[1]]] - x[elements[:, t[0]]] for t in _TRIANGLES])
@@ -179,10 +161,10 @@ def membrane_stress(mesh: FEMesh, step: int, *, reference_step: int = 0,
     ``yield_stress`` that is not positive and finite.
     """
     young, poisson = _check_material(young, poisson)
-    step = _check_step(mesh, step, "step")
-    reference_step = _check_step(mesh, reference_step, "reference_step")
-    ref = _coords(mesh, reference_step)
-    cur = ref if step == reference_step else _coords(mesh, step)
+    step = mesh.step_index(step)
+    reference_step = mesh.step_index(reference_step, "reference_step")
+    ref = mesh.finite_coordinates(reference_step)
+    cur = ref if step == reference_step else mesh.finite_coordinates(step)
     return _capped(_membrane(ref, cur, mesh.elements.astype(np.int64), young, poisson),
                    _check_yield(yield_stress))
 
@@ -223,12 +205,12 @@ def with_membrane_stress(mesh: FEMesh, *, reference_step: int = 0, young: float 
     """
     young, poisson = _check_material(young, poisson)
     yield_stress = _check_yield(yield_stress)
-    reference_step = _check_step(mesh, reference_step, "reference_step")
-    ref = _coords(mesh, reference_step)
+    reference_step = mesh.step_index(reference_step, "reference_step")
+    ref = mesh.finite_coordinates(reference_step)
     elements = mesh.elements.astype(np.int64)
     values = np.empty((mesh.n_steps, len(STRESS_FIELDS), mesh.n_elements))
     for step in range(mesh.n_steps):
-        cur = ref if step == reference_step else _coords(mesh, step)
+        cur = ref if step == reference_step else mesh.finite_coordinates(step)
         sigma = _capped(_membrane(ref, cur, elements, young, poisson), yield_stress)
         for c, (i, j) in enumerate(_VOIGT):
             values[step, c] = sigma[:, i, j]

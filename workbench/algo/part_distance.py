@@ -48,7 +48,6 @@ from .hierarchy import (
     KINDS,
     ElementHierarchy,
     check_finite,
-    check_step,
     distinct,
     local_origin,
     used_nodes,
@@ -145,7 +144,7 @@ def _check(mesh, cutoff, kind, leaf_size, step, what="cutoff"):
         raise ValueError(f"leaf_size must be an integer >= 1, got {leaf_size!r}")
     if len(mesh.elements) == 0:
         raise ValueError(f"{mesh.name}: the mesh has no elements")
-    step = check_step(mesh, step)
+    step = mesh.step_index(step)
     coords = mesh.coordinates(step)
     used = used_nodes(mesh.elements, mesh.n_nodes)
     check_finite(coords, used)

@@ -314,14 +314,6 @@ def _check_cutoff(cutoff) -> float:
     return value
 
 
-def _check_step(mesh, step) -> int:
-    if isinstance(step, bool) or not isinstance(step, (int, np.integer)):
-        raise ValueError(f"step must be an integer, got {step!r}")
-    if not 0 <= int(step) < mesh.n_steps:
-        raise ValueError(f"step {step} out of range: the mesh has {mesh.n_steps} steps")
-    return int(step)
-
-
 def reference_part_distances(tool: str, mesh: FEMesh, cutoff: float, *, step: int = 0,
                              local_origin: bool = True, sample: int | None = None,
                              seed: int = 0) -> RefResult:
@@ -343,7 +335,7 @@ def reference_part_distances(tool: str, mesh: FEMesh, cutoff: float, *, step: in
     if tool not in TOOLS:
         raise ValueError(f"unknown distance tool {tool!r}; known: {', '.join(TOOLS)}")
     cutoff = _check_cutoff(cutoff)
-    coords = mesh.coordinates(_check_step(mesh, step))
+    coords = mesh.coordinates(mesh.step_index(step))
     triangulation = mesh.triangulation
     n = mesh.n_nodes
     if sample is None and tool == "trimesh":

@@ -223,10 +223,7 @@ class MeshPath(GLPath):
 
     def set_step(self, step: int) -> int:
         self._require_prepared()
-        if int(step) != step or not 0 <= step < self.mesh.n_steps:
-            raise ValueError(f"step {step} out of range: {self.mesh.name} has "
-                             f"{self.mesh.n_steps} steps")
-        step = int(step)
+        step = self.mesh.step_index(step)
         shown = self.data.shown_coordinates(step)
         positions = self.data.positions(shown, self.origin)
         self._positions.write(positions)

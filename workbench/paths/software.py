@@ -164,9 +164,7 @@ class SoftwarePath(RenderPath):
         mesh, data = self.mesh, self.data
         if mesh is None:
             raise RuntimeError(f"software path {self.name!r} is not prepared")
-        if int(step) != step or not 0 <= step < mesh.n_steps:
-            raise ValueError(f"step {step} out of range: {mesh.name} has {mesh.n_steps} steps")
-        step = int(step)
+        step = mesh.step_index(step)
         shown = data.shown_coordinates(step)
         # what GL uploads per step: float32 relative to the origin (subtracted in float64)
         self._positions = data.positions(shown, self.origin)

@@ -133,6 +133,28 @@ class FEMesh:
             return self.nodes
         return self.steps[step]
 
+    def step_index(self, step: Any, what: str = "step") -> int:
+        """``step`` as an int in [0, n_steps); ValueError naming ``what`` for anything but a
+        Python or numpy integer (a bool or a float such as 1.0 included) or a step out of
+        range."""
+        if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, np.integer)):
+            raise ValueError(f"{what} must be an integer step, got {step!r}")
+        if not 0 <= int(step) < self.n_steps:
+            raise ValueError(f"{what} {step} out of range: {self.name} has steps "
+                             f"0..{self.n_steps - 1}")
+        return int(step)
+
+    def finite_coordinates(self, step: int | None = None) -> np.ndarray:
+        """:meth:`coordinates` of ``step``, refused (ValueError naming the step and the first
+        nodes) where any is not finite."""
+        coords = self.coordinates(step)
+        finite = np.isfinite(coords).all(axis=1)
+        if not finite.all():
+            bad = np.flatnonzero(~finite)
+            raise ValueError(f"{self.name}: non-finite coordinates at step {step}, nodes "
+                             f"{bad[:5].tolist()} ({len(bad)} in all)")
+        return coords
+
     def node_field(self, name: str, step: int | None = None) -> np.ndarray:
         """(N,) values of a per-node field at ``step`` (static fields ignore the step)."""
         values = self.node_fields[name]

@@ -127,7 +127,7 @@ def force_tube(mesh: FEMesh, control_points, *, steps=None, per_segment: int = 8
     crossed = np.zeros(shape, np.int64)
     elements = mesh.elements.astype(np.int64)
     for row, step in enumerate(steps):
-        coords = _finite_coordinates(mesh, int(step))
+        coords = mesh.finite_coordinates(int(step))
         moved = pts + coords[anchors] - base[anchors]
         points, normals = section_planes(moved, per_segment, blend)
         thickness = mesh.element_field(thickness_field, int(step))
@@ -182,16 +182,6 @@ def _selected_elements(mesh: FEMesh, base: np.ndarray, pts: np.ndarray, parts,
         raise ValueError(f"no element of {mesh.name} is selected (parts={parts}, "
                          f"selection_radius={selection_radius})")
     return include
-
-
-def _finite_coordinates(mesh: FEMesh, step: int) -> np.ndarray:
-    """(N, 3) coordinates of mesh step ``step``; refused (ValueError) where not finite."""
-    coords = mesh.coordinates(step)
-    if not np.isfinite(coords).all():
-        bad = np.flatnonzero(~np.isfinite(coords).all(axis=1))
-        raise ValueError(f"{mesh.name}: non-finite coordinates at step {step}, nodes "
-                         f"{bad[:5].tolist()}")
-    return coords
 
 
 def _plane_query(mesh: FEMesh, step: int, cut) -> Callable | None:

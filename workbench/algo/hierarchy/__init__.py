@@ -68,12 +68,11 @@ what only it does.
 from .element_hierarchy import KINDS, ElementHierarchy, NearestElements
 from .inputs import (
     check_finite,
-    check_step,
     distinct,
     local_origin,
     squared_bound,
     used_nodes,
 )
 
-__all__ = ["KINDS", "ElementHierarchy", "NearestElements", "check_finite", "check_step",
+__all__ = ["KINDS", "ElementHierarchy", "NearestElements", "check_finite",
            "distinct", "local_origin", "squared_bound", "used_nodes"]

@@ -14,7 +14,6 @@ import numpy as np
 from .inputs import (
     check_elements,
     check_finite,
-    check_step,
     distinct,
     local_origin,
     squared_bound,
@@ -96,7 +95,7 @@ class ElementHierarchy:
             raise ValueError(f"leaf_size must be an integer >= 1, got {leaf_size!r}")
         self.kind = kind
         self.leaf_size = int(leaf_size)
-        self.step = check_step(mesh, step)
+        self.step = mesh.step_index(step)
         sel = check_elements(elements, len(mesh.elements))
         coords = mesh.coordinates(self.step)
         enodes = np.asarray(mesh.elements, dtype=np.int64)[sel]  # (E, 4)

@@ -32,13 +32,6 @@ def squared_bound(cutoff: float) -> float:
     return b
 
 
-def check_step(mesh, step) -> int:
-    """``step`` as an int in [0, mesh.n_steps); ValueError otherwise."""
-    if isinstance(step, (bool, np.bool_)) or int(step) != step or not 0 <= step < mesh.n_steps:
-        raise ValueError(f"step must be an integer in [0, {mesh.n_steps}), got {step!r}")
-    return int(step)
-
-
 def distinct(values) -> np.ndarray:
     """Sorted distinct values of an integer array (by sorting, quick for integer ids)."""
     v = np.sort(np.asarray(values).ravel())
