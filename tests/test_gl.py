@@ -13,6 +13,7 @@ from workbench.gl import (
     renderer,
     write_masks,
 )
+from workbench.gl.context import describe, is_software_renderer, timer_queries_meaningful
 
 VERT = """#version 330
 uniform mat4 mvp;
@@ -148,7 +149,11 @@ def test_msaa_resolves_and_timer_reports(ctx):
     assert image.shape == (32, 32, 4) and red_mask(image).sum() == 16 * 16
     with GpuTimer(ctx) as timer:
         draw_quad(ctx, cam, corners)
-    assert timer.elapsed_ms >= 0.0
+    # a GPU reports a time; a software renderer's queries time nothing and report none
+    if timer.meaningful:
+        assert timer.elapsed_ms >= 0.0
+    else:
+        assert timer.elapsed_ms is None and is_software_renderer(renderer(ctx))
 
 
 def test_every_shader_ships_with_the_package():
@@ -225,3 +230,23 @@ def test_write_masks_stop_colour_and_depth_writes_and_restore_them(ctx):
     assert (image[:3, :, :3] == 255).all() and (image[:, 4:, :3] == 255).all()
     assert fb.fbo.color_mask == (True,) * 4 and fb.fbo.depth_mask
     fb.release()
+
+
+@pytest.mark.parametrize("name, software", [
+    ("llvmpipe (LLVM 15.0.6, 256 bits)", True), ("softpipe", True),
+    ("Mesa Intel(R) UHD Graphics 630 (CFL GT2)", False), ("NVIDIA H200/PCIe/SSE2", False),
+    ("AMD Radeon RX 7900 XTX (radeonsi, navi31, LLVM 17.0.6, DRM 3.54, 6.5.0)", False),
+    ("Google SwiftShader", True), ("lavapipe", True)])
+def test_software_renderers_are_told_from_gpus(name, software):
+    assert is_software_renderer(name) is software
+
+
+def test_context_description_names_renderer_driver_and_device(ctx):
+    info = describe(ctx)
+    assert info["renderer"] == renderer(ctx) and info["gl_version"] == ctx.info["GL_VERSION"]
+    assert info["gl_vendor"] == ctx.info["GL_VENDOR"]
+    if "Mesa" in info["gl_version"]:
+        assert info["driver"].startswith("Mesa ") and info["driver"] in info["gl_version"]
+    # Mesa's EGL exposes EGL_EXT_device_query: the device is named (a DRM file or its kind)
+    assert info["egl_device"] is None or len(info["egl_device"]) > 0
+    assert timer_queries_meaningful(ctx) is not is_software_renderer(info["renderer"])

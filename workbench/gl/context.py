@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import ctypes
 import os
+import re
 from collections.abc import Iterator
 from contextlib import contextmanager
 from types import ModuleType
@@ -40,6 +42,69 @@ def renderer(ctx: moderngl.Context) -> str:
 
 def gl_version(ctx: moderngl.Context) -> str:
     return str(ctx.info["GL_VERSION"])
+
+
+# renderers that rasterize on the CPU: their GL_TIME_ELAPSED queries do not time the draw
+# (llvmpipe answers ~3e-05 ms for whole frames), so no GPU time is recorded on them
+SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "swiftshader", "software rasterizer",
+                      "lavapipe")
+
+
+def is_software_renderer(name: str) -> bool:
+    """Whether the renderer string ``name`` is a CPU rasterizer (Mesa llvmpipe, softpipe,
+    swrast; SwiftShader; Microsoft's software rasterizer)."""
+    name = name.lower()
+    return any(kind in name for kind in SOFTWARE_RENDERERS)
+
+
+def timer_queries_meaningful(ctx: moderngl.Context) -> bool:
+    """Whether ``ctx``'s GL_TIME_ELAPSED queries time the draws: on a GPU, not on a software
+    renderer."""
+    return not is_software_renderer(renderer(ctx))
+
+
+def describe(ctx: moderngl.Context) -> dict[str, str | None]:
+    """What identifies the renderer of ``ctx``: ``renderer``, ``gl_vendor``, ``gl_version``,
+    ``driver`` (Mesa's version, e.g. "Mesa 22.3.6", else the text after the GL version
+    number) and ``egl_device`` (the EGL device's DRM device file, or its device extensions
+    where it has no file; None where EGL cannot say)."""
+    version = gl_version(ctx)
+    mesa = re.search(r"Mesa \S+", version)
+    driver = mesa.group(0) if mesa else (version.split(" ", 1)[1] if " " in version else None)
+    return {"renderer": renderer(ctx), "gl_vendor": str(ctx.info["GL_VENDOR"]),
+            "gl_version": version, "driver": driver, "egl_device": _egl_device()}
+
+
+EGL_DEVICE_EXT, EGL_EXTENSIONS, EGL_DRM_DEVICE_FILE_EXT = 0x322C, 0x3055, 0x3233
+
+
+def _egl_device() -> str | None:
+    """The EGL device of the current display (EGL_EXT_device_query): its DRM device file where
+    it has one, else its device extensions (Mesa's software device reads
+    "EGL_MESA_device_software ..."); None where the query is not available. PyOpenGL does not
+    bind these entry points, so they are fetched with eglGetProcAddress."""
+    try:
+        lib = ctypes.CDLL("libEGL.so.1")
+        lib.eglGetProcAddress.restype = ctypes.c_void_p
+        lib.eglGetProcAddress.argtypes = [ctypes.c_char_p]
+        lib.eglGetCurrentDisplay.restype = ctypes.c_void_p
+        display_attrib = lib.eglGetProcAddress(b"eglQueryDisplayAttribEXT")
+        device_string = lib.eglGetProcAddress(b"eglQueryDeviceStringEXT")
+        display = lib.eglGetCurrentDisplay()
+        if not (display and display_attrib and device_string):
+            return None
+        query_attrib = ctypes.CFUNCTYPE(ctypes.c_uint, ctypes.c_void_p, ctypes.c_int,
+                                        ctypes.POINTER(ctypes.c_void_p))(display_attrib)
+        query_string = ctypes.CFUNCTYPE(ctypes.c_char_p, ctypes.c_void_p,
+                                        ctypes.c_int)(device_string)
+        device = ctypes.c_void_p()
+        if not query_attrib(display, EGL_DEVICE_EXT, ctypes.byref(device)) or not device:
+            return None
+        found = query_string(device, EGL_DRM_DEVICE_FILE_EXT) or query_string(device,
+                                                                              EGL_EXTENSIONS)
+        return found.decode() if found else None
+    except (OSError, AttributeError):  # no libEGL.so.1 or no such entry point
+        return None
 
 
 def raw_gl() -> ModuleType:

@@ -27,13 +27,21 @@ class _Query:
 
 
 class GpuTimer(_Query):
-    """GL_TIME_ELAPSED (ARB_timer_query). On llvmpipe this is the software rasterizer's time."""
+    """GL_TIME_ELAPSED (ARB_timer_query) in milliseconds, or None on a software renderer, whose
+    timer queries do not time the draw (llvmpipe answers ~3e-05 ms for whole frames); see
+    :func:`workbench.gl.context.timer_queries_meaningful`. ``meaningful`` says which."""
 
     kind = {"time": True}
 
+    def __init__(self, ctx: moderngl.Context) -> None:
+        from .context import timer_queries_meaningful
+
+        super().__init__(ctx)
+        self.meaningful = timer_queries_meaningful(ctx)
+
     @property
-    def elapsed_ms(self) -> float:
-        return self.query.elapsed / 1e6
+    def elapsed_ms(self) -> float | None:
+        return self.query.elapsed / 1e6 if self.meaningful else None
 
 
 class SamplesPassed(_Query):

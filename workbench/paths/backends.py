@@ -76,8 +76,10 @@ class GLBackend:
     def finish(self) -> None:
         self.ctx.finish()
 
-    def gpu_timer(self) -> GpuTimer:
-        return GpuTimer(self.ctx)  # moderngl 5.13 queries have no release(); it is collected
+    def gpu_timer(self) -> GpuTimer | None:
+        """A GPU time query, or None on a software renderer (its queries time nothing)."""
+        timer = GpuTimer(self.ctx)  # moderngl 5.13 queries have no release(); it is collected
+        return timer if timer.meaningful else None
 
 
 @dataclass

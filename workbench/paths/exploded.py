@@ -20,8 +20,9 @@ Beyond ``draw`` the path offers what the paper's interaction needs:
   time with ``depth ≤`` over a depth-only pre-pass of the same geometry, so a count is the number
   of pixels where the focus is the nearest surface (no overdraw of its own back faces). The
   focus never moves, so ``p_unocc`` is counted once per camera, step and image size and kept.
-  Returns ``(p_unocc, p_occ, gpu_ms)``; ``last_occlusion`` holds the counts, the GPU and wall
-  times, whether ``p_unocc`` was counted anew and whether ``p_occ`` came from the frame.
+  Returns ``(p_unocc, p_occ, gpu_ms)``; ``last_occlusion`` holds the counts, the GPU (None
+  on a software renderer) and wall times, whether ``p_unocc`` was counted anew and whether
+  ``p_occ`` came from the frame.
 * **Counting in the frame** (the thesis's "during the actual rendering"). With
   ``count_in_draw`` on (the default), :meth:`ExplodedPath.draw` ends with the same ``depth ≤``
   count of the focus over the frame it has just drawn, colour and depth writes off: that is
@@ -499,7 +500,8 @@ class ExplodedPath(MeshPath):
         start = time.perf_counter()
         p_occ = self._in_frame.samples
         counted = frame["key"] not in self._unoccluded
-        gpu_ms = self._counted(frame_size, behind=False)[2]["gpu_ms"] if counted else 0.0
+        gpu_ms = (self._counted(frame_size, behind=False)[2]["gpu_ms"] if counted
+                  else 0.0 if self._timer.meaningful else None)
         p_unocc = self._unoccluded[frame["key"]]
         wall_ms = (time.perf_counter() - start) * 1e3
         self.last_occlusion = dict(p_unocc=p_unocc, p_occ=p_occ, in_frame=True, gpu_ms=gpu_ms,

@@ -317,13 +317,18 @@ def sweep_row(rec, label, focus, kind, theta, v, frames, exponent) -> dict:
         "final_phase": rec["phase"], "o_max": o_max, "final_alpha": rec["alpha"][-1],
         "visible_through_ghost_pct": (None if rec["ghost_visible"] is None
                                       else 100.0 * rec["ghost_visible"]),
-        "draw_gpu_ms": statistics.median(rec["d_gpu"]), "draw_wall_ms": draw,
+        "draw_gpu_ms": gpu_median(rec["d_gpu"]), "draw_wall_ms": draw,
         "counted_in_frame_pct": 100.0 * sum(rec["in_frame"]) / len(rec["in_frame"]),
         "occlusion_wall_ms": occlusion,
         "occlusion_over_draw": occlusion / draw if draw > 0 else None,
-        "separate_pass_gpu_ms": statistics.median(rec["sep_gpu"]),
+        "separate_pass_gpu_ms": gpu_median(rec["sep_gpu"]),
         "separate_pass_wall_ms": separate,
         "separate_over_draw": separate / draw if draw > 0 else None}
+
+
+def gpu_median(samples: list[float | None]) -> float | None:
+    """The median GPU time (ms), None where the renderer's timer queries time nothing."""
+    return None if any(v is None for v in samples) else statistics.median(samples)
 
 
 def compare_row(ctx, scene, label, focus, manual, camera, direction, size, theta, rec) -> dict:
