@@ -25,7 +25,8 @@ TABLES = {
     "table": [
         "renderer", "scene", "size", "case", "set", "rules", "triangles", "line_edges", "gpu_ms",
         "gpu_ms_min", "gpu_ms_max", "wall_ms", "wall_ms_min", "wall_ms_max", "readback_ms",
-        "repeats", "speed_vs_overdraw", "gpu_speed_vs_overdraw", "rgba_texels_per_element",
+        "repeats", "wall_ms_lo", "wall_ms_hi", "speed_vs_overdraw", "gpu_speed_vs_overdraw",
+        "rgba_texels_per_element",
         "texture_mb", "narrow_elements", "ssim", "reference", *WIRE, *ERRORS],
     "table3": ["renderer", "scene", "size", "case", "rules", "triangles", "line_edges",
                "gpu_ms", "wall_ms", "speed_vs_overdraw", "rgba_texels_per_element",

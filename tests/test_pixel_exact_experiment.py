@@ -12,7 +12,8 @@ ERRORS = ["max_diff_255", "mean_diff_255", "share_over_1", "share_over_1_off_edg
 TABLES = {
     "table": ["target_polygons", "cells", "tets", "polygons", "quads", "slice_ms", "path",
               "edge_overdraw", "element_store", "gpu_ms", "gpu_ms_min", "gpu_ms_max", "wall_ms",
-              "wall_ms_min", "wall_ms_max", "readback_ms", "repeats", "prepare_ms",
+              "wall_ms_min", "wall_ms_max", "readback_ms", "repeats", "wall_ms_lo",
+              "wall_ms_hi", "prepare_ms",
               "bytes_uploaded", *ERRORS, "crack_pixels", "renderer", "size",
               "wall_vs_per_vertex"],
     "slicing": ["tets", "build_s", "sort_s", "frames", "polygons_median", "polygons_max",

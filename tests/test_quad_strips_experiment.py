@@ -84,7 +84,8 @@ COLUMNS = {
     "draw": ["renderer", "scene", "size", "case", "path", "style", "triangles", "vertices",
              "vertices_sent", "strips", "vs_invocations", "bytes_per_step", "gpu_ms",
              "gpu_ms_min", "gpu_ms_max", "wall_ms", "wall_ms_min", "wall_ms_max",
-             "readback_ms", "repeats", "wall_over_list", "reference", "differing_px",
+             "readback_ms", "repeats", "wall_ms_lo", "wall_ms_hi",
+             "wall_over_list", "reference", "differing_px",
              "max_diff_255", "wire_pixels", "overdraw_wire_pixels", "wire_recall_1px",
              "wire_precision_1px", "wire_iou_1px", "wire_exact_overlap"],
 }

@@ -17,13 +17,15 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from contextlib import ExitStack
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from ..data import shared_file
+from .stats import StoppingRule
 from .tables import write_table
+from .timing import empty_gpu_note
 
 if TYPE_CHECKING:
     import moderngl
@@ -37,6 +39,15 @@ T = TypeVar("T")
 
 SIZES = ("full", "quick", "tiny")
 FULL_REPEATS, QUICK_REPEATS = 9, 5
+# draws go on until the wall median's 95 % interval is within ±2 % (full) or ±5 % (quick),
+# up to these counts
+FULL_STOP = StoppingRule(rel_half_width=0.02, min_samples=FULL_REPEATS, max_samples=41)
+QUICK_STOP = StoppingRule(rel_half_width=0.05, min_samples=QUICK_REPEATS, max_samples=15)
+# interleaved ratios (A B A B …): pairs until the ratio's interval is within ±2 % / ±5 %
+FULL_RATIO_STOP = StoppingRule(rel_half_width=0.02, min_samples=FULL_REPEATS, max_samples=61)
+QUICK_RATIO_STOP = StoppingRule(rel_half_width=0.05, min_samples=QUICK_REPEATS, max_samples=21)
+TINY_RATIO_STOP = StoppingRule(rel_half_width=1.0, min_samples=QUICK_REPEATS,
+                               max_samples=QUICK_REPEATS)
 
 
 @dataclass(frozen=True)
@@ -60,6 +71,7 @@ class ExperimentContext:
     size: str = "full"
     progress: Callable[[str], None] | None = None
     skipped: list[str] = field(default_factory=list)
+    tables: list[tuple[str, list[dict[str, Any]]]] = field(default_factory=list)
     _gl_scope: ExitStack | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -92,6 +104,25 @@ class ExperimentContext:
         otherwise."""
         return FULL_REPEATS if self.size == "full" else QUICK_REPEATS
 
+    @property
+    def stop(self) -> StoppingRule | None:
+        """When timed draws stop: at full size once the median's 95 % interval is within
+        ±2 % (9 to 41 draws), at quick size within ±5 % (5 to 15); at tiny size after
+        :attr:`repeats`."""
+        if self.size == "tiny":
+            return None
+        return FULL_STOP if self.size == "full" else QUICK_STOP
+
+    def ratio_stop(self, max_samples: int | None = None) -> StoppingRule:
+        """When interleaved pairs stop (:mod:`workbench.experiment.interleave`): the ratio's
+        95 % interval within ±2 % (full, 9 to 61 pairs) or ±5 % (quick, 5 to 21); 5 pairs at
+        tiny size. ``max_samples`` lowers the most pairs (for slow peers)."""
+        rule = self.pick(FULL_RATIO_STOP, QUICK_RATIO_STOP, TINY_RATIO_STOP)
+        if max_samples is not None:
+            rule = replace(rule, max_samples=max(rule.min_samples,
+                                                 min(rule.max_samples, max_samples)))
+        return rule
+
     # ------------------------------------------------------------------ output
     def say(self, message: str) -> None:
         """One progress line."""
@@ -104,8 +135,13 @@ class ExperimentContext:
 
     def table(self, rows: Sequence[dict[str, Any]], name: str, title: str,
               columns: Sequence[str] | None = None) -> None:
-        """Write ``rows`` as ``<name>.csv`` and ``<name>.md`` (titled) into the run's folder."""
-        write_table(rows, self.out_dir, name, columns=columns, title=title)
+        """Write ``rows`` as ``<name>.csv`` and ``<name>.md`` (titled, with a note where its
+        GPU times are empty on a software renderer) into the run's folder, and keep them in
+        :attr:`tables` for the results store."""
+        rows = list(rows)
+        write_table(rows, self.out_dir, name, columns=columns, title=title,
+                    notes=empty_gpu_note(rows))
+        self.tables.append((name, rows))
 
     # ------------------------------------------------------------------ data and drawing
     def shared(self, relative: Path | str, what: str) -> Path | None:
@@ -170,8 +206,10 @@ class ExperimentContext:
                 backend: moderngl.Context | Backend | None = None,
                 **options: Any) -> Measurement:
         """:func:`~workbench.experiment.measure.measure` on ``backend`` (default the run's GL
-        context) with this run's repeats unless ``repeats`` is given."""
+        context) with this run's repeats and stopping rule unless ``repeats`` or ``stop`` is
+        given."""
         from .measure import measure
 
         options.setdefault("repeats", self.repeats)
+        options.setdefault("stop", self.stop)
         return measure(self.gl if backend is None else backend, scene, path, style, **options)

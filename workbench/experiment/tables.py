@@ -74,13 +74,18 @@ def _plain(value):
     return value.item() if isinstance(value, np.generic) else value
 
 
+# raw repetitions (lists of ms) go to the results store, not into a CSV or Markdown cell
+STORE_ONLY_SUFFIX = "_samples_ms"
+
+
 def table_columns(rows: Iterable[dict[str, Any]]) -> list[str]:
-    """The union of the rows' keys in first-seen order."""
+    """The union of the rows' keys in first-seen order, without the store-only columns of raw
+    samples (names ending in ``_samples_ms``)."""
     columns: dict[str, None] = {}
     for row in rows:
         for key in row:
             columns.setdefault(key, None)
-    return list(columns)
+    return [c for c in columns if not str(c).endswith(STORE_ONLY_SUFFIX)]
 
 
 def _check_rows(rows) -> list[dict]:
@@ -129,11 +134,14 @@ def _is_number(value) -> bool:
 
 
 def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[str] | None = None,
-                   title: str | None = None) -> str:
-    """An aligned Markdown pipe table (numeric columns right-aligned), with an optional heading."""
+                   title: str | None = None, notes: Sequence[str] = ()) -> str:
+    """An aligned Markdown pipe table (numeric columns right-aligned), with an optional heading
+    and ``notes`` (one paragraph each) between heading and table."""
     rows = _check_rows(rows)
     columns = list(table_columns(rows) if columns is None else columns)
     lines = [f"# {title}", ""] if title else []
+    for note in notes:
+        lines += [f"_{note}_", ""]
     if not columns:
         return "\n".join(lines + ["_no rows_", ""])
     cells = [[format_value(row.get(c)) for c in columns] for row in rows]
@@ -162,11 +170,12 @@ def _csv_value(value):
 def write_table(rows: Sequence[dict[str, Any]], directory: str | os.PathLike[str],
                 name: str = "table",
                 columns: Sequence[str] | None = None,
-                title: str | None = None) -> tuple[Path, Path]:
+                title: str | None = None, notes: Sequence[str] = ()) -> tuple[Path, Path]:
     """Write ``rows`` as ``<directory>/<name>.csv`` and ``<name>.md``; returns both paths.
 
     ``columns`` picks and orders the columns (missing values stay empty); by default all keys in
-    first-seen order. Floats are written to the CSV at full precision and to Markdown with four
+    first-seen order, less the raw-sample lists (see :func:`table_columns`); ``notes`` go under
+    the Markdown title. Floats are written to the CSV at full precision and to Markdown with four
     significant digits. Both files are replaced atomically; the Markdown is formatted before
     either is touched, so a row that cannot be formatted leaves the previous table in place.
     Refuses rows that are not dicts and a missing directory.
@@ -176,7 +185,7 @@ def write_table(rows: Sequence[dict[str, Any]], directory: str | os.PathLike[str
     if not directory.is_dir():
         raise FileNotFoundError(f"table directory {directory} does not exist")
     columns = list(table_columns(rows) if columns is None else columns)
-    md_text = markdown_table(rows, columns, title)
+    md_text = markdown_table(rows, columns, title, notes)
     csv_path, md_path = directory / f"{name}.csv", directory / f"{name}.md"
     with atomic_open(csv_path, "w", encoding="utf-8", newline="") as handle:
         writer = csv.writer(handle)

@@ -7,13 +7,14 @@ over the pixels either draws, and what the path's ``needs`` saved: ``derive_ms``
 ``derive_bytes`` of the scene data it made the mesh derive (triangulation, element edges,
 crease-split Gouraud vertices), ``skipped_ms`` and ``skipped_bytes`` of the rest, which a scene
 deriving everything would have computed for nothing (both from nothing, on a fresh copy of the
-mesh). Every path is measured by :func:`workbench.experiment.measure.measure`. On llvmpipe
-the GPU timer query covers only part of the rasterizer's work; wall time (draw + ``finish``)
-is the figure to compare there.
+mesh). A scene's paths are measured together by
+:func:`workbench.experiment.measure.measure_together` (their draws interleaved, each time with
+its 95 % interval); GPU time is recorded only where the renderer's timer queries time the draw
+(not on llvmpipe, where wall time — draw + ``finish`` — is the time).
 In the same run the same triangles are drawn by pyrender through EGL at the same size, with
 the same culling and comparable lighting (SSIM against our Gouraud image shows the comparison
 is like for like), and a bare position-only draw gives the floor. ``targets.md`` holds the
-ratios the foundation is judged by.
+ratios the foundation is judged by, each measured interleaved with its 95 % interval.
 
 Run: ``workbench run render_paths [--quick]``.
 """
@@ -27,6 +28,8 @@ import numpy as np
 from workbench.experiment.compare import compare_drawn, difference_image
 from workbench.experiment.context import ExperimentContext
 from workbench.experiment.figures import save_field_figure, save_image_grid
+from workbench.experiment.interleave import Clock, draw_clock, interleaved_ratios
+from workbench.experiment.measure import Together, measure_together, prepared
 from workbench.experiment.reference import PyrenderReference
 from workbench.experiment.registry import experiment
 from workbench.experiment.timing import time_call
@@ -92,13 +95,19 @@ def path_rows(exp: ExperimentContext, label: str, mesh, configs, camera: Camera,
               size) -> tuple[list[dict], dict]:
     """One row per path configuration of :func:`path_configs` on ``mesh`` at ``size`` (W, H):
     the measurement, what the path's needs saved, and the colour error against its reference
-    configuration where it has one. Returns the rows and the images by configuration."""
+    configuration where it has one. The configurations are measured together, their draws
+    interleaved (:func:`~workbench.experiment.measure.measure_together`), so that their times
+    hold against each other and against another run. Returns the rows and the images by
+    configuration."""
     rows, images = [], {}
     costs: dict[float, dict] = {}
-    for case, name, style, samples, reference in configs:
-        path = make_path(name, style)
-        probe = set_step_time(exp.repeats) if mesh.n_steps > 1 else None
-        m = exp.measure(mesh, path, camera=camera, size=size, samples=samples, probe=probe)
+    probe = set_step_time(exp.repeats) if mesh.n_steps > 1 else None
+    measured = measure_together(
+        exp.gl, mesh, [Together(make_path(name, style), samples=samples, probe=probe)
+                       for _, name, style, samples, _ in configs],
+        camera=camera, size=size, repeats=exp.repeats, stop=exp.stop)
+    for (case, name, style, samples, reference), m in zip(configs, measured):
+        path = m.path
         images[case] = image = m.image
         row = dict(renderer=exp.renderer, scene=label, case=case, path=name,
                    style=style.summary(), size=f"{size[0]}x{size[1]}", samples=samples,
@@ -113,7 +122,7 @@ def path_rows(exp: ExperimentContext, label: str, mesh, configs, camera: Camera,
             row.update(reference=reference, max_diff_255=diff.max_abs,
                        share_differing=diff.share_differing, psnr_db=diff.psnr, ssim=diff.ssim)
         rows.append(row)
-        exp.say(f"  {case}: gpu {m.timing.gpu_ms:.2f} ms, wall {m.timing.wall_ms:.2f} ms, "
+        exp.say(f"  {case}: wall {m.timing.wall_ms:.2f} ms, "
                 f"needs skipped {row['skipped_bytes'] / 2**20:.1f} MiB")
     return rows, images
 
@@ -122,14 +131,14 @@ def pyrender_row(exp: ExperimentContext, label: str, mesh, step: int, camera: Ca
                  ours: np.ndarray):
     """pyrender (EGL, always 4× MSAA) drawing the crease-split Gouraud triangles of step
     ``step`` at ``size``, timed with read-back and compared with our 4× MSAA Gouraud image
-    ``ours``. Returns its row, its image and the crease split."""
+    ``ours``. Returns its row, its image, the crease split and the reference itself, still
+    prepared (the caller releases it)."""
     split = mesh.gouraud(Style().crease_deg)
     coords = mesh.coordinates(step)
     ref = PyrenderReference(coords[split.vertex_node], split.triangles, split.normals(coords),
                             camera=camera, size=size, base_color=Style().base_color)
     ref_image = ref.render()
     ref_timing = ref.time(warmup=2, repeat=exp.repeats)
-    ref.release()
     diff = compare_drawn(ref_image, ours)
     row = dict(renderer=exp.renderer, scene=label, case="pyrender (EGL)", path="pyrender",
                size=f"{size[0]}x{size[1]}", samples=4, triangles=len(split.triangles),
@@ -139,24 +148,52 @@ def pyrender_row(exp: ExperimentContext, label: str, mesh, step: int, camera: Ca
                share_differing=diff.share_differing, psnr_db=diff.psnr, ssim=diff.ssim)
     exp.say(f"  pyrender: wall {ref_timing.wall_ms:.2f} ms, SSIM vs gouraud 4x MSAA "
             f"{diff.ssim:.3f}")
-    return row, ref_image, split
+    return row, ref_image, split, ref
+
+
+def interleaved_targets(exp: ExperimentContext, mesh, configs: dict, camera: Camera, size,
+                        ref: PyrenderReference) -> dict:
+    """The two ratios the targets state, each measured interleaved (A B A B …, see
+    :mod:`workbench.experiment.interleave`) with its 95 % interval: per-pixel bands over the
+    position-only draw, and per-pixel bands with 4× MSAA and read-back over pyrender (which
+    reads back in its render)."""
+    def setting(case):
+        _, name, style, samples, _ = configs[case]
+        return dict(path=name, style=style, camera=camera, size=size, samples=samples)
+
+    with prepared(exp.gl, mesh, **setting("pixel bands")) as bands, \
+            prepared(exp.gl, mesh, **setting("position")) as floor, \
+            prepared(exp.gl, mesh, **setting("pixel bands, 4x MSAA")) as msaa:
+        draw_msaa = draw_clock(msaa)
+        floor_ratio = interleaved_ratios(
+            {"bands": draw_clock(bands), "position": draw_clock(floor)},
+            [("bands", "position")], exp.ratio_stop())[("bands", "position")]
+        peer_ratio = interleaved_ratios(
+            {"msaa": Clock(lambda: (draw_msaa.run(), msaa.target.read()), draw_msaa.setup),
+             "pyrender": Clock(ref.render)},
+            [("msaa", "pyrender")], exp.ratio_stop(max_samples=15))[("msaa", "pyrender")]
+    exp.say(f"  interleaved: pixel bands / position-only {floor_ratio.interval.estimate:.3f} "
+            f"[{floor_ratio.interval.lo:.3f}, {floor_ratio.interval.hi:.3f}], 4x MSAA + "
+            f"read-back / pyrender {peer_ratio.interval.estimate:.3f}")
+    return {**floor_ratio.as_row("contour_over_position_only"),
+            **peer_ratio.as_row("contour_msaa_over_pyrender")}
 
 
 def target_row(exp: ExperimentContext, label: str, mesh, size, rows: list[dict],
-               reference: dict, split) -> dict:
+               reference: dict, split, ratios: dict) -> dict:
     """The targets of one scene: the contour path against the position-only draw and against
-    pyrender (its ``reference`` row), and what a time step uploads against preparation."""
+    pyrender (its ``reference`` row) — the times from their own rows, the ratios measured
+    interleaved (``ratios``, from :func:`interleaved_targets`) — and what a time step uploads
+    against preparation."""
     by_case = {r["case"]: r for r in rows}
     contour, contour_msaa = by_case["pixel bands"], by_case["pixel bands, 4x MSAA"]
     return {
         "renderer": exp.renderer, "scene": label, "size": f"{size[0]}x{size[1]}",
         "triangles": contour["triangles"], "contour_wall_ms": contour["wall_ms"],
         "position_only_wall_ms": by_case["position"]["wall_ms"],
-        "contour_over_position_only": contour["wall_ms"] / by_case["position"]["wall_ms"],
         "contour_msaa_incl_readback_ms": contour_msaa["wall_ms"] + contour_msaa["readback_ms"],
         "pyrender_incl_readback_ms": reference["wall_ms"],
-        "contour_msaa_over_pyrender":
-            (contour_msaa["wall_ms"] + contour_msaa["readback_ms"]) / reference["wall_ms"],
+        **ratios,
         "pyrender_ssim": reference["ssim"],
         "nodes": len(mesh.used_nodes()), "crease_vertices_added": split.added,
         "bytes_per_step": contour["bytes_per_step"],
@@ -192,12 +229,17 @@ def run(exp: ExperimentContext) -> list[dict]:
         camera = Camera.fit_box(lo, hi, aspect=size[0] / size[1], **view)
         value_range = scale_for(mesh, field).value_range
         clip_plane = (*(-camera.view_matrix()[0, :3]), float(camera.view_matrix()[0, :3] @ center))
-        configs = path_configs(step, field, element_field, value_range, clip_plane)
+        configs = list(path_configs(step, field, element_field, value_range, clip_plane))
         scene_rows, images = path_rows(exp, label, mesh, configs, camera, size)
-        reference, ref_image, split = pyrender_row(exp, label, mesh, step, camera, size,
-                                                   images["gouraud, 4x MSAA"])
+        reference, ref_image, split, ref = pyrender_row(exp, label, mesh, step, camera, size,
+                                                        images["gouraud, 4x MSAA"])
+        try:
+            ratios = interleaved_targets(exp, mesh, {c[0]: c for c in configs}, camera, size,
+                                         ref)
+        finally:
+            ref.release()
         rows += scene_rows + [reference]
-        targets.append(target_row(exp, label, mesh, size, scene_rows, reference, split))
+        targets.append(target_row(exp, label, mesh, size, scene_rows, reference, split, ratios))
         save_figures(exp, label, images, ref_image, reference["ssim"], value_range, field, units)
     exp.table(targets, "targets", "Targets: contour path against pyrender and a bare draw")
     return rows

@@ -249,8 +249,9 @@ def add_image_comparisons(rows: list[dict], images: dict) -> None:
     base = next(r for r in rows if r["case"] == OVERDRAW)
     for r in rows:
         r["speed_vs_overdraw"] = base["wall_ms"] / r["wall_ms"]
-        if r["gpu_ms"] and base["gpu_ms"]:
-            r["gpu_speed_vs_overdraw"] = base["gpu_ms"] / r["gpu_ms"]
+        # None on a software renderer, whose timer queries time nothing
+        r["gpu_speed_vs_overdraw"] = (base["gpu_ms"] / r["gpu_ms"]
+                                      if r["gpu_ms"] and base["gpu_ms"] else None)
         wire = "wire" in r["case"] or r["case"] == OVERDRAW
         reference = OVERDRAW if wire else SHADED
         if r["case"] != reference:

@@ -15,6 +15,11 @@ the same shading (share of differing pixels, largest difference; the EGL row nam
 ``reference``). Quick runs: 125 × 125 quads per sheet at 500 × 500 (the paper's triangle size)
 and 250 × 250 at 1000 × 1000; tiny runs: 16 × 16 at 100 × 100 and 24 × 24 at 120 × 120.
 
+**Interleaved** (``interleaved.md``): the speeds the README states — llvmpipe's position-only
+floor, flat and band draws over the software rasterizer's (GL rule, all threads) — measured
+interleaved (one draw of each in turn, repeated until each ratio's 95 % interval is within
+±2 %, quick ±5 %), each with its interval.
+
 **Steps** (``steps.md``, ``steps.png``): the paper's Table 2 columns for the paper's pipeline
 (span table S = 10, no early depth rejection): each step vectorised or not, its time with the
 kernels interpreted by Python (vectorisation off) and compiled (on) on a small case and their
@@ -38,6 +43,7 @@ import resource
 import statistics
 import time
 import tracemalloc
+from contextlib import ExitStack
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,7 +58,8 @@ from workbench.algo.softraster.spantable import (
 from workbench.experiment.compare import compare_images, difference_map
 from workbench.experiment.context import ExperimentContext
 from workbench.experiment.figures import save_image_grid
-from workbench.experiment.measure import default_camera
+from workbench.experiment.interleave import draw_clock, interleaved_ratios
+from workbench.experiment.measure import default_camera, prepared
 from workbench.experiment.registry import experiment
 from workbench.experiment.tables import atomic_open
 from workbench.paths import SoftwareRasterizer, Style
@@ -212,6 +219,40 @@ def bench_rows(exp: ExperimentContext, bench: Bench) -> tuple[list[dict], dict]:
                 f"{row['speed_vs_llvmpipe_floor']:.2f}x llvmpipe's floor, "
                 f"{row['differing_pct']:.3f} % pixels differ from EGL")
     return rows, images
+
+
+# (llvmpipe's draw, the software draw it is set against): the speeds the README states
+INTERLEAVED = (("EGL position-only (the floor)", "software bands, GL rule"),
+               ("EGL flat", "software flat, GL rule"),
+               ("EGL bands", "software bands, GL rule"))
+
+
+def interleaved_rows(exp: ExperimentContext, bench: Bench) -> list[dict]:
+    """The software rasterizer's speed against llvmpipe for each pair of :data:`INTERLEAVED`:
+    llvmpipe's wall ms over the software rasterizer's (GL rule, all threads), both drawn in
+    turn, with the ratio's 95 % interval and the pairs' median times."""
+    mesh, size = bench.mesh, bench.size
+    camera = default_camera(mesh, size, view=(0.0, 0.0), up="y")
+    drawn = {"EGL position-only (the floor)": (exp.gl, "position", {}),
+             "EGL flat": (exp.gl, "flat", {}), "EGL bands": (exp.gl, "pixel_color", BANDS),
+             "software flat, GL rule": (SoftwareRasterizer(), "flat", {}),
+             "software bands, GL rule": (SoftwareRasterizer(), "pixel_color", BANDS)}
+    with ExitStack() as stack:
+        clocks = {label: draw_clock(stack.enter_context(
+                      prepared(backend, mesh, name, Style(**options), camera, size)))
+                  for label, (backend, name, options) in drawn.items()}
+        ratios = interleaved_ratios(clocks, INTERLEAVED, exp.ratio_stop())
+    rows = []
+    for (gl_case, software_case), ratio in ratios.items():
+        rows.append(dict(scene=bench.label, triangles=len(mesh.triangles),
+                         size=f"{size[0]}x{size[1]}", renderer=exp.renderer, case=software_case,
+                         against=gl_case,
+                         software_ms=statistics.median(ratio.denominator_ms),
+                         llvmpipe_ms=statistics.median(ratio.numerator_ms),
+                         **ratio.as_row("speed_vs_llvmpipe")))
+        exp.say(f"{bench.label} interleaved: {software_case} {ratio.interval.estimate:.2f}x "
+                f"{gl_case} [{ratio.interval.lo:.2f}, {ratio.interval.hi:.2f}]")
+    return rows
 
 
 def small_case_steps(exp: ExperimentContext) -> dict:
@@ -394,13 +435,16 @@ def paper_rows() -> list[dict]:
             "look-up table against llvmpipe, per-step times, sort-last compositing on Dask")
 def run(exp: ExperimentContext) -> list[dict]:
     exp.say(f"renderer: {exp.renderer}")
-    rows, images = [], {}
+    rows, images, interleaved = [], {}, []
     for bench in benches(exp):
         bench_out, bench_images = bench_rows(exp, bench)
         rows += bench_out
+        interleaved += interleaved_rows(exp, bench)
         if bench.main:
             images = bench_images
     rows += paper_rows()
+    exp.table(interleaved, "interleaved", "The software rasterizer against llvmpipe, measured "
+                                          "interleaved (speed = llvmpipe ms / software ms)")
     small = small_case_steps(exp)
     steps = step_rows(rows, small)
     exp.table(steps, "steps", f"Per-step times (ms; paper columns in s); small case: "
