@@ -8,6 +8,8 @@
   test using one is marked ``shared_data``.
 * ``experiment_run``: ``experiment_run(name, size)`` runs a registered experiment once per
   session at ``size`` ("tiny", or "quick" for the slow tests) and returns ``(rows, out_dir)``.
+* Every run a test starts (in process or as a subprocess) records into a results store of the
+  test session's own (``WORKBENCH_RESULTS``), never into ``figures/results``.
 * Markers: ``slow`` (end-to-end experiment runs and cluster sweeps; ``pytest`` leaves them out,
   ``pytest -m "slow or not slow"`` runs everything), ``gl``, ``shared_data``.
 """
@@ -25,6 +27,21 @@ if os.environ.get("CI"):
     settings.load_profile("ci")
 
 SHARED_FIXTURES = {"car", "car_deck", "d3plot_file"}
+
+
+@pytest.fixture(autouse=True, scope="session")
+def session_results_store(tmp_path_factory):
+    """The results store of the session: set as ``WORKBENCH_RESULTS`` for every test."""
+    from workbench.experiment.store import RESULTS_ENV
+
+    root = tmp_path_factory.mktemp("results")
+    before = os.environ.get(RESULTS_ENV)
+    os.environ[RESULTS_ENV] = str(root)
+    yield root
+    if before is None:
+        os.environ.pop(RESULTS_ENV, None)
+    else:
+        os.environ[RESULTS_ENV] = before
 
 
 def pytest_collection_modifyitems(items):

@@ -1,9 +1,13 @@
 """``workbench list``, ``run`` and ``reproduce``: the registered experiments, one of them, or
-all of them with a progress bar, each writing ``figures/<experiment>/``."""
+all of them with a progress bar, each writing ``figures/<experiment>/`` and appending its rows
+to the results store (one run record for the command)."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
+
+from .results import add_results_option, store_of
 
 
 def add_parser(subparsers) -> None:
@@ -15,12 +19,14 @@ def add_parser(subparsers) -> None:
     p.add_argument("experiment")
     p.add_argument("--quick", action="store_true", help="small sizes and few repetitions")
     p.add_argument("--figures", default="figures", help="output folder (default figures/)")
+    add_results_option(p)
     p.set_defaults(func=cmd_run)
 
     p = subparsers.add_parser("reproduce",
                               help="run every registered experiment, with a progress bar")
     p.add_argument("--quick", action="store_true", help="small sizes and few repetitions")
     p.add_argument("--figures", default="figures", help="output folder (default figures/)")
+    add_results_option(p)
     p.set_defaults(func=cmd_reproduce)
 
 
@@ -32,14 +38,28 @@ def cmd_list(args) -> int:
     return 0
 
 
+def start_recording(args, command: str):
+    """The :class:`~workbench.experiment.recording.Recorder` of this command's run in the
+    store ``--results`` (or the environment, or ``<figures>/results``) names."""
+    from ..experiment.recording import start_run
+
+    size = "quick" if getattr(args, "quick", False) else "full"
+    return start_run(store_of(args, args.figures).root, command, size=size)
+
+
 def cmd_run(args) -> int:
-    from ..experiment.registry import discover, run_experiment
+    from ..experiment.registry import discover, get_experiment, run_experiment
 
     discover()
+    get_experiment(args.experiment)  # an unknown name is refused before anything is recorded
+    recorder = start_recording(args, f"run {args.experiment}" + " --quick" * args.quick)
     rows, out_dir = run_experiment(args.experiment, figures_root=Path(args.figures),
                                    quick=args.quick,
-                                   progress=lambda msg: print(f"  {msg}", flush=True))
+                                   progress=lambda msg: print(f"  {msg}", flush=True),
+                                   recorder=recorder)
     print(f"{args.experiment}: {len(rows)} rows -> {out_dir}")
+    print(f"results: run {recorder.run_id}, {recorder.appended} rows -> "
+          f"{recorder.store.root}", file=sys.stderr)
     return 0
 
 
@@ -49,10 +69,14 @@ def cmd_reproduce(args) -> int:
     from ..experiment.registry import discover, run_experiment
 
     names = sorted(discover())
+    recorder = start_recording(args, "reproduce" + " --quick" * args.quick)
     bar = tqdm(names, desc="reproduce", unit="experiment")
     for name in bar:
         bar.set_postfix_str(name)
         rows, out_dir = run_experiment(name, figures_root=Path(args.figures), quick=args.quick,
-                                       progress=lambda msg: bar.write(f"  {name}: {msg}"))  # noqa: B023
+                                       progress=lambda msg: bar.write(f"  {name}: {msg}"),  # noqa: B023
+                                       recorder=recorder)
         bar.write(f"{name}: {len(rows)} rows -> {out_dir}")
+    print(f"results: run {recorder.run_id}, {recorder.appended} rows -> "
+          f"{recorder.store.root}", file=sys.stderr)
     return 0

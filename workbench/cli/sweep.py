@@ -11,23 +11,30 @@ import sys
 from pathlib import Path
 
 from .arguments import refused
+from .results import add_results_option, store_of
 
 
 def cmd_sweep(args) -> int:
     """``workbench sweep``: run the config, print the summary; 1 when a point failed."""
+    from ..experiment.recording import start_run
     from ..sweep import load_config, run_sweep
 
     config = load_config(args.config)
     out = Path(args.out) if args.out else Path("figures") / "sweeps" / config.name
+    recorder = start_run(store_of(args).root, f"sweep {args.config}" + " --quick" * args.quick,
+                         size="quick" if args.quick else "full")
     try:
         result = run_sweep(config, out, workers=args.workers, scheduler=args.scheduler,
-                           quick=args.quick, timed=False if args.untimed else None)
+                           quick=args.quick, timed=False if args.untimed else None,
+                           recorder=recorder)
     except KeyboardInterrupt:
         print(f"sweep {config.name}: interrupted; finished points are kept in {out / 'points'}",
               file=sys.stderr)
         return 130
     print(f"{out / 'table.md'}, {out / 'pareto.png'}")
     print(result.summary)
+    print(f"results: run {recorder.run_id}, {recorder.appended} rows -> "
+          f"{recorder.store.root}", file=sys.stderr)
     return 1 if result.failed else 0
 
 
@@ -49,6 +56,7 @@ def add_parser(subparsers):
                    help="smaller built-in scenes and at most 5 timed repeats")
     p.add_argument("--untimed", action="store_true",
                    help="draw every point once without timing (error-only, fully parallel)")
+    add_results_option(p)
     p.set_defaults(func=cmd_sweep)
     return p
 

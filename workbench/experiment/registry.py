@@ -20,9 +20,14 @@ import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .context import SIZES, ExperimentContext
 from .tables import write_table
+from .timing import empty_gpu_note
+
+if TYPE_CHECKING:
+    from .recording import Recorder
 
 Progress = Callable[[str], None]
 RunFunction = Callable[[ExperimentContext], list]
@@ -99,7 +104,8 @@ def get_experiment(name: str) -> Experiment:
 
 def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figures"),
                    quick: bool = False, progress: Progress | None = None,
-                   size: str | None = None) -> tuple[list[dict], Path]:
+                   size: str | None = None,
+                   recorder: Recorder | None = None) -> tuple[list[dict], Path]:
     """Run experiment ``name`` into ``figures_root/<name>/`` and write its table there.
 
     ``size`` is "full", "quick" or "tiny" (see :mod:`workbench.experiment.context`); by
@@ -109,7 +115,9 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     (``.<name>.<random>.<pid>.partial``); its ``table.csv`` and ``table.md`` (titled with the
     name and description) go there too, and only then does the staging folder replace the
     output folder, so a run's outputs change as a set: a run that fails or is killed leaves the
-    previous outputs whole. What killed runs left behind (staging folders, a previous output
+    previous outputs whole. With a ``recorder`` every table's rows are then appended to its
+    results store (columns ``experiment``, ``table`` and ``experiment_size`` added), once the
+    folder is in place. What killed runs left behind (staging folders, a previous output
     folder set aside, temporary files) is cleaned up first. Returns ``(rows, out_dir)``.
     Unknown names raise KeyError listing the known ones; rows that are not dicts raise TypeError.
     """
@@ -135,11 +143,15 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
         bad = [type(r).__name__ for r in rows if not isinstance(r, dict)]
         if bad:
             raise TypeError(f"experiment {name!r} returned rows that are not dicts: {bad[:3]}")
-        write_table(rows, staging, "table", title=f"{exp.name}: {exp.description}")
+        write_table(rows, staging, "table", title=f"{exp.name}: {exp.description}",
+                    notes=empty_gpu_note(rows))
         _swap_in(staging, out_dir)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
+    if recorder is not None:
+        for table, table_rows in [("table", rows), *context.tables]:
+            recorder.append(table_rows, experiment=exp.name, table=table, experiment_size=size)
     return rows, out_dir
 
 

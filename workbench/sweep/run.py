@@ -10,6 +10,7 @@ import time
 import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..experiment.tables import table_columns, write_table
 from .cache import cached_row, json_default, store_row
@@ -17,6 +18,9 @@ from .config import SweepConfig, grid_points, load_config
 from .pareto import save_pareto
 from .points import Point, failure_row, run_point
 from .sources import point_key
+
+if TYPE_CHECKING:
+    from ..experiment.recording import Recorder
 
 # what every worker imports once its context exists, so that the first point's time is not
 # spent importing
@@ -58,7 +62,7 @@ def _progress(total: int, initial: int, name: str, enabled: bool):
 
 def run_sweep(config: SweepConfig | str | Path, out_dir, *, workers: int | None = None,
               scheduler: str | None = None, quick: bool = False, progress: bool = True,
-              timed: bool | None = None) -> SweepResult:
+              timed: bool | None = None, recorder: Recorder | None = None) -> SweepResult:
     """Run ``config`` (a :class:`SweepConfig` or a config file) on a Dask cluster (a new
     LocalCluster of ``workers`` processes, default one per CPU, or the one at ``scheduler``),
     computing only points not cached in ``out_dir/points``; write ``table.csv``, ``table.md``
@@ -66,7 +70,10 @@ def run_sweep(config: SweepConfig | str | Path, out_dir, *, workers: int | None 
 
     ``quick``: smaller built-in scenes, at most 5 repeats. ``timed`` (default the config's):
     False draws every point once, untimed. ``progress``: a tqdm bar on stderr. A failing point
-    is stored with its ``error`` and counted in ``failed``; the sweep goes on.
+    is stored with its ``error`` and counted in ``failed``; the sweep goes on. With a
+    ``recorder`` the points computed now (not those from the cache, recorded by their own run)
+    are appended to its results store as table ``points`` of experiment ``sweep:<name>``,
+    also when the sweep is interrupted, and the rows carry the recorder's run id.
     """
     from ..experiment.cluster import sweep_cluster
 
@@ -76,7 +83,7 @@ def run_sweep(config: SweepConfig | str | Path, out_dir, *, workers: int | None 
     out = Path(out_dir)
     points_dir = out / "points"
     points_dir.mkdir(parents=True, exist_ok=True)
-    run_id = uuid.uuid4().hex[:12]
+    run_id = recorder.run_id if recorder is not None else uuid.uuid4().hex[:12]
     rows: dict[int, dict] = {}
     skip_ms, computed = [], 0
     untimed = not any(p.timed for p in points)
@@ -97,6 +104,10 @@ def run_sweep(config: SweepConfig | str | Path, out_dir, *, workers: int | None 
             computed = _compute(cluster, missing, keys, points_dir, run_id, rows, bar)
         finally:
             bar.close()
+            if recorder is not None:
+                recorder.append([rows[p.index] for p in missing if p.index in rows],
+                                experiment=f"sweep:{config.name}", table="points",
+                                experiment_size="quick" if quick else "full")
         compute_s = time.perf_counter() - start
         renderer, count = cluster.renderer, cluster.workers
     ordered = [rows[p.index] for p in points]

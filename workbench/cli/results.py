@@ -1,0 +1,179 @@
+"""``workbench results``: the results store of every run — query it with SQL, compare two runs
+(or commits, or machines), draw a Pareto figure of any query, and regenerate the measured
+claims of the README and docs/results.md from it.
+
+The store is ``--results DIR``, else ``$WORKBENCH_RESULTS``, else ``figures/results``.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from .arguments import refused
+
+RESULTS_HELP = ("results store folder (default: $WORKBENCH_RESULTS, else <figures>/results)")
+
+
+def add_results_option(parser) -> None:
+    """Add ``--results DIR`` (the results store) to a command's parser."""
+    parser.add_argument("--results", metavar="DIR", help=RESULTS_HELP)
+
+
+def store_of(args, figures: str | Path = "figures"):
+    """The :class:`~workbench.experiment.store.ResultsStore` that ``args.results`` (or the
+    environment, or ``figures``) names."""
+    from ..experiment.store import ResultsStore, results_root
+
+    return ResultsStore(results_root(getattr(args, "results", None), figures=figures))
+
+
+def add_parser(subparsers) -> None:
+    """Add ``results`` and its subcommands to the ``workbench`` command's subparsers."""
+    p = subparsers.add_parser(
+        "results", help="query, compare and report the stored results of every run",
+        description="Every run of `workbench run`, `reproduce`, `sweep` and `render` appends its "
+                    "rows to one results store (Parquet). Query it with DuckDB SQL over the "
+                    "views rows, runs and machines (joined by run_id and machine_id), compare "
+                    "two runs, plot time against error, or regenerate the measured claims.")
+    sub = p.add_subparsers(dest="results_command", required=True)
+
+    q = sub.add_parser("query", help="run SQL over the views rows, runs, machines",
+                       description="Run one DuckDB SQL statement over the views `rows` (every "
+                                   "stored row, with run_id, experiment, table), `runs` (one "
+                                   "per run: commit, dirty, started, load, libraries, with the "
+                                   "machine's cpu and renderer) and `machines` (fingerprints).")
+    q.add_argument("sql", help='e.g. "SELECT path, median(wall_ms) FROM rows GROUP BY path"')
+    q.add_argument("--csv", metavar="FILE", help="write the result as CSV instead of printing")
+    q.add_argument("--limit", type=int, default=200, metavar="N",
+                   help="print at most N rows (default 200; --csv writes all)")
+    add_results_option(q)
+    q.set_defaults(func=cmd_query)
+
+    c = sub.add_parser("compare", help="pair equal measurements of two runs and flag changes",
+                       description="Pair the equal measurements (experiment, table, parameters) "
+                                   "of A and B — each a run id, a commit or a machine id, or a "
+                                   "unique prefix — and report per pair the time ratio B/A with "
+                                   "its 95 %% interval, relative to the drift of its group "
+                                   "(the median ratio of the times of one experiment, table "
+                                   "and scene), and the error columns. A change is flagged "
+                                   "when the interval excludes 1 and the ratio is off by more "
+                                   "than the threshold. Exit status 1 when any is.")
+    c.add_argument("a", help="run id, commit or machine id (or a unique prefix)")
+    c.add_argument("b", help="run id, commit or machine id (or a unique prefix)")
+    c.add_argument("--threshold", type=float, default=None, metavar="T",
+                   help="relative change below which nothing is flagged (default 0.10)")
+    c.add_argument("--all", action="store_true", help="list every pair, not only flagged ones")
+    c.add_argument("--no-drift", action="store_true",
+                   help="compare times as they are, not relative to their group's drift")
+    c.add_argument("--csv", metavar="FILE", help="write every pair as CSV")
+    add_results_option(c)
+    c.set_defaults(func=cmd_compare)
+
+    f = sub.add_parser("pareto", help="figure of time against error from a query",
+                       description="Plot the rows of a query as time against error, with the "
+                                   "front of the rows no other is both faster and more exact "
+                                   "than.")
+    f.add_argument("sql", help="a query returning the time and error columns")
+    f.add_argument("-o", "--out", required=True, metavar="PNG", help="figure file")
+    f.add_argument("--time", default="wall_ms", help="time column (default wall_ms)")
+    f.add_argument("--error", default="max_diff_255", help="error column (default max_diff_255)")
+    f.add_argument("--label", default="path", help="column naming each point (default path)")
+    add_results_option(f)
+    f.set_defaults(func=cmd_pareto)
+
+    r = sub.add_parser("report", help="regenerate the README's claims and docs/results.md",
+                       description="Write the measured claims of the README (between its "
+                                   "results markers) and docs/results.md from the latest "
+                                   "stored run of each experiment, each ratio with its "
+                                   "interval and the machine it ran on.")
+    r.add_argument("--readme", default="README.md", metavar="FILE")
+    r.add_argument("--doc", default="docs/results.md", metavar="FILE")
+    add_results_option(r)
+    r.set_defaults(func=cmd_report)
+
+
+def _print_table(table, limit: int | None = None) -> None:
+    from ..experiment.tables import markdown_table
+
+    rows = table.to_pylist()
+    shown = rows if limit is None else rows[:limit]
+    print(markdown_table(shown, columns=table.column_names), end="")
+    if limit is not None and len(rows) > limit:
+        print(f"({len(rows) - limit} more rows; --limit N or --csv FILE for all)")
+
+
+def cmd_query(args) -> int:
+    """``workbench results query``: print the result (or write it as CSV); 0."""
+    import duckdb
+
+    from ..experiment.tables import write_table
+
+    store = store_of(args)
+    try:
+        table = store.query(args.sql)
+    except duckdb.Error as exc:
+        return refused(ValueError(f"query refused by DuckDB: {str(exc).splitlines()[0]}"))
+    if args.csv:
+        out = Path(args.csv)
+        write_table(table.to_pylist(), out.parent if str(out.parent) else Path("."),
+                    out.stem, columns=table.column_names)
+        print(f"{len(table)} rows -> {out.with_suffix('.csv')}")
+    else:
+        _print_table(table, args.limit)
+    return 0
+
+
+def cmd_compare(args) -> int:
+    """``workbench results compare A B``: the flagged pairs (or all), a summary line; 1 when a
+    change is flagged, 0 otherwise."""
+    from ..experiment.run_compare import THRESHOLD, compare_runs, summary
+    from ..experiment.tables import markdown_table, write_table
+
+    threshold = THRESHOLD if args.threshold is None else args.threshold
+    lines = compare_runs(store_of(args), args.a, args.b, threshold=threshold,
+                         drift=not args.no_drift)
+    if args.csv:
+        out = Path(args.csv)
+        write_table(lines, out.parent if str(out.parent) else Path("."), out.stem)
+    shown = lines if args.all else [line for line in lines if line["flagged"]]
+    columns = ["experiment", "table", "measurement", "quantity", "a", "b", "ratio", "drift",
+               "relative", "relative_lo", "relative_hi", "flagged", "errors_changed"]
+    if shown:
+        print(markdown_table(shown, columns=columns), end="")
+    print(f"compare {args.a} -> {args.b}: {summary(lines)} (threshold {threshold:.0%})")
+    return 1 if any(line["flagged"] for line in lines) else 0
+
+
+def cmd_pareto(args) -> int:
+    """``workbench results pareto``: the figure of the query's rows; 0."""
+    import duckdb
+
+    from ..sweep.pareto import save_pareto
+
+    try:
+        rows = store_of(args).query(args.sql).to_pylist()
+    except duckdb.Error as exc:
+        return refused(ValueError(f"query refused by DuckDB: {str(exc).splitlines()[0]}"))
+    for column in (args.time, args.error):
+        if rows and column not in rows[0]:
+            return refused(ValueError(f"the query returns no column {column!r} (it returns "
+                                      f"{', '.join(rows[0])})"))
+    if not rows:
+        return refused(ValueError("the query returns no rows"))
+    for row in rows:
+        row["path"] = str(row.get(args.label))  # the figure colours points by "path"
+    save_pareto(Path(args.out), rows, time_column=args.time, metric=args.error,
+                title=f"{args.error} against {args.time}", reference=None)
+    print(f"{len(rows)} points -> {args.out}")
+    return 0
+
+
+def cmd_report(args) -> int:
+    """``workbench results report``: rewrite the README's claims and docs/results.md; 0."""
+    from ..experiment.report import write_report
+
+    written = write_report(store_of(args), Path(args.readme), Path(args.doc))
+    for path in written:
+        print(f"wrote {path}", file=sys.stderr)
+    return 0
