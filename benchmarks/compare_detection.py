@@ -70,7 +70,7 @@ def main() -> None:
     parser.add_argument("--slow", type=float, default=0.2, help="added share of the draw time")
     parser.add_argument("--n", type=int, default=64, help="quads per sheet side")
     parser.add_argument("--size", type=int, default=400, help="image side in pixels")
-    parser.add_argument("--thresholds", default="0.1,0.15,0.2,0.25")
+    parser.add_argument("--thresholds", default="0,0.05,0.1,0.25")
     args = parser.parse_args()
     ctx = create_context()
     machine = machine_fingerprint(renderer=describe(ctx))

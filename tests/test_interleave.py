@@ -119,6 +119,9 @@ def test_empty_gpu_columns_on_a_software_renderer_get_a_note():
     assert empty_gpu_note([{**rows[0], "gpu_ms": 0.5}]) == []
     assert empty_gpu_note([{**rows[0], "renderer": "NVIDIA H200/PCIe/SSE2"}]) == []
     assert empty_gpu_note([{"renderer": SOFTWARE, "wall_ms": 1.0}]) == []
+    # rows without a renderer column: the run's renderer, where it is known
+    assert empty_gpu_note([{"draw_gpu_ms": None}], SOFTWARE) != []
+    assert empty_gpu_note([{"draw_gpu_ms": None}]) == []
 
 
 def test_experiment_tables_say_why_gpu_time_is_empty(tmp_path):

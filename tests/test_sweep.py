@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 import workbench.scene.readers as scene_readers
+from workbench.experiment.store import ResultsStore
 from workbench.experiment.tables import read_table
 from workbench.sweep import (
     Point,
@@ -169,7 +170,7 @@ def test_point_key_follows_the_shaders_a_path_loads(tmp_path):
 
 
 @pytest.mark.slow
-def test_failing_point_is_recorded_and_exit_status_is_1(tmp_path):
+def test_failing_point_is_recorded_and_exit_status_is_1(tmp_path, session_results_store):
     config_path = write_config(tmp_path, """
         name = "failing"
         repeats = 5
@@ -193,6 +194,12 @@ def test_failing_point_is_recorded_and_exit_status_is_1(tmp_path):
     assert all("\n" not in r["error"] for r in rows[1:])
     stored = [json.loads(p.read_text())["row"] for p in (out / "points").glob("*.json")]
     assert sum(1 for r in stored if r.get("error")) == 3  # failures are cached too
+    # the computed points went to the results store too, under the sweep's run
+    store = ResultsStore(session_results_store)
+    recorded = store.query("SELECT run_id, error, wall_ms FROM rows "
+                           "WHERE experiment = 'sweep:failing'").to_pylist()
+    assert len(recorded) == 4 and sum(1 for r in recorded if r["error"]) == 3
+    assert {r["run_id"] for r in recorded} == {r["run_id"] for r in rows}
 
 
 def test_unknown_grid_key_is_refused_before_anything_runs(tmp_path):

@@ -57,12 +57,14 @@ def add_parser(subparsers) -> None:
                                    "its 95 %% interval, relative to the drift of its group "
                                    "(the median ratio of the times of one experiment, table "
                                    "and scene), and the error columns. A change is flagged "
-                                   "when the interval excludes 1 and the ratio is off by more "
-                                   "than the threshold. Exit status 1 when any is.")
+                                   "when its whole interval lies beyond the threshold (slower "
+                                   "than 1+T or faster than 1/(1+T)). Exit status 1 when any "
+                                   "is.")
     c.add_argument("a", help="run id, commit or machine id (or a unique prefix)")
     c.add_argument("b", help="run id, commit or machine id (or a unique prefix)")
     c.add_argument("--threshold", type=float, default=None, metavar="T",
-                   help="relative change below which nothing is flagged (default 0.10)")
+                   help="a change is flagged when its 95 %% interval lies beyond 1+T (or below "
+                        "1/(1+T)); default 0.10")
     c.add_argument("--all", action="store_true", help="list every pair, not only flagged ones")
     c.add_argument("--no-drift", action="store_true",
                    help="compare times as they are, not relative to their group's drift")

@@ -42,10 +42,10 @@ FULL_REPEATS, QUICK_REPEATS = 9, 5
 # draws go on until the wall median's 95 % interval is within ±2 % (full) or ±5 % (quick),
 # up to these counts
 FULL_STOP = StoppingRule(rel_half_width=0.02, min_samples=FULL_REPEATS, max_samples=41)
-QUICK_STOP = StoppingRule(rel_half_width=0.05, min_samples=QUICK_REPEATS, max_samples=15)
+QUICK_STOP = StoppingRule(rel_half_width=0.05, min_samples=QUICK_REPEATS, max_samples=9)
 # interleaved ratios (A B A B …): pairs until the ratio's interval is within ±2 % / ±5 %
 FULL_RATIO_STOP = StoppingRule(rel_half_width=0.02, min_samples=FULL_REPEATS, max_samples=61)
-QUICK_RATIO_STOP = StoppingRule(rel_half_width=0.05, min_samples=QUICK_REPEATS, max_samples=21)
+QUICK_RATIO_STOP = StoppingRule(rel_half_width=0.05, min_samples=QUICK_REPEATS, max_samples=11)
 TINY_RATIO_STOP = StoppingRule(rel_half_width=1.0, min_samples=QUICK_REPEATS,
                                max_samples=QUICK_REPEATS)
 
@@ -72,6 +72,7 @@ class ExperimentContext:
     progress: Callable[[str], None] | None = None
     skipped: list[str] = field(default_factory=list)
     tables: list[tuple[str, list[dict[str, Any]]]] = field(default_factory=list)
+    gl_renderer: str | None = None  # the renderer of the run's GL context, once made
     _gl_scope: ExitStack | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -107,7 +108,7 @@ class ExperimentContext:
     @property
     def stop(self) -> StoppingRule | None:
         """When timed draws stop: at full size once the median's 95 % interval is within
-        ±2 % (9 to 41 draws), at quick size within ±5 % (5 to 15); at tiny size after
+        ±2 % (9 to 41 draws), at quick size within ±5 % (5 to 9); at tiny size after
         :attr:`repeats`."""
         if self.size == "tiny":
             return None
@@ -115,7 +116,7 @@ class ExperimentContext:
 
     def ratio_stop(self, max_samples: int | None = None) -> StoppingRule:
         """When interleaved pairs stop (:mod:`workbench.experiment.interleave`): the ratio's
-        95 % interval within ±2 % (full, 9 to 61 pairs) or ±5 % (quick, 5 to 21); 5 pairs at
+        95 % interval within ±2 % (full, 9 to 61 pairs) or ±5 % (quick, 5 to 11); 5 pairs at
         tiny size. ``max_samples`` lowers the most pairs (for slow peers)."""
         rule = self.pick(FULL_RATIO_STOP, QUICK_RATIO_STOP, TINY_RATIO_STOP)
         if max_samples is not None:
@@ -140,7 +141,7 @@ class ExperimentContext:
         :attr:`tables` for the results store."""
         rows = list(rows)
         write_table(rows, self.out_dir, name, columns=columns, title=title,
-                    notes=empty_gpu_note(rows))
+                    notes=empty_gpu_note(rows, self.gl_renderer))
         self.tables.append((name, rows))
 
     # ------------------------------------------------------------------ data and drawing
@@ -181,6 +182,7 @@ class ExperimentContext:
             raise
         restore.display = egl().eglGetCurrentDisplay()
         self._gl_scope = scope
+        self.gl_renderer = str(ctx.info["GL_RENDERER"])
         return ctx
 
     def close(self) -> None:

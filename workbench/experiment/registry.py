@@ -144,7 +144,7 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
         if bad:
             raise TypeError(f"experiment {name!r} returned rows that are not dicts: {bad[:3]}")
         write_table(rows, staging, "table", title=f"{exp.name}: {exp.description}",
-                    notes=empty_gpu_note(rows))
+                    notes=empty_gpu_note(rows, context.gl_renderer))
         _swap_in(staging, out_dir)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)

@@ -85,15 +85,17 @@ def latest_sources(store: ResultsStore) -> dict[str, Source]:
     return dict(sorted(best.items()))
 
 
+def _quoted(text: str) -> str:
+    """``text`` as an SQL string literal."""
+    return "'" + str(text).replace("'", "''") + "'"
+
+
 def stored_table(store: ResultsStore, source: Source, table: str) -> list[dict[str, Any]]:
     """The rows of ``table`` of ``source``'s experiment in its run, in their order, with only
     the columns that table has (the store's views hold every table's columns)."""
-    def quoted(text: str) -> str:
-        return "'" + text.replace("'", "''") + "'"
-
-    result = store.query(f"SELECT * FROM rows WHERE run_id = {quoted(source.run_id)} AND "
-                         f"experiment = {quoted(source.experiment)} AND \"table\" = "
-                         f"{quoted(table)} ORDER BY row_index")
+    result = store.query(f"SELECT * FROM rows WHERE run_id = {_quoted(source.run_id)} AND "
+                         f"experiment = {_quoted(source.experiment)} AND \"table\" = "
+                         f"{_quoted(table)} ORDER BY row_index")
     rows = result.to_pylist()
     keep = [c for c in result.column_names
             if c not in ("run_id", "row_index", "experiment", "table", "experiment_size")
@@ -104,8 +106,8 @@ def stored_table(store: ResultsStore, source: Source, table: str) -> list[dict[s
 def stored_table_names(store: ResultsStore, source: Source) -> list[str]:
     """The tables ``source``'s experiment stored in its run, main table first."""
     names = store.query(
-        f"SELECT DISTINCT \"table\" FROM rows WHERE run_id = '{source.run_id}' AND "
-        f"experiment = '{source.experiment}'").column("table").to_pylist()
+        f"SELECT DISTINCT \"table\" FROM rows WHERE run_id = {_quoted(source.run_id)} AND "
+        f"experiment = {_quoted(source.experiment)}").column("table").to_pylist()
     return sorted(names, key=lambda n: (n != "table", n))
 
 

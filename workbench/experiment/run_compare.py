@@ -23,9 +23,10 @@ of the times of one experiment, table and scene. A line's ``drift`` is that medi
 is the machine's speed as much as the code's. Ratios that carry their own interval (measured
 interleaved in one run) are already free of drift and are compared as they are.
 
-A line is *flagged* as changed only when its (relative) interval excludes 1 **and** its
-(relative) ratio is off 1 by more than ``threshold`` (default 10 %). Error columns (image
-differences) are compared exactly: their values in A and B and whether any changed.
+A line is *flagged* as changed only when its whole (relative) interval lies beyond the
+threshold band ``[1 / (1 + threshold), 1 + threshold]`` (default 10 %): the change is larger
+than the threshold with 95 % confidence, not merely different from nothing. Error columns
+(image differences) are compared exactly: their values in A and B and whether any changed.
 """
 
 from __future__ import annotations
@@ -176,9 +177,8 @@ def compare_runs(store: ResultsStore, a: str, b: str, threshold: float = THRESHO
         d = drifts.get(line.pop("group"), 1.0) if line.pop("timed") else 1.0
         line.update(drift=d, relative=line["ratio"] / d, relative_lo=line["ratio_lo"] / d,
                     relative_hi=line["ratio_hi"] / d)
-        beyond = abs(line["relative"] - 1.0) > threshold
-        excludes = line["relative_lo"] > 1.0 or line["relative_hi"] < 1.0
-        line["flagged"] = beyond and excludes
+        line["flagged"] = (line["relative_lo"] > 1.0 + threshold
+                           or line["relative_hi"] < 1.0 / (1.0 + threshold))
     return out
 
 

@@ -110,15 +110,17 @@ EMPTY_GPU_NOTE = ("{columns} empty: {renderers} rasterizes on the CPU, and its G
                   "is the time.")
 
 
-def empty_gpu_note(rows: list[dict[str, Any]]) -> list[str]:
+def empty_gpu_note(rows: list[dict[str, Any]], renderer: str | None = None) -> list[str]:
     """A table's note on its GPU-time columns (names containing ``gpu_ms``) where every value is
-    empty because the rows' renderers are software renderers; no note otherwise."""
+    empty because the rows' renderers (their ``renderer`` column, else ``renderer``) are
+    software renderers; no note otherwise."""
     from ..gl.context import is_software_renderer
 
     columns = sorted({k for row in rows for k in row if "gpu_ms" in k})
     if not columns or any(row.get(c) is not None for row in rows for c in columns):
         return []
-    renderers = sorted({str(r["renderer"]) for r in rows if r.get("renderer")})
+    renderers = sorted({str(r.get("renderer") or renderer) for r in rows
+                        if r.get("renderer") or renderer})
     if not renderers or not all(is_software_renderer(r) for r in renderers):
         return []
     return [EMPTY_GPU_NOTE.format(columns=", ".join(columns), renderers=" and ".join(renderers))]

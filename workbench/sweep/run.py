@@ -145,12 +145,13 @@ def _compute(cluster, points: list[Point], keys: dict, points_dir: Path, run_id:
     return len(points)
 
 
-_UNSTABLE = re.compile(r"(_ms|_s)(_min|_max)?$")
+_UNSTABLE = re.compile(r"(_ms|_s)(_min|_max|_lo|_hi)?$")
 
 
 def stable_row(row: dict) -> dict:
     """``row`` without what differs between equal runs: times (columns ending in ``_ms`` or
-    ``_s``, with their ``_min``/``_max``) and ``run_id``."""
+    ``_s``, with their ``_min``/``_max`` and their interval's ``_lo``/``_hi``) and
+    ``run_id``."""
     return {k: v for k, v in row.items() if k != "run_id" and not _UNSTABLE.search(k)}
 
 
