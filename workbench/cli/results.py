@@ -32,7 +32,7 @@ def add_parser(subparsers) -> None:
     """Add ``results`` and its subcommands to the ``workbench`` command's subparsers."""
     p = subparsers.add_parser(
         "results", help="query, compare and report the stored results of every run",
-        description="Every run of `workbench run`, `reproduce`, `sweep` and `render` appends its "
+        description="Every run of `workbench run`, `reproduce` and `sweep` appends its "
                     "rows to one results store (Parquet). Query it with DuckDB SQL over the "
                     "views rows, runs and machines (joined by run_id and machine_id), compare "
                     "two runs, plot time against error, or regenerate the measured claims.")

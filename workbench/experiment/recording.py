@@ -1,9 +1,8 @@
 """A command's run, recorded in the results store: its machine, its run record and its rows.
 
-``workbench run``, ``reproduce``, ``sweep`` and ``render`` start a :class:`Recorder` (see
-:func:`start_run`); every table an experiment writes, every sweep point and every measured
-render is appended to the store under the run's id, beside the CSV/Markdown tables written from
-the same rows.
+``workbench run``, ``reproduce`` and ``sweep`` start a :class:`Recorder` (see
+:func:`start_run`); every table an experiment writes and every sweep point computed is appended
+to the store under the run's id, beside the CSV/Markdown tables written from the same rows.
 """
 
 from __future__ import annotations
