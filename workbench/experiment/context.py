@@ -171,7 +171,7 @@ class ExperimentContext:
     @cached_property
     def gl(self) -> moderngl.Context:
         """The run's headless GL context, created on first use (and current from then on)."""
-        from ..gl.context import create_context, egl, keeping_current
+        from ..gl.context import create_context, egl, keeping_current, renderer
 
         scope = ExitStack()
         restore = scope.enter_context(keeping_current())
@@ -182,7 +182,7 @@ class ExperimentContext:
             raise
         restore.display = egl().eglGetCurrentDisplay()
         self._gl_scope = scope
-        self.gl_renderer = str(ctx.info["GL_RENDERER"])
+        self.gl_renderer = renderer(ctx)
         return ctx
 
     def close(self) -> None:

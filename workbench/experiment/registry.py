@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .context import SIZES, ExperimentContext
+from .store import process_alive
 from .tables import write_table
 from .timing import empty_gpu_note
 
@@ -169,16 +170,6 @@ def _swap_in(staging: Path, out_dir: Path) -> None:
     shutil.rmtree(old, ignore_errors=True)
 
 
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
 def clean_dead_runs(root: Path, name: str) -> list[Path]:
     """Remove what runs of experiment ``name`` that died left in ``root``: their staging
     folders, temporary files in the output folder, and a previous output folder set aside (put
@@ -190,7 +181,7 @@ def clean_dead_runs(root: Path, name: str) -> list[Path]:
         parts = entry.name.rsplit(".", 2)
         if len(parts) != 3 or parts[2] not in ("partial", "old") or not parts[1].isdigit():
             continue
-        if _alive(int(parts[1])) and int(parts[1]) != os.getpid():
+        if process_alive(int(parts[1])) and int(parts[1]) != os.getpid():
             continue
         if parts[2] == "old" and not out_dir.exists():
             os.replace(entry, out_dir)

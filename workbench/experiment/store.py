@@ -188,7 +188,9 @@ def _write(table: pa.Table, path: Path, exclusive: bool = False) -> bool:
     return True
 
 
-def _alive(pid: int) -> bool:
+def process_alive(pid: int) -> bool:
+    """Whether process ``pid`` still runs on this machine (a zombie does not: its writes are
+    over)."""
     if pid == os.getpid():
         return True
     try:
@@ -400,7 +402,8 @@ class ResultsStore:
         for pattern in ("machines/.*.tmp", "runs/.*.tmp", "rows/*/.*.tmp"):
             for path in self.root.glob(pattern):
                 match = _TEMP.fullmatch(path.name)
-                dead = bool(match and match["host"] == _HOST and not _alive(int(match["pid"])))
+                dead = bool(match and match["host"] == _HOST
+                            and not process_alive(int(match["pid"])))
                 try:
                     if dead or now - path.stat().st_mtime > TEMP_MAX_AGE_S:
                         path.unlink()
