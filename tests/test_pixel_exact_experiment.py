@@ -23,6 +23,9 @@ TABLES = {
     "sweep": ["sweep", "cells", "threshold_mm2", "threshold_vs_mean_area", "polygons", "path",
               "wall_ms", "gpu_ms", *ERRORS, "crack_pixels", "crack_pixels_skirts", "renderer",
               "fit_U_err_max"],
+    "interleaved": ["target_polygons", "polygons", "size", "renderer", "per_pixel_ms",
+                    "per_vertex_ms", "per_pixel_over_per_vertex", "per_pixel_over_per_vertex_lo",
+                    "per_pixel_over_per_vertex_hi", "per_pixel_over_per_vertex_pairs"],
     "stability": ["case", "offset_mm", "polygons", *ERRORS, "f32_global_U_err_rel",
                   "f32_local_U_err_rel", "nan_pixels", "renderer", "t_us", "zero_area_polygons",
                   "nan_corners", "area_error", "zero_U_pixels"],
@@ -118,6 +121,13 @@ def test_tiny_per_pixel_is_exact_off_element_boundaries_and_per_vertex_is_not(ti
 
 def test_tiny_slicing_and_stability_rows(tiny):
     check_slicing_and_stability(tiny[1])
+
+
+def test_tiny_interleaved_ratio_carries_its_interval(tiny):
+    (row,) = read_table(tiny[1] / "interleaved.csv")
+    name = "per_pixel_over_per_vertex"
+    assert row[f"{name}_lo"] <= row[name] <= row[f"{name}_hi"] and row[f"{name}_pairs"] >= 5
+    assert row["per_pixel_ms"] > 0 and row["per_vertex_ms"] > 0 and row["target_polygons"] == 1000
 
 
 # ------------------------------------------------------------------------------ quick size

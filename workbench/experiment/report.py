@@ -197,12 +197,16 @@ def pixel_exact_claims(tables: Tables) -> list[str]:
     if not {"per_pixel", "per_vertex"} <= set(plain):
         return []
     pixel, vertex = plain["per_pixel"], plain["per_vertex"]
-    return [f"{top:,} polygons, no edge overdraw: per pixel {num(100 * pixel['share_over_1'])} "
-            f"% of the covered pixels more than 1/255 off the exact image, per vertex "
-            f"{num(100 * vertex['share_over_1'])} %; per pixel costs "
-            f"{num(pixel['wall_vs_per_vertex'])}× per vertex (separate measurements); skirts "
-            f"leave {span([r['crack_pixels'] for r in rows if r['edge_overdraw'] == 'skirts'])}"
-            f" crack pixels"]
+    out = [f"{top:,} polygons, no edge overdraw: per pixel {num(100 * pixel['share_over_1'])} "
+           f"% of the covered pixels more than 1/255 off the exact image, per vertex "
+           f"{num(100 * vertex['share_over_1'])} %; skirts leave "
+           f"{span([r['crack_pixels'] for r in rows if r['edge_overdraw'] == 'skirts'])} crack "
+           f"pixels"]
+    out += [f"{r['polygons']:,} polygons at {r['size']}: per pixel "
+            f"{interval(r, 'per_pixel_over_per_vertex')} per vertex's time "
+            f"({num(r['per_pixel_ms'])} against {num(r['per_vertex_ms'])} ms), interleaved"
+            for r in tables("interleaved")]
+    return out
 
 
 def exploded_claims(tables: Tables) -> list[str]:
