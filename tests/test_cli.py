@@ -286,3 +286,36 @@ def test_a_missing_parameter_is_one_warning_line_and_the_part_still_renders(tmp_
     assert result.stderr.strip().splitlines() == [
         f"workbench: warning: {deck}:7: *SECTION_SHELL: parameter 't' is not defined by "
         f"*PARAMETER in this deck or its includes: the thickness is missing"]
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["render", "spacetime:radial:4", "-O", "height_scale=nan", "-o", "x.png"],
+     "height_scale must be non-negative and finite, got nan"),
+    (["render", "spacetime:radial:4", "-O", "height_scale=abc", "-o", "x.png"],
+     "height_scale must be a number, got 'abc'"),
+    (["hausdorff", "semicylinders:2", "semicylinders:2", "--step", "999"],
+     "--step 999 out of range"),
+    (["hausdorff", "semicylinders:2", "semicylinders:2", "--step", "-1"],
+     "argument --step: must be at least 0, got -1"),
+    (["stress", "render", "--cycles", "0"], "argument --cycles: must be at least 1, got 0"),
+    (["stress", "render", "--cycles", "-1"], "argument --cycles: must be at least 1, got -1"),
+    (["stress", "readers", "--n", "-1"], "argument --n: must be at least 1, got -1"),
+    (["render", "semicylinders:2", "--scheduler", "tcp://127.0.0.1:1", "-o", "x.png"],
+     "--scheduler applies to sort-last rendering: give --domains D as well"),
+    (["render", "semicylinders:2", "-o", "x.txt"], "render writes a PNG image"),
+    (["render", "semicylinders:2", "--colormap", "nosuchmap", "-o", "x.png"],
+     "unknown colormap 'nosuchmap'"),
+])
+def test_bad_command_lines_end_in_one_line_and_status_2(argv, message, tmp_path, capsys,
+                                                        monkeypatch):
+    """Each bad request is refused before anything is drawn or written: one line on stderr,
+    exit status 2, no traceback and no output file."""
+    monkeypatch.chdir(tmp_path)
+    try:
+        status = main(argv)
+    except SystemExit as exc:  # argparse refuses its own arguments by exiting
+        status = exc.code
+    err = capsys.readouterr().err
+    assert status == 2 and message in err, err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert not list(tmp_path.iterdir())

@@ -38,15 +38,34 @@ def image_size(text: str) -> tuple[int, int]:
     return w, h
 
 
+def at_least(minimum: int):
+    """An argparse type: an integer ``>= minimum`` (refused in one line otherwise)."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"must be at least {minimum}, got {value}")
+        return value
+
+    parse.__name__ = f"integer >= {minimum}"
+    return parse
+
+
 def key_value(text: str) -> tuple[str, object]:
-    """``KEY=VALUE`` of ``--option``: VALUE read as a Python literal (number, tuple, bool), else
-    kept as a string."""
+    """``KEY=VALUE`` of ``--option``: VALUE read as a Python literal (number, tuple, bool), or
+    as a float (``nan``, ``inf``), else kept as a string."""
     key, sep, value = text.partition("=")
     if not sep or not key:
         raise argparse.ArgumentTypeError(f"expected KEY=VALUE, got {text!r}")
     try:
         return key.strip(), ast.literal_eval(value)
     except (ValueError, SyntaxError):
+        pass
+    try:  # nan and inf are numbers the literal syntax does not spell
+        return key.strip(), float(value)
+    except ValueError:
         return key.strip(), value
 
 

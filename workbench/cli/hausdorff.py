@@ -3,6 +3,8 @@ lower <= H <= upper, one-sided (A to B) or symmetric."""
 
 from __future__ import annotations
 
+from .arguments import at_least
+
 
 def add_parser(subparsers) -> None:
     """Add ``hausdorff`` to the ``workbench`` command's subparsers."""
@@ -15,7 +17,9 @@ def add_parser(subparsers) -> None:
     p.add_argument("--symmetric", action="store_true", help="max of both directions")
     p.add_argument("--width", type=float, default=0.01,
                    help="bracket width to reach, %% of A's bounding-box diagonal (default 0.01)")
-    p.add_argument("--step", type=int, default=0, help="time step of the coordinates (default 0)")
+    p.add_argument("--step", type=at_least(0), default=0,
+                   help="time step of the coordinates (default 0); B's last step where B has "
+                        "fewer")
     p.set_defaults(func=cmd_hausdorff)
 
 
@@ -25,8 +29,8 @@ def cmd_hausdorff(args) -> int:
     from ..scene.builtin import load_mesh
 
     a, b = load_mesh(args.mesh_a), load_mesh(args.mesh_b)
-    va, fa = a.coordinates(args.step), a.triangles
-    vb, fb = b.coordinates(args.step if args.step < b.n_steps else 0), b.triangles
+    va, fa = a.finite_coordinates(a.step_index(args.step, "--step")), a.triangles
+    vb, fb = b.finite_coordinates(min(args.step, b.n_steps - 1)), b.triangles
     lo, hi = va[a.used_nodes()].min(axis=0), va[a.used_nodes()].max(axis=0)
     diagonal = float(((hi - lo) ** 2).sum() ** 0.5)
     width = args.width / 100.0 * diagonal

@@ -125,10 +125,29 @@ def _render_options(args, kind: str) -> dict:
             raise ValueError(f"--{given[0].replace('_deg', '').replace('_', '-')} applies to the "
                              f"mesh paths, not to a spacetime scene")
         options = {}
+    options.update(dict(args.option or ()))
     if args.colormap is not None:
         options["colormap"] = args.colormap
-    options.update(dict(args.option or ()))
+    if "colormap" in options:  # refused by name even where no field is drawn with it
+        from ..paths.colormap import colormap_lut
+
+        colormap_lut(options["colormap"])
     return options
+
+
+def _check_output_and_cluster(args) -> None:
+    """Refuse (ValueError) an output that is not a PNG file name, and Dask options without
+    ``--domains``."""
+    if Path(args.output).suffix.lower() != ".png":
+        raise ValueError(f"-o {args.output}: render writes a PNG image; give a file name "
+                         f"ending in .png")
+    if args.domains is None:
+        given = [f"--{name}" for name in ("scheduler", "workers")
+                 if getattr(args, name, None) is not None]
+        if given:
+            verb = "apply" if len(given) > 1 else "applies"
+            raise ValueError(f"{' and '.join(given)} {verb} to sort-last rendering: give "
+                             f"--domains D as well")
 
 
 def _backend(args, path):
@@ -173,6 +192,7 @@ def cmd_render(args) -> int:
     from ..paths.registry import scene_path
     from ..scene.builtin import load_scene
 
+    _check_output_and_cluster(args)
     scene = load_scene(args.mesh, all_faces=args.all_faces)
     is_mesh = scene.kind == "mesh"
     if is_mesh:

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import sys
 
+from .arguments import at_least
+
 
 def _print_report(title: str, report, unit: str) -> bool:
     """Print a suite's title line, table and failures, then OK or FAILED; returns ``ok``."""
@@ -53,8 +55,8 @@ def add_parser(subparsers) -> None:
                     "prepare/draw/release cycles that keep no GL object and no memory, the same "
                     "image in other processes. all: both. Exit status 1 on any failure.")
     p.add_argument("suite", choices=["readers", "render", "all"], help="which suite to run")
-    p.add_argument("--n", type=int, default=200, help="reader mutations (default 200)")
+    p.add_argument("--n", type=at_least(1), default=200, help="reader mutations (default 200)")
     p.add_argument("--seed", type=int, default=0, help="random seed of the mutations (default 0)")
-    p.add_argument("--cycles", type=int, default=300,
+    p.add_argument("--cycles", type=at_least(1), default=300,
                    help="prepare/draw/release cycles of the render soak (default 300)")
     p.set_defaults(func=cmd_stress)

@@ -43,6 +43,7 @@ evaluation at pixel centres is the exact image the paths are measured against.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from numbers import Real
 from typing import TYPE_CHECKING
 
 import moderngl
@@ -100,6 +101,10 @@ class SpacetimeStyle:
         if self.element_store not in ELEMENT_STORES:
             raise ValueError(f"element_store must be one of {ELEMENT_STORES}, "
                              f"got {self.element_store!r}")
+        for name in ("U_max", "height_scale"):
+            value = getattr(self, name)
+            if isinstance(value, (bool, np.bool_)) or not isinstance(value, Real):
+                raise ValueError(f"{name} must be a number, got {value!r}")
         if not (np.isfinite(self.U_max) and self.U_max > 0):
             raise ValueError(f"U_max must be positive and finite, got {self.U_max}")
         if not (np.isfinite(self.height_scale) and self.height_scale >= 0):
