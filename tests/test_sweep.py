@@ -387,7 +387,7 @@ def test_a_point_drawn_by_the_software_rasterizer(ctx):
     row = measured_columns(soft, ctx)
     assert row["renderer"].startswith("software rasterizer")
     assert row["share_differing"] <= 0.005
-    assert soft.columns()["rasterizer"] == "software" and "rasterizer" not in gl.columns()
+    assert soft.columns()["rasterizer"] == "software" and gl.columns()["rasterizer"] == "gl"
 
 
 def test_es2008_views_config_is_valid():
@@ -396,3 +396,8 @@ def test_es2008_views_config_is_valid():
     points = grid_points(config, quick=True)
     assert {p.rasterizer for p in points} == {"software", "gl"}
     assert len({p.view for p in points}) == 8 and len(points) == 16
+    # every grid key is a column: no two points' rows look alike
+    rows = [p.columns() for p in points]
+    assert all({"rasterizer", "view", "samples"} <= set(r) for r in rows)
+    assert len({tuple((k, v) for k, v in r.items() if k != "point") for r in rows}) == 16
+    assert rows[0]["view"] == "[0.0,0.0]" and {r["rasterizer"] for r in rows} == {"software", "gl"}

@@ -79,13 +79,14 @@ class Point:
             repeats=self.repeats if self.timed else None, timed=self.timed, quick=self.quick)))
 
     def columns(self) -> dict:
-        """The point's own table columns: index, scene, path, its options, size, and the
+        """The point's own table columns: index, scene, path, rasterizer, its options, size,
+        samples and view (every grid key, so that no two points' rows look alike), and the
         simplifier and tolerance when it has them. Sequence values are written compactly."""
-        row = dict(point=self.index, scene=self.scene, path=self.path)
-        if self.rasterizer != "gl":
-            row["rasterizer"] = self.rasterizer
+        row = dict(point=self.index, scene=self.scene, path=self.path,
+                   rasterizer=self.rasterizer)
         row.update({k: cell_value(v) for k, v in self.options.items()})
         row["size"] = f"{self.size[0]}x{self.size[1]}"
+        row.update(samples=self.samples, view=cell_value(list(self.view)))
         if self.simplifier is not None:
             row.update(simplifier=self.simplifier, tolerance=self.tolerance)
         if self.quadrisection is not None:
