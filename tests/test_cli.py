@@ -319,3 +319,17 @@ def test_bad_command_lines_end_in_one_line_and_status_2(argv, message, tmp_path,
     assert status == 2 and message in err, err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
     assert not list(tmp_path.iterdir())
+
+
+def test_an_unreachable_scheduler_is_refused_soon(tmp_path, capsys):
+    """Nothing listens on port 1 of the loopback: one line, status 2, well before the old
+    30 s connection timeout (the bound is generous: it is the connect timeout that matters)."""
+    import time
+
+    start = time.monotonic()
+    status = main(["render", "semicylinders:4", "--domains", "2", "--rasterizer", "software",
+                   "--scheduler", "tcp://127.0.0.1:1", "-o", str(tmp_path / "x.png")])
+    elapsed = time.monotonic() - start
+    err = capsys.readouterr().err
+    assert status == 2 and "127.0.0.1:1" in err and len(err.strip().splitlines()) == 1
+    assert elapsed < 20 and not (tmp_path / "x.png").exists()

@@ -624,6 +624,23 @@ def test_tables_are_written_with_ordinary_permissions(tmp_path):
         assert stat.S_IMODE(path.stat().st_mode) == 0o644
 
 
+def test_an_experiments_output_folder_has_ordinary_permissions(tmp_path):
+    import os
+    import stat
+
+    @experiment("dummy-mode", "an output folder as readable as any")
+    def run(exp):
+        return [{"a": 1}]
+
+    mask = os.umask(0o022)
+    try:
+        _, out_dir = run_experiment("dummy-mode", tmp_path)
+    finally:
+        os.umask(mask)
+        EXPERIMENTS.pop("dummy-mode", None)
+    assert stat.S_IMODE(out_dir.stat().st_mode) == 0o755
+
+
 def test_experiment_outputs_are_replaced_as_a_set(tmp_path):
     """A run that fails leaves the previous outputs whole; a killed run's leftovers (staging
     folder, the previous folder set aside, temporary files) are cleaned by the next run."""

@@ -32,7 +32,8 @@ if TYPE_CHECKING:
     from distributed import Worker
 
 PLUGIN_NAME = "workbench-gl"
-CONNECT_TIMEOUT_S = 30
+# a scheduler that answers at all answers within a second; one that does not is refused soon
+CONNECT_TIMEOUT_S = 5
 WORKER_WAIT_S = 60
 
 

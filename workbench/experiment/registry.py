@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 
 from .context import SIZES, ExperimentContext
 from .store import process_alive
-from .tables import write_table
+from .tables import current_umask, write_table
 from .timing import empty_gpu_note
 
 if TYPE_CHECKING:
@@ -132,6 +132,7 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     clean_dead_runs(root, exp.name)
     staging = Path(tempfile.mkdtemp(dir=root, prefix=f".{exp.name}.",
                                     suffix=f".{os.getpid()}.partial"))
+    os.chmod(staging, 0o777 & ~current_umask())  # mkdtemp makes 0700; the output folder is public
     context = ExperimentContext(exp.name, staging, size, progress)
     try:
         try:

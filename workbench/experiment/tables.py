@@ -22,7 +22,8 @@ import numpy as np
 SIGNIFICANT_DIGITS = 4
 
 
-def _umask() -> int:
+def current_umask() -> int:
+    """The process's file-mode creation mask (read without changing it for good)."""
     mask = os.umask(0)
     os.umask(mask)
     return mask
@@ -40,7 +41,7 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w",
         raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; a table is as readable as any file
+    os.chmod(tmp, 0o666 & ~current_umask())  # mkstemp makes 0600; a table is readable as any
     try:
         with os.fdopen(fd, mode, **kwargs) as handle:
             yield handle
