@@ -331,3 +331,16 @@ def test_car_bracket_is_above_pymeshlab_sampled_distance(car_pair):
     # the lower bound is attained where reported
     a = r.location[0]
     assert distance_to_mesh(a, u, g)[0] == pytest.approx(r.lower, rel=1e-9, abs=1e-12 * diag)
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e3, 1e6])
+def test_a_surface_against_itself_has_a_bracket_holding_zero(offset):
+    """The exact distance of a surface to itself is 0: rounding of the computed distances must
+    not lift the certified lower bound above it, wherever the surface lies."""
+    rng = np.random.default_rng(7)
+    v, f = pyramid(0.6)
+    v = v * rng.uniform(0.5, 40.0) + offset
+    for one_sided in (True, False):
+        r = hausdorff(v, f, v.copy(), f.copy(), one_sided=one_sided)
+        assert r.lower == 0.0 <= r.upper
+        assert r.upper <= 1e-9 * max(1.0, offset)

@@ -213,7 +213,13 @@ def _one_sided(a: _Surface, b: _Surface, tol: float, max_depth: int, split: str,
                 point_a, point_b = point, near[0]
             lower = max(found, new_lower)
 
-    global_upper = max(float(upper.max()), lower)
+    # the computed distances carry float64 rounding of the size of the two surfaces: widen the
+    # bracket by it so that it holds the exact value (0 for a surface against itself); the
+    # diagonal of both together does not depend on the origin or on which surface is A
+    both = np.concatenate([v, b.bvh.corners.reshape(-1, 3)])
+    margin = _ROUNDING * float(np.linalg.norm(both.max(axis=0) - both.min(axis=0)))
+    lower = max(0.0, lower - margin)
+    global_upper = max(float(upper.max()), lower) + margin
     area2 = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]),
                            axis=1)
     area = 0.5 * float(area2.sum())
