@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import itertools
 import tempfile
-import time
 from pathlib import Path
 
 from workbench.experiment.measure import Together, measure_together
@@ -26,6 +25,7 @@ from workbench.experiment.store import ResultsStore
 from workbench.gl import create_context
 from workbench.gl.context import describe
 from workbench.paths import Style, make_path
+from workbench.reliability.faults import slowed
 from workbench.scene import generators
 
 PATHS = (("position", {}), ("flat", {}), ("gouraud", {}),
@@ -34,27 +34,11 @@ PATHS = (("position", {}), ("flat", {}), ("gouraud", {}),
 SLOWED = 2  # gouraud
 
 
-def slowed(path, ctx, share: float):
-    """``path`` whose draw spins for ``share`` of its own time after it."""
-    draw = path.draw
-
-    def slow_draw():
-        start = time.perf_counter()
-        draw()
-        ctx.finish()
-        end = time.perf_counter() + share * (time.perf_counter() - start)
-        while time.perf_counter() < end:
-            pass
-
-    path.draw = slow_draw
-    return path
-
-
 def record(store, machine, ctx, mesh, size, share: float) -> str:
     """One run of :data:`PATHS` measured together (path :data:`SLOWED` slowed by ``share``)."""
     paths = [make_path(name, Style(**options)) for name, options in PATHS]
     if share:
-        paths[SLOWED] = slowed(paths[SLOWED], ctx, share)
+        paths[SLOWED] = slowed(paths[SLOWED], ctx.finish, share)
     measured = measure_together(ctx, mesh, [Together(p) for p in paths], size=(size, size),
                                 repeats=9, stop=StoppingRule(0.02, 9, 41))
     run = run_record(machine, f"compare_detection share={share}", size="bench")

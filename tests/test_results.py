@@ -19,6 +19,7 @@ from workbench.experiment.run_compare import compare_runs, measurement_key, sele
 from workbench.experiment.stats import StoppingRule
 from workbench.experiment.store import ResultsStore
 from workbench.paths import make_path
+from workbench.reliability.faults import slowed
 from workbench.scene import generators
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -27,29 +28,12 @@ PATHS = ("position", "flat", "gouraud")
 SLOWED: dict[str, float] = {}  # path name -> added share of its own draw time
 
 
-def slowed(path, ctx, share: float):
-    """``path`` whose draw takes ``1 + share`` times as long: after drawing and waiting for
-    the draw, it spins for ``share`` of the time that took."""
-    draw = path.draw
-
-    def slow_draw():
-        start = time.perf_counter()
-        draw()
-        ctx.finish()
-        end = time.perf_counter() + share * (time.perf_counter() - start)
-        while time.perf_counter() < end:
-            pass
-
-    path.draw = slow_draw
-    return path
-
-
 def probe(exp: ExperimentContext) -> list[dict]:
     """Three paths on the semicylinders measured together, one of them slowed by ``SLOWED``;
     a second table."""
     mesh = generators.semicylinders(n=64)
     paths = [make_path(name) for name in PATHS]
-    paths = [slowed(p, exp.gl, SLOWED[p.name]) if p.name in SLOWED else p for p in paths]
+    paths = [slowed(p, exp.gl.finish, SLOWED[p.name]) if p.name in SLOWED else p for p in paths]
     measured = measure_together(exp.gl, mesh, [Together(p) for p in paths], size=(400, 400),
                                 repeats=9, stop=StoppingRule(0.03, min_samples=9,
                                                              max_samples=21))
@@ -277,3 +261,18 @@ def test_workbench_run_records_into_the_chosen_store(probe_experiment, tmp_path)
     assert {(r["experiment"], r["experiment_size"], r["table"]) for r in rows} == {
         (NAME, "quick", "table"), (NAME, "quick", "extra")}
     assert not (tmp_path / "fig" / "results").exists()
+
+
+def test_a_slowed_draw_takes_its_share_longer_and_a_negative_share_is_refused():
+    class Busy:
+        def draw(self):
+            end = time.perf_counter() + 0.004
+            while time.perf_counter() < end:
+                pass
+
+    path = slowed(Busy(), lambda: None, 1.0)
+    start = time.perf_counter()
+    path.draw()
+    assert time.perf_counter() - start >= 0.008  # the 4 ms draw, then as long again
+    with pytest.raises(ValueError, match="share"):
+        slowed(Busy(), lambda: None, -0.1)

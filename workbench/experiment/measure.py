@@ -25,7 +25,7 @@ from ..paths.base import RenderPath
 from ..paths.registry import DEFAULT_PATHS, path_class
 from ..paths.style import style_summary
 from ..scene.needs import Derivation, derive, derived_items, needed_items
-from .timing import MIN_REPEATS, TIMING_COLUMNS, Timing, time_draw
+from .timing import MIN_REPEATS, TIMING_COLUMNS, Timing, time_draw, time_readback, timed_draw
 
 if TYPE_CHECKING:
     import moderngl
@@ -247,29 +247,15 @@ def measure_together(backend: moderngl.Context | Backend, scene: Scene,
             rounds += 1
             for i, (r, timer) in enumerate(zip(ready, timers)):
                 r.bind()
-                r.target.clear(background)
-                backend.finish()
-                start = time.perf_counter()
-                if timer is None:
-                    r.path.draw()
-                else:
-                    with timer:
-                        r.path.draw()
-                backend.finish()
-                elapsed = (time.perf_counter() - start) * 1e3
+                wall_ms, gpu_ms = timed_draw(backend, r.target, r.path.draw, timer, background)
                 if rounds > warmup:
-                    wall[i].append(elapsed)
-                    if timer is not None:
-                        gpu[i].append(timer.elapsed_ms)
+                    wall[i].append(wall_ms)
+                    gpu[i].append(gpu_ms)
         out = []
         for i, (r, spec) in enumerate(zip(ready, paths)):
             r.bind()
             image = r.target.read()
-            readback = []
-            for _ in range(len(wall[i])):
-                start = time.perf_counter()
-                r.target.read()
-                readback.append((time.perf_counter() - start) * 1e3)
+            readback = time_readback(r.target, len(wall[i]))
             timing = Timing.from_samples(wall[i], gpu[i] if timers[i] is not None else None,
                                          readback)
             probed = spec.probe(r.path) if spec.probe is not None else {}

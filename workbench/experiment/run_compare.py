@@ -31,7 +31,6 @@ than the threshold with 95 % confidence, not merely different from nothing. Erro
 
 from __future__ import annotations
 
-import math
 import re
 import statistics
 from collections import Counter, defaultdict
@@ -39,6 +38,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from .stats import CONFIDENCE, ratio_of_medians_interval
+from .tables import finite_number
 
 if TYPE_CHECKING:
     from .store import ResultsStore
@@ -104,12 +104,6 @@ def _keyed(rows: list[dict[str, Any]]) -> dict[tuple, dict[str, Any]]:
     return keyed
 
 
-def _number(value: Any) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return None
-    return float(value) if math.isfinite(value) else None
-
-
 def _quantities(a: dict[str, Any], b: dict[str, Any], resamples: int,
                 confidence: float) -> list[dict[str, Any]]:
     """(quantity, A, B, ratio, lo, hi) of every time with samples or value with an interval
@@ -118,7 +112,7 @@ def _quantities(a: dict[str, Any], b: dict[str, Any], resamples: int,
     for column in a:
         # wall_ms's samples are wall_samples_ms (gpu_ms: gpu_samples_ms)
         samples = f"{column[:-3]}_samples_ms" if column.endswith("_ms") else None
-        a_value, b_value = _number(a.get(column)), _number(b.get(column))
+        a_value, b_value = finite_number(a.get(column)), finite_number(b.get(column))
         if a_value is None or b_value is None or a_value <= 0 or b_value <= 0:
             continue
         if samples and a.get(samples) and b.get(samples):
@@ -127,7 +121,7 @@ def _quantities(a: dict[str, Any], b: dict[str, Any], resamples: int,
             found.append(dict(quantity=column, a=a_value, b=b_value, ratio=i.estimate,
                               ratio_lo=i.lo, ratio_hi=i.hi, timed=True))
             continue
-        bounds = [_number(r.get(f"{column}_{end}")) for r in (a, b) for end in ("lo", "hi")]
+        bounds = [finite_number(r.get(f"{column}_{end}")) for r in (a, b) for end in ("lo", "hi")]
         if all(v is not None and v > 0 for v in bounds):
             a_lo, a_hi, b_lo, b_hi = bounds
             found.append(dict(quantity=column, a=a_value, b=b_value, ratio=b_value / a_value,

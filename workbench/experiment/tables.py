@@ -129,6 +129,14 @@ def format_value(value: object) -> str:
     return str(value).replace("|", "\\|").replace("\n", " ")
 
 
+def finite_number(value: Any) -> float | None:
+    """``value`` as a float where it is a finite int or float (not a bool), else None."""
+    value = _plain(value)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    return float(value) if math.isfinite(value) else None
+
+
 def _is_number(value) -> bool:
     value = _plain(value)
     return isinstance(value, Real) and not isinstance(value, bool)

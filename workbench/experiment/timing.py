@@ -154,27 +154,42 @@ def time_draw(backend: moderngl.Context | Backend, fb: Framebuffer | SoftwareTar
     i = 0
     while i < warmup + repeat or (stop is not None and not stop.done(wall)):
         i += 1
-        fb.clear(background)
-        backend.finish()
-        start = time.perf_counter()
-        if timer is None:
-            draw()
-        else:
-            with timer:
-                draw()
-        backend.finish()
-        elapsed = (time.perf_counter() - start) * 1e3
+        wall_ms, gpu_ms = timed_draw(backend, fb, draw, timer, background)
         if i > warmup:
-            wall.append(elapsed)
-            if timer is not None:
-                gpu.append(timer.elapsed_ms)
+            wall.append(wall_ms)
+            gpu.append(gpu_ms)
     fb.read()
-    readback = []
-    for _ in range(readback_repeat):
+    return Timing.from_samples(wall, gpu if timer is not None else None,
+                               time_readback(fb, readback_repeat))
+
+
+def timed_draw(backend: Backend, fb: Framebuffer | SoftwareTarget, draw: Callable[[], Any],
+               timer: Any, background: tuple[float, float, float, float]
+               ) -> tuple[float, float | None]:
+    """One timed draw, as :func:`time_draw` times each: ``fb`` cleared to ``background`` and
+    waited for outside the clock, then the wall ms of ``draw()`` and the backend's ``finish``,
+    inside ``timer`` (the backend's GPU timer, or None) whose ms come second (None without)."""
+    fb.clear(background)
+    backend.finish()
+    start = time.perf_counter()
+    if timer is None:
+        draw()
+    else:
+        with timer:
+            draw()
+    backend.finish()
+    wall_ms = (time.perf_counter() - start) * 1e3
+    return wall_ms, None if timer is None else timer.elapsed_ms
+
+
+def time_readback(fb: Framebuffer | SoftwareTarget, repeat: int) -> list[float]:
+    """Wall ms of ``repeat`` reads of ``fb``'s finished image."""
+    times = []
+    for _ in range(repeat):
         start = time.perf_counter()
         fb.read()
-        readback.append((time.perf_counter() - start) * 1e3)
-    return Timing.from_samples(wall, gpu if timer is not None else None, readback)
+        times.append((time.perf_counter() - start) * 1e3)
+    return times
 
 
 def time_call(fn: Callable[[], Any], warmup: int = 1, repeat: int = 5,

@@ -25,6 +25,7 @@ import moderngl
 
 from ..algo.softraster import RasterOptions
 from ..gl import Framebuffer, GpuTimer, renderer
+from ..gl.context import timer_queries_meaningful
 from .base import RenderPath
 from .registry import make_path
 from .software import SoftwarePath, SoftwareTarget
@@ -78,8 +79,9 @@ class GLBackend:
 
     def gpu_timer(self) -> GpuTimer | None:
         """A GPU time query, or None on a software renderer (its queries time nothing)."""
-        timer = GpuTimer(self.ctx)  # moderngl 5.13 queries have no release(); it is collected
-        return timer if timer.meaningful else None
+        if not timer_queries_meaningful(self.ctx):
+            return None
+        return GpuTimer(self.ctx)  # moderngl 5.13 queries have no release(); it is collected
 
 
 @dataclass

@@ -9,7 +9,9 @@ render paths far from the origin, drawn many times and in other processes.
 * :mod:`~workbench.reliability.d3plot` — damaged copies of the shared d3plot
   (:func:`run_d3plot_stress`);
 * :mod:`~workbench.reliability.render` — far offsets, the soak and determinism
-  (:func:`run_render_stress`).
+  (:func:`run_render_stress`);
+* :mod:`~workbench.reliability.faults` — faults injected to show that a check can fail (a
+  path slowed by a known share).
 
 ``workbench stress readers|render|all`` runs them (:mod:`workbench.cli.stress`).
 """

@@ -7,6 +7,8 @@ import itertools
 import math
 from pathlib import Path
 
+from ..experiment.tables import finite_number
+
 
 def pareto_front(points: list[tuple[float, float]]) -> list[int]:
     """Indices of the non-dominated (time, error) pairs, both minimised, by increasing time:
@@ -34,12 +36,6 @@ def _axis_label(column: str, reference: str | None) -> str:
     }.get(column, column)
 
 
-def _number(value) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return None
-    return float(value) if math.isfinite(value) else None
-
-
 def save_pareto(path: Path, rows: list[dict], *, time_column: str, metric: str | None,
                 title: str, reference: str | None = None) -> Path:
     """Time against error, one colour per path (and one marker per simplifier), the Pareto
@@ -56,7 +52,7 @@ def save_pareto(path: Path, rows: list[dict], *, time_column: str, metric: str |
     fig = Figure(figsize=(8, 5.5), dpi=100)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
-    data = [(r, _number(r.get(time_column)), _number(r.get(metric)) if metric else None)
+    data = [(r, finite_number(r.get(time_column)), finite_number(r.get(metric)) if metric else None)
             for r in rows if not r.get("error")]
     data = [(r, x, y) for r, x, y in data if x is not None and x > 0 and y is not None]
     if not data:
