@@ -221,10 +221,10 @@ def test_cli_writes_gif(ctx, mesh, tmp_path, capsys):
     with Image.open(out) as gif:
         assert gif.n_frames == 12 and gif.size == (96, 80)
     lines = capsys.readouterr().out.strip().splitlines()
-    assert lines[-1].startswith("revealed ") and "after 12 frames, offset " in lines[-1]
+    assert lines[-1].startswith("revealed at frame ") and " of 12: " in lines[-1]
     assert lines[-1].endswith("of o_max 3.46")
-    revealed = float(lines[-1].split()[1])
-    assert 0.8 <= revealed <= 1.0
+    visible, _, total = lines[-1].split("(")[1].split(")")[0].split()
+    assert 0.8 <= int(visible) / int(total) <= 1.0
     strip = tmp_path / "strip.png"
     assert main(["explode", str(deck), "--focus", "7", "--frames", "3", "--size", "40x30",
                  "-o", str(strip)]) == 0

@@ -4,17 +4,19 @@
 Each frame is drawn, counting the focus part's visible pixels as it is drawn; the occlusion
 ratio r then advances the offset of the two halves
 (:meth:`~workbench.paths.exploded.ExplodedPath.step_animation`, s_u = 1, speed ∝ r^p with
-``--ratio-exponent p``). r and the offset are printed per frame, the frames are written as an
-animated GIF or as a strip PNG (frames side by side), and the last line says how much of the
-focus is visible at the end: ``revealed R after F frames, offset O of o_max M``
-(R = p_occ/p_unocc, 0 to 1).
+``--ratio-exponent p``). r, the focus's visible and unoccluded pixel counts and the offset are
+printed per frame, the frames are written as an animated GIF or as a strip PNG (frames side by
+side), and the last line names the first frame K of N whose r is at or below the path's
+``revealed_below`` (0: every pixel of the focus visible): ``revealed at frame K of N: S % of
+its pixels visible (P_OCC of P_UNOCC), offset O of o_max M``, or ``not revealed within N frames:
+S % of its pixels visible (…) in the last frame, …`` (S = 100·p_occ/p_unocc; offsets in model
+units). A focus part with no pixels in the view (smaller than a pixel, edge-on) is refused.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 import numpy as np
 
@@ -52,10 +54,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def _progress(frames: int):
-    """(tqdm bar over the frame numbers, its write-a-line function), on stderr."""
+    """(tqdm bar over the frame numbers, its write-a-line function), on stderr. The bar shows
+    from the second frame on, so that a run refused at its first frame (a focus without pixels)
+    leaves only the one line of the refusal on stderr."""
     from tqdm import tqdm
 
-    bar = tqdm(range(frames), desc="explode", unit="frame", file=sys.stderr)
+    bar = tqdm(range(frames), desc="explode", unit="frame", file=sys.stderr, delay=1e-3)
     return bar, bar.write
 
 
@@ -76,11 +80,12 @@ def cmd_explode(args) -> int:
     from ..experiment.exploded import explode_animation
     from ..experiment.figures import save_animation
     from ..experiment.measure import default_camera
+    from ..experiment.targets import output_target
     from ..gl import create_context
     from ..paths import make_path
     from ..paths.exploded import exploded_camera
 
-    out = Path(args.output)
+    out = output_target(args.output)
     if out.suffix.lower() not in FORMATS:
         raise ValueError(f"output {out} must end in .gif (animation) or .png (strip)")
     if args.frames < 1:
@@ -93,7 +98,9 @@ def cmd_explode(args) -> int:
     steps, write = _progress(args.frames)
 
     def report(i: int, offset: float, r: float, path) -> None:
-        write(f"frame {i + 1:>3}/{args.frames}: offset {offset:.4g}, r {r:.3f} -> "
+        counts = path.last_occlusion
+        write(f"frame {i + 1:>3}/{args.frames}: offset {offset:.4g}, r {r:.3f} "
+              f"({counts['p_occ']} of {counts['p_unocc']} px visible) -> "
               f"offset {path.offset:.4g}, alpha {path.alpha:.3f}")
 
     try:
@@ -104,6 +111,20 @@ def cmd_explode(args) -> int:
     out.parent.mkdir(parents=True, exist_ok=True)
     save_animation(out, run.frames)
     print(f"{out}: {len(run.frames)} frames of {scene.name}, focus part {args.focus}")
-    print(f"revealed {run.revealed:.3g} after {len(run.frames)} frames, offset {run.offset:.3g} of "
-          f"o_max {run.o_max:.3g}")
+    print(_reveal_line(run))
     return 0
+
+
+def _reveal_line(run) -> str:
+    """The last line: the first frame that revealed the focus, or that none did and how much
+    of it the last frame shows, with the pixel counts and the offset of that frame."""
+    frame = run.revealed_frame
+    k = (frame or len(run.frames)) - 1
+    share = (f"{100.0 * min(1.0, run.p_occ[k] / run.p_unocc[k]):.3g} % of its pixels visible "
+             f"({run.p_occ[k]} of {run.p_unocc[k]})")
+    where = f"offset {run.offsets[k]:.3g} of o_max {run.o_max:.3g}"
+    n = len(run.frames)
+    if frame is None:
+        return (f"not revealed within {n} frame{'s' * (n != 1)}: {share} in the last frame, "
+                f"{where}")
+    return f"revealed at frame {frame} of {n}: {share}, {where}"

@@ -136,9 +136,11 @@ def _render_options(args, kind: str) -> dict:
 
 
 def _check_output_and_cluster(args) -> None:
-    """Refuse (ValueError) an output that is not a PNG file name, and Dask options without
-    ``--domains``."""
-    if Path(args.output).suffix.lower() != ".png":
+    """Refuse (ValueError) an output that exists and is not a regular file, one that is not a
+    PNG file name, and Dask options without ``--domains``."""
+    from ..experiment.targets import output_target
+
+    if output_target(args.output).suffix.lower() != ".png":
         raise ValueError(f"-o {args.output}: render writes a PNG image; give a file name "
                          f"ending in .png")
     if args.domains is None:
@@ -185,6 +187,72 @@ def _write_image(out: Path, image, path, field: str | None, args, title: str) ->
         save_png(out, image)
 
 
+# the widest model drawn (model units): beyond it the float32 coordinates relative to its
+# centre and the matrices that scale them near float32's limit, 3.4e38 (1e38 draws nothing)
+FLOAT32_EXTENT = 0.1 * 3.4028235e38
+
+
+def _extent_of(mesh, step: int) -> tuple[float, str]:
+    """(extent, words): the largest side of the box of ``mesh``'s referenced nodes at ``step``
+    (model units), and words naming it with the node farthest from the nodes' median (the
+    stray node that makes the box that wide)."""
+    import numpy as np
+
+    nodes = mesh.coordinates(step)
+    used = mesh.used_nodes()
+    points = nodes[used]
+    extent = float(np.max(points.max(axis=0) - points.min(axis=0)))
+    distance = np.linalg.norm(points - np.median(points, axis=0), axis=1)
+    far = int(used[np.argmax(distance)])
+    label = (f"node {int(mesh.node_ids[far])}" if mesh.node_ids is not None
+             else f"node index {far}")
+    x, y, z = nodes[far]
+    return extent, (f"its extent of {extent:.3g} {mesh.units} ({label} at ({x:.3g}, {y:.3g}, "
+                    f"{z:.3g}) lies {distance.max():.3g} {mesh.units} from the median node)")
+
+
+def _check_extent(scene, step: int) -> None:
+    """Refuse (ValueError) an FE mesh wider than :data:`FLOAT32_EXTENT`: its coordinates
+    relative to its centre, and the matrices that scale them, overflow float32 and draw
+    nothing."""
+    if scene.kind != "mesh":
+        return
+    extent, words = _extent_of(scene, step)
+    if extent > FLOAT32_EXTENT:
+        raise ValueError(f"{scene.name}: {words} is beyond what float32 coordinates relative "
+                         f"to its centre can draw (at most {FLOAT32_EXTENT:.3g})")
+
+
+def _check_drawn(image, scene, camera, size: tuple[int, int], step: int) -> None:
+    """Refuse (ValueError, one line) an image in which no pixel differs from the white
+    background: nothing of the scene was drawn, so no image is written. For an FE mesh whose
+    elements all project thinner than a pixel the line says so, with the model's extent and
+    its farthest node: the camera is fitted to the box of every referenced node, so one node
+    far out (1e20 mm among millimetre-sized elements) makes the view that wide."""
+    import numpy as np
+
+    from ..experiment.compare import coverage
+    from ..experiment.measure import WHITE
+
+    if coverage(image, WHITE).any():
+        return
+    why = ""
+    if scene.kind == "mesh":
+        win = camera.project(scene.coordinates(step), size)[:, :2]
+        tri = scene.triangles
+        a, b, c = win[tri[:, 0]], win[tri[:, 1]], win[tri[:, 2]]
+        ab, ac, bc = b - a, c - a, c - b
+        area2 = np.abs(ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0])
+        longest = np.max([np.hypot(*e.T) for e in (ab, ac, bc)], axis=0)
+        # each triangle's width across its longest edge, in pixels
+        widths = np.divide(area2, longest, out=np.zeros_like(area2), where=longest > 0)
+        if widths.max() < 1.0:
+            why = (f"; every element is thinner than a pixel (the widest {widths.max():.2g} "
+                   f"px) in the view fitted to {_extent_of(scene, step)[1]}")
+    raise ValueError(f"the {size[0]}x{size[1]} image shows nothing of {scene.name}: no pixel "
+                     f"differs from the background{why}")
+
+
 def cmd_render(args) -> int:
     """Draw the scene, write ``--output``, print what was drawn; 0."""
     from ..experiment.measure import measure
@@ -204,10 +272,12 @@ def cmd_render(args) -> int:
     size = args.size
     camera = path.default_camera(scene, size, view=args.view, projection=args.projection,
                                  up=args.up, style=path.style)
+    _check_extent(scene, args.step)
     if args.domains is not None:
         return _render_sortlast(args, scene, path, camera, size)
     result = measure(backend, scene, path, camera=camera, size=size, samples=args.samples,
                      timed=False)
+    _check_drawn(result.image, scene, camera, size, args.step)
     out = Path(args.output)
     field = args.field if args.field is not None else getattr(path.style, "field", None)
     _write_image(out, result.image, path, field if is_mesh else None, args,
@@ -237,6 +307,7 @@ def _render_sortlast(args, mesh, path, camera, size) -> int:
     with sweep_cluster(args.workers, args.scheduler, gl=False) as cluster:
         frame, stats = render_sortlast(cluster.client, render_domain, domains,
                                        method=args.composite)
+    _check_drawn(frame.color, mesh, camera, size, args.step)
     out = Path(args.output)
     path.prepare(None, mesh, camera)  # the colour scale of the bar
     _write_image(out, frame.color, path, args.field, args,

@@ -174,8 +174,10 @@ def cmd_pareto(args) -> int:
 def cmd_report(args) -> int:
     """``workbench results report``: rewrite the README's claims and docs/results.md; 0."""
     from ..experiment.report import write_report
+    from ..experiment.targets import output_target
 
-    written = write_report(store_of(args), Path(args.readme), Path(args.doc))
+    # refused before the README is read: reading a FIFO would block
+    written = write_report(store_of(args), *map(output_target, (args.readme, args.doc)))
     for path in written:
         print(f"wrote {path}", file=sys.stderr)
     return 0

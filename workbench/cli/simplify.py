@@ -21,8 +21,11 @@ def cmd_simplify(args) -> int:
     """Print the triangle counts, time, tolerance and collapses, and write ``--output``; 0."""
     from ..algo.simplify import hausdorff_decimate
     from ..experiment.export import write_surface
+    from ..experiment.targets import output_target
     from ..scene.builtin import load_mesh
 
+    if args.output:
+        output_target(args.output)  # refused before the decimation, not after it
     mesh = load_mesh(args.mesh)
     tri = mesh.triangulation
     d = hausdorff_decimate(mesh.nodes, tri.triangles, args.tol / 100.0, relative=True,

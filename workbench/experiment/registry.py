@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 from .context import SIZES, ExperimentContext
 from .store import process_alive
 from .tables import current_umask, write_table
+from .targets import output_folder
 from .timing import empty_gpu_note
 
 if TYPE_CHECKING:
@@ -121,6 +122,8 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     folder is in place. What killed runs left behind (staging folders, a previous output
     folder set aside, temporary files) is cleaned up first. Returns ``(rows, out_dir)``.
     Unknown names raise KeyError listing the known ones; rows that are not dicts raise TypeError.
+    An output folder that is a symbolic link (wherever it points) or not a folder is refused
+    (ValueError) before the experiment runs, and again just before the swap.
     """
     exp = get_experiment(name)
     size = size if size is not None else ("quick" if quick else "full")
@@ -130,6 +133,7 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     root.mkdir(parents=True, exist_ok=True)
     out_dir = root / exp.name
     clean_dead_runs(root, exp.name)
+    output_folder(out_dir)
     staging = Path(tempfile.mkdtemp(dir=root, prefix=f".{exp.name}.",
                                     suffix=f".{os.getpid()}.partial"))
     os.chmod(staging, 0o777 & ~current_umask())  # mkdtemp makes 0700; the output folder is public
@@ -160,8 +164,9 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
 def _swap_in(staging: Path, out_dir: Path) -> None:
     """Put ``staging`` in the place of ``out_dir``: the previous folder is set aside as
     ``.<name>.<pid>.old`` first and removed last (a kill in between leaves it for
-    :func:`clean_dead_runs` to put back)."""
-    if not out_dir.exists():
+    :func:`clean_dead_runs` to put back). Refuses (ValueError) an ``out_dir`` that has become
+    a symbolic link or something other than a folder."""
+    if not os.path.lexists(output_folder(out_dir)):
         os.replace(staging, out_dir)
         return
     old = out_dir.with_name(f".{out_dir.name}.{os.getpid()}.old")
@@ -184,12 +189,12 @@ def clean_dead_runs(root: Path, name: str) -> list[Path]:
             continue
         if process_alive(int(parts[1])) and int(parts[1]) != os.getpid():
             continue
-        if parts[2] == "old" and not out_dir.exists():
+        if parts[2] == "old" and not os.path.lexists(out_dir):
             os.replace(entry, out_dir)
         else:
             shutil.rmtree(entry, ignore_errors=True)
         done.append(entry)
-    if out_dir.is_dir():
+    if out_dir.is_dir() and not out_dir.is_symlink():  # never remove files through a link
         for tmp in out_dir.glob(".*.tmp"):
             tmp.unlink(missing_ok=True)
             done.append(tmp)

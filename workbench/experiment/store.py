@@ -9,7 +9,10 @@ Layout under the root (one file per write, so concurrent writers never touch the
 Every file is written to a hidden temporary file in its folder (``.<name>.<pid>@<host>.<hex>.tmp``),
 flushed, fsync'd and then moved into place (``os.replace``; ``os.link`` where an existing file
 must win). Readers only list ``*.parquet`` names not starting with ``.``, so a writer killed
-mid-write leaves at most a hidden temporary file, which ``ResultsStore.clean`` removes.
+mid-write leaves at most a hidden temporary file, which ``ResultsStore.clean`` removes. A file
+to be written that exists and is not a regular file, and a folder under the root that is a
+symbolic link or not a folder, are refused (ValueError) before anything is written
+(:mod:`workbench.experiment.targets`); the root itself may be a link to the store's folder.
 
 Types. Within one ``append_rows`` call each column is normalised: numpy scalars become Python
 values; all-bool → BOOLEAN; all-int → BIGINT; ints and floats → DOUBLE (NaN and ±inf kept);
@@ -42,6 +45,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from .targets import output_folder, output_target
 
 if TYPE_CHECKING:
     import duckdb
@@ -156,12 +161,17 @@ def _fsync_dir(folder: Path) -> None:
         pass  # not every file system syncs folders; the file itself is synced
 
 
-def _write(table: pa.Table, path: Path, exclusive: bool = False) -> bool:
-    """Write ``table`` to ``path`` atomically; returns False (writing nothing) where
-    ``exclusive`` and ``path`` already exists."""
+def _write(table: pa.Table, path: Path, root: Path, exclusive: bool = False) -> bool:
+    """Write ``table`` to ``path`` (a file under the store's ``root``) atomically; returns
+    False (writing nothing) where ``exclusive`` and ``path`` already exists. The folders
+    between ``root`` and ``path`` are made as needed; one that is a symbolic link or not a
+    folder is refused (ValueError), as is a ``path`` that exists and is not a regular file."""
     import pyarrow.parquet as pq
 
-    path.parent.mkdir(parents=True, exist_ok=True)
+    root.mkdir(parents=True, exist_ok=True)
+    for folder in reversed(path.relative_to(root).parents[:-1]):
+        output_folder(root / folder, create=True)
+    output_target(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}@{_HOST}.{secrets.token_hex(4)}.tmp")
     try:
         with open(tmp, "xb") as handle:
@@ -172,13 +182,14 @@ def _write(table: pa.Table, path: Path, exclusive: bool = False) -> bool:
             try:
                 os.link(tmp, path)  # fails if path exists: the first writer wins
             except FileExistsError:
+                output_target(path)
                 return False
             except OSError:  # no hard links on this file system: check, then move
-                if path.exists():
+                if os.path.lexists(output_target(path)):
                     return False
                 os.replace(tmp, path)
         else:
-            os.replace(tmp, path)
+            os.replace(tmp, output_target(path))
     finally:
         try:
             os.unlink(tmp)
@@ -233,8 +244,8 @@ class ResultsStore:
             raise TypeError(f"machine must be a dict, got {type(machine).__name__}")
         machine_id = _check_id(machine.get("machine_id"), "machine_id")
         path = self.root / "machines" / f"{machine_id}.parquet"
-        if not path.exists():
-            _write(_table([machine], {}), path, exclusive=True)
+        if not output_target(path).exists():
+            _write(_table([machine], {}), path, self.root, exclusive=True)
 
     def record_run(self, run: dict) -> None:
         """Record one run as ``runs/<run_id>.parquet``; returns None.
@@ -247,7 +258,8 @@ class ResultsStore:
         run_id = _check_id(run.get("run_id"), "run_id")
         _check_id(run.get("machine_id"), "machine_id")
         path = self.root / "runs" / f"{run_id}.parquet"
-        if path.exists() or not _write(_table([run], {}), path, exclusive=True):
+        if (output_target(path).exists()
+                or not _write(_table([run], {}), path, self.root, exclusive=True)):
             raise ValueError(f"run {run_id!r} is recorded already in {self.root}")
 
     def append_rows(self, run_id: str, rows: Sequence[dict], **common: Any) -> Path | None:
@@ -265,7 +277,7 @@ class ResultsStore:
             return None
         table = _table(rows, {"run_id": run_id, **common}, index=True)
         path = self.root / "rows" / f"run_id={run_id}" / f"{uuid.uuid4().hex}.parquet"
-        _write(table, path)
+        _write(table, path, self.root)
         return path
 
     # reading -------------------------------------------------------------------------------

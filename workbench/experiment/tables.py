@@ -3,6 +3,8 @@
 A row is a plain dict; a table's columns are the union of its rows' keys in first-seen order.
 Every file is written to a temporary file in the target folder and moved into place with
 ``os.replace``, so an interrupted run leaves the previous table (or none), never half of one.
+A target that exists and is not a regular file (a device, FIFO, socket, directory or symbolic
+link) is refused before anything is written (:func:`~workbench.experiment.targets.output_target`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,8 @@ from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
+
+from .targets import output_target
 
 SIGNIFICANT_DIGITS = 4
 
@@ -35,11 +39,14 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w",
     """Open a temporary file beside ``path`` for writing; move it onto ``path`` on success.
 
     On an exception the temporary file is removed and ``path`` is left as it was.
-    ``mode`` must be ``"w"`` or ``"wb"``; extra arguments go to ``open``.
+    ``mode`` must be ``"w"`` or ``"wb"``; extra arguments go to ``open``. An existing ``path``
+    that is not a regular file (device, FIFO, socket, directory, symbolic link) is refused with
+    a ValueError, before the temporary file is made and again just before it would replace
+    ``path``.
     """
     if mode not in ("w", "wb"):
         raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
-    path = Path(path)
+    path = output_target(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     os.chmod(tmp, 0o666 & ~current_umask())  # mkstemp makes 0600; a table is readable as any
     try:
@@ -47,7 +54,7 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w",
             yield handle
             handle.flush()
             os.fsync(handle.fileno())
-        os.replace(tmp, path)
+        os.replace(tmp, output_target(path))
     except BaseException:
         try:
             os.unlink(tmp)
@@ -187,7 +194,8 @@ def write_table(rows: Sequence[dict[str, Any]], directory: str | os.PathLike[str
     the Markdown title. Floats are written to the CSV at full precision and to Markdown with four
     significant digits. Both files are replaced atomically; the Markdown is formatted before
     either is touched, so a row that cannot be formatted leaves the previous table in place.
-    Refuses rows that are not dicts and a missing directory.
+    Refuses rows that are not dicts, a missing directory and (before writing either file) a
+    ``.csv`` or ``.md`` target that exists and is not a regular file.
     """
     rows = _check_rows(rows)
     directory = Path(directory)
@@ -195,7 +203,8 @@ def write_table(rows: Sequence[dict[str, Any]], directory: str | os.PathLike[str
         raise FileNotFoundError(f"table directory {directory} does not exist")
     columns = list(table_columns(rows) if columns is None else columns)
     md_text = markdown_table(rows, columns, title, notes)
-    csv_path, md_path = directory / f"{name}.csv", directory / f"{name}.md"
+    csv_path = output_target(directory / f"{name}.csv")
+    md_path = output_target(directory / f"{name}.md")
     with atomic_open(csv_path, "w", encoding="utf-8", newline="") as handle:
         writer = csv.writer(handle)
         if columns:

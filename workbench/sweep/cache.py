@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from ..experiment.tables import atomic_write_text
+from ..experiment.targets import output_folder
 from .points import Point
 
 
@@ -37,5 +38,5 @@ def store_row(points_dir: Path, key: str, point: Point, row: dict) -> dict:
     values, so computed and cached rows read the same)."""
     text = json.dumps(dict(key=key, params=point.params(), row=row), default=json_default,
                       indent=1)
-    atomic_write_text(points_dir / f"{key}.json", text)
+    atomic_write_text(output_folder(points_dir) / f"{key}.json", text)
     return json.loads(text)["row"]

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 import re
 import tomllib
 from dataclasses import dataclass
@@ -84,6 +85,19 @@ def _check_scene(spec) -> str:
                      f"with ':N' for the sized ones) nor an existing file")
 
 
+def _check_view(value) -> tuple[float, float]:
+    """(azimuth, elevation) in degrees from a two-number list; ValueError for anything else:
+    another length, a non-number (true/false included), NaN or an infinity (a camera turned by
+    NaN degrees draws nothing)."""
+    if (not isinstance(value, (tuple, list)) or len(value) != 2
+            or not all(isinstance(a, (int, float)) and not isinstance(a, bool) for a in value)):
+        raise ValueError(f"view must be [azimuth, elevation] in degrees, got {value!r}")
+    if not all(math.isfinite(a) for a in value):
+        raise ValueError(f"view angles must be finite numbers of degrees, got "
+                         f"[{value[0]!r}, {value[1]!r}]")
+    return float(value[0]), float(value[1])
+
+
 def _check_sweep_values(key: str, values: list) -> list:
     """The values of a sweep-level or simplification key, checked and normalised."""
     from ..paths import PATHS
@@ -101,9 +115,7 @@ def _check_sweep_values(key: str, values: list) -> list:
             if isinstance(v, bool) or not isinstance(v, int) or v < 0:
                 raise ValueError(f"samples must be a non-negative integer, got {v!r}")
         elif key == "view":
-            if len(v) != 2 or not all(isinstance(a, (int, float)) for a in v):
-                raise ValueError(f"view must be [azimuth, elevation] in degrees, got {v!r}")
-            v = (float(v[0]), float(v[1]))
+            v = _check_view(v)
         elif key == "rasterizer":
             if v not in RASTERIZERS:
                 raise ValueError(f"rasterizer must be one of {', '.join(RASTERIZERS)}, got {v!r}")
@@ -142,6 +154,7 @@ def load_config(path) -> SweepConfig:
 
     Refused with ValueError naming the file and the key: TOML errors, unknown top-level keys,
     a grid without ``scene`` or ``path``, an empty list, an unknown path, scene or simplifier,
+    a ``view`` that is not two finite angles (NaN and infinities included),
     a grid key that none of the grid's paths takes, option values a path's style refuses,
     ``repeats`` < 5, a ``metric`` the sweep cannot give; OSError for a missing file.
     """

@@ -197,7 +197,8 @@ def measured_columns(point: Point, ctx) -> dict:
     ``scene_name``; ``lock_wait_ms`` is how long the timed draw waited for the host's draw
     lock), the simplification columns, and the image differences (:meth:`ImageDiff.as_row`: max and
     mean absolute difference in 1/255, share of pixels differing, PSNR in dB, SSIM) against the
-    reference image."""
+    reference image. ValueError when the image shows nothing of the scene (no pixel differs
+    from the background)."""
     from ..experiment.cluster import draw_lock
     from ..experiment.compare import compare_images
     from ..experiment.measure import measure
@@ -229,6 +230,11 @@ def measured_columns(point: Point, ctx) -> dict:
             measured = measure(backend, scene, path, repeats=point.repeats, **kwargs)
     else:
         measured = measure(backend, scene, path, timed=False, **kwargs)
+    if measured.row["covered_px"] == 0:
+        # a point that draws nothing (a view turned by NaN degrees, a scene outside the view)
+        # has no image to time or compare: counted as failed, not as a result
+        raise ValueError(f"the image shows nothing of the scene: no pixel of the "
+                         f"{point.size[0]}x{point.size[1]} image differs from the background")
     row = {("scene_name" if k == "scene" else k): v for k, v in measured.row.items()
            if k != "path"}
     row.update(columns)

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..experiment.tables import table_columns, write_table
+from ..experiment.targets import output_folder, output_target
 from .cache import cached_row, json_default, store_row
 from .config import SweepConfig, grid_points, load_config
 from .pareto import save_pareto
@@ -73,16 +74,20 @@ def run_sweep(config: SweepConfig | str | Path, out_dir, *, workers: int | None 
     is stored with its ``error`` and counted in ``failed``; the sweep goes on. With a
     ``recorder`` the points computed now (not those from the cache, recorded by their own run)
     are appended to its results store as table ``points`` of experiment ``sweep:<name>``,
-    also when the sweep is interrupted, and the rows carry the recorder's run id.
+    also when the sweep is interrupted, and the rows carry the recorder's run id. An
+    ``out_dir`` or ``out_dir/points`` that is a symbolic link (wherever it points) or not a
+    folder is refused (ValueError) before any point is computed, as is a ``table.csv``,
+    ``table.md`` or ``pareto.png`` there that exists and is not a regular file.
     """
     from ..experiment.cluster import sweep_cluster
 
     if not isinstance(config, SweepConfig):
         config = load_config(config)
     points = grid_points(config, quick=quick, timed=timed)
-    out = Path(out_dir)
-    points_dir = out / "points"
-    points_dir.mkdir(parents=True, exist_ok=True)
+    out = output_folder(out_dir)
+    for name in ("table.csv", "table.md", "pareto.png"):  # refused now, not after the points
+        output_target(out / name)
+    points_dir = output_folder(output_folder(out, create=True) / "points", create=True)
     run_id = recorder.run_id if recorder is not None else uuid.uuid4().hex[:12]
     rows: dict[int, dict] = {}
     skip_ms, computed = [], 0
@@ -162,8 +167,10 @@ def _columns(rows: list[dict]) -> list[str]:
 
 def write_results(config: SweepConfig, rows: list[dict], out: Path, renderer: str, *,
                   timed: bool = True) -> None:
-    """``table.csv``, ``table.md`` and ``pareto.png`` of ``rows`` in ``out``."""
+    """``table.csv``, ``table.md`` and ``pareto.png`` of ``rows`` in ``out`` (refused, as a
+    ValueError, where ``out`` is a symbolic link or not a folder)."""
     title = f"Sweep {config.name} ({renderer})"
+    out = output_folder(out)
     write_table(rows, out, "table", columns=_columns(rows), title=title)
     save_pareto(out / "pareto.png", rows, time_column="wall_ms" if timed else "point_ms",
                 metric=config.metric, title=f"sweep {config.name} on {renderer}",

@@ -26,7 +26,9 @@ rule, evaluated here in exact integer arithmetic per scan line.
   renamed over the final name (``os.replace``), so an interrupted write never leaves a partial
   table under that name. A file that cannot be read, has the wrong shape, dtype or size, or
   fails its CRC-32 is rebuilt and replaced, never trusted. A folder that cannot be written
-  only costs the disk copy (a warning); the table is still returned.
+  only costs the disk copy (a warning); the table is still returned. So does a cache path that
+  exists and is not a regular file (a FIFO, a device, a folder, a symbolic link): it is never
+  replaced, and is read only where a regular file lies behind its links.
 * **Refused** (ValueError): a size that is not an integer in 2..63 (int8 must hold
   ``2S − 1``), and offsets outside ``[−S, S − 1]`` in :func:`table_spans`.
 """
@@ -174,6 +176,8 @@ def _crc(lo: np.ndarray, hi: np.ndarray) -> int:
 def _load(path: Path, size: int) -> tuple[np.ndarray, np.ndarray] | None:
     """The arrays stored at ``path`` if they are a valid size-``size`` table, else None."""
     shape = (2 * size,) * 5
+    if not path.is_file():
+        return None  # opening a FIFO or a device would block or read without end
     try:
         with np.load(path, allow_pickle=False) as z:
             meta = z["meta"]
@@ -196,20 +200,24 @@ def _load(path: Path, size: int) -> tuple[np.ndarray, np.ndarray] | None:
 
 def _save(path: Path, lo: np.ndarray, hi: np.ndarray) -> bool:
     """Write the table atomically (temporary file in the same folder, then ``os.replace``);
-    False with a warning where the folder cannot be written."""
+    False with a warning where the folder cannot be written or ``path`` exists and is not a
+    regular file."""
+    from ...experiment.targets import output_target
+
     meta = np.array([FORMAT_VERSION, lo.shape[0] // 2, _crc(lo, hi)], np.int64)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
+        output_target(path)
         fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
         try:
             with os.fdopen(fd, "wb") as f:
                 np.savez(f, lo=lo, hi=hi, meta=meta)
-            os.replace(tmp, path)
+            os.replace(tmp, output_target(path))
         finally:  # also on KeyboardInterrupt: no temporary file stays behind
             if os.path.exists(tmp):
                 os.unlink(tmp)
         return True
-    except OSError as exc:
+    except (OSError, ValueError) as exc:
         warnings.warn(f"span table not cached at {path}: {exc}", RuntimeWarning, stacklevel=3)
         return False
 
