@@ -12,6 +12,19 @@ from hypothesis import strategies as st
 from workbench.scene.mesh import FEMesh
 from workbench.scene.solids import boundary_surface, solid_faces, solid_kinds
 
+
+@pytest.fixture(autouse=True, scope="module", params=["numpy", "compiled"])
+def kernels(request):
+    """Every test runs on both paths: the numpy steps of small models and the compiled kernels
+    of large ones (forced for every size)."""
+    from workbench.scene import solids
+
+    saved = solids.COMPILED_FROM
+    solids.COMPILED_FROM = 10**12 if request.param == "numpy" else 0
+    yield request.param
+    solids.COMPILED_FROM = saved
+
+
 # LS-DYNA hex corner i as (x, y, z) bits.
 CORNERS = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
 # Kuhn (Freudenthal) split of a cube into 6 tets: a conforming tet mesh on a grid.
