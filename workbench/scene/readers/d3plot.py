@@ -30,8 +30,16 @@ count). Shells of rigid parts carry no stress, strain or thickness in a d3plot; 
 are NaN. Beams, solids and thick shells are not read. Part ids are the user part ids, names
 come from the part titles.
 
-Refused with :class:`~workbench.scene.readers.errors.ParseError`: a file lasso-python cannot
-read, or one without shell or solid elements.
+**Damaged families.** Each member of a family ends with the end-of-file marker (-999999.0)
+right after its last whole state (:func:`family_layout`). Named in a ParseWarning, never
+dropped silently: a member cut or with a damaged end (its whole states before are read), a
+member missing from the numbering, no state at all (``d3plot01`` missing), bytes after a
+marker, announced fields, times, coordinates or ids not read, and the shell (solid) fields of a
+header whose flags do not fit its counts or that gives impossible values (not read). A lost
+last member cannot be told from the end of the run. Refused with ParseError: a file
+lasso-python cannot read, no shell or solid element, a member without data, a header whose
+state size misses a member's marker or whose geometry runs past a complete first file. Every
+message is one line: lasso-python's log and tracebacks are captured and reduced.
 """
 
 from __future__ import annotations
@@ -39,6 +47,7 @@ from __future__ import annotations
 import logging
 import os
 import re
+import warnings as _python_warnings
 from dataclasses import dataclass
 from pathlib import Path
 from warnings import warn as _warn
@@ -46,10 +55,19 @@ from warnings import warn as _warn
 import numpy as np
 
 from ..mesh import FEMesh
+from .d3plot_family import (
+    STRESS_COMPONENTS,
+    Member,
+    _data_end,
+    _drop_damaged_layouts,
+    _expected_fields,
+    _family,
+    _select_states,
+    family_members,
+)
 from .errors import ParseError, ParseWarning, build_mesh
 
 RIGID_MATERIAL_TYPE = 20
-STRESS_COMPONENTS = ("xx", "yy", "zz", "xy", "yz", "zx")  # d3plot (and lasso-python) order
 
 
 def von_mises(stress: np.ndarray) -> np.ndarray:
@@ -108,28 +126,41 @@ def read_d3plot(path: str | os.PathLike[str], units: str = "mm", all_faces: bool
     first one beside it. See the module notes for the fields. ``units`` labels the coordinates.
     Solid elements are drawn by their boundary faces (every face with ``all_faces``), each
     keeping its solid's id and part; the shell fields are NaN on them. ``stress_components``
-    reads the six mid-surface stress components as element fields.
+    reads the six mid-surface stress components as element fields. What could not be read is
+    named in a ParseWarning (module notes); ParseError for a file that cannot be read.
     """
     from lasso.dyna import ArrayType
 
     path = _first_member(Path(path))
-    arrays, warnings = _lasso_arrays(path)
+    plot, warnings = _lasso_read(path)
+    arrays = dict(plot.arrays)
+    members, notes = getattr(plot, "family", None) or _family(path, plot)
+    _select_states(arrays, members, ArrayType)
+    dropped = _drop_damaged_layouts(plot, arrays, ArrayType, stress_components, notes)
     elements = _elements(path, arrays, ArrayType, warnings, all_faces)
     parts, part_names = _parts(path, arrays, ArrayType, warnings, elements.part_index)
-    steps = times = None
-    if ArrayType.node_displacement in arrays and len(arrays[ArrayType.node_displacement]):
-        steps = np.asarray(arrays[ArrayType.node_displacement], dtype=np.float64)
-        times = np.asarray(arrays.get(ArrayType.global_timesteps, np.arange(len(steps))),
-                           dtype=np.float64)
-    n_states = 0 if steps is None else len(steps)
+    n_states = sum(min(m.states, m.read) for m in members)
+    steps, times = _steps_and_times(arrays, ArrayType, elements.nodes, n_states, notes)
     fields = {}
     if n_states:
         fields = _shell_fields(arrays, ArrayType, elements, n_states, stress_components)
         if elements.n_solids:
             _solid_fields(fields, arrays, ArrayType, elements.face_of, elements.n_shells,
                           n_states)
+        lost = [name for name in _expected_fields(plot, stress_components)
+                if name not in fields and name not in dropped]
+        if lost:
+            notes.append(f"fields the header announces were not read: {', '.join(lost)}")
 
     node_ids = arrays.get(ArrayType.node_ids)
+    if warnings.failures:  # a failed section can take the user ids with it: say which
+        lost = [what for what, gone in (
+            ("user part ids (parts are numbered 1, 2, ... in their internal order)",
+             ArrayType.part_ids not in arrays and ArrayType.part_titles_ids not in arrays),
+            ("node ids", node_ids is None), ("element ids", elements.element_ids is None))
+            if gone]
+        if lost:
+            notes.append(f"not read, as a section failed: {'; '.join(lost)}")
     mesh = build_mesh(
         path, nodes=elements.nodes, elements=elements.connectivity, parts=parts,
         steps=steps, times=times, element_fields=fields, part_names=part_names,
@@ -138,6 +169,8 @@ def read_d3plot(path: str | os.PathLike[str], units: str = "mm", all_faces: bool
     for failure in warnings.failures:  # read, but with sections missing: say which
         _warn(ParseWarning(path, f"lasso-python could not read {failure}: what it holds is "
                                  f"missing"), stacklevel=2)
+    for note in notes:
+        _warn(ParseWarning(path, note), stacklevel=2)
     return mesh
 
 
@@ -150,24 +183,100 @@ def _first_member(path: Path) -> Path:
     return path
 
 
-def _lasso_arrays(path: Path):
-    """(lasso-python's arrays of the d3plot family at ``path``, the warnings it logged while
-    reading); ParseError when it cannot read the file at all."""
+def _lasso_read(path: Path):
+    """(lasso-python's D3plot of the family at ``path``, the warnings it logged while reading);
+    ParseError when it cannot read the file at all. Its log, Python warnings and numpy floating
+    point messages are captured: nothing of them reaches the console."""
     from lasso.dyna import D3plot
 
     warnings = _LassoWarnings()
-    logger = logging.getLogger("lasso")
-    logger.addHandler(warnings)
-    propagate, logger.propagate = logger.propagate, False  # its tracebacks are ours to report
+    # lasso-python logs under "lasso..." and, for some modules, under their file path
+    loggers = [logging.getLogger("lasso")] + [
+        logging.getLogger(name) for name in list(logging.root.manager.loggerDict)
+        if re.search(r"(^|[\\/])lasso[\\/]", name)]
+    saved = [(logger, logger.propagate) for logger in loggers]
+    for logger in loggers:
+        logger.addHandler(warnings)
+        logger.propagate = False  # its tracebacks are ours to report, in one line each
     try:
-        plot = D3plot(str(path))
+        with _python_warnings.catch_warnings(), np.errstate(all="ignore"):
+            _python_warnings.simplefilter("ignore")
+            plot = _guarded(D3plot)(str(path))
+    except ParseError as exc:  # the family does not fit the header
+        raise ParseError(path, exc.message + warnings.summary()) from None
     except Exception as exc:  # lasso raises many types; all mean "cannot read this file"
-        raise ParseError(path, f"lasso-python could not read it: {type(exc).__name__}: "
-                               f"{str(exc).strip()}") from exc
+        raise ParseError(path, _unreadable(path, exc) + warnings.summary()) from exc
     finally:
-        logger.removeHandler(warnings)
-        logger.propagate = propagate
-    return plot.arrays, warnings
+        for logger, propagate in saved:
+            logger.removeHandler(warnings)
+            logger.propagate = propagate
+    return plot, warnings
+
+
+def _guarded(D3plot):
+    """lasso-python's D3plot refusing an airbag particle section (announced by the header's
+    NPEFG) whose counts do not fit the file: it would loop over them for hours."""
+
+    class Guarded(D3plot):
+        def _read_particle_data(self):
+            npefg = self.header.raw_header.get("npefg", 0)
+            if 0 < npefg <= 10_000_000 and self._buffer:
+                w, at = self.header.wordsize, self.geometry_section_size
+                counts = [self._buffer.read_number(at + k * w, self.header.itype)
+                          for k in (0, 1, 3) if at + (k + 1) * w <= self._buffer.size]
+                if len(counts) < 3 or min(counts) < 0 \
+                        or 9 * w * sum(int(c) for c in counts) > self._buffer.size:
+                    raise ValueError(f"the airbag particle section the header announces "
+                                     f"(NPEFG {npefg}) does not fit the file")
+            super()._read_particle_data()
+
+        def _read_states(self, filepath):
+            # before lasso-python sizes its buffers by a header that may not fit the files
+            self.family = _family(Path(filepath), self)
+            super()._read_states(filepath)
+
+    return Guarded
+
+
+def _unreadable(path: Path, exc: Exception) -> str:
+    """Why lasso-python could not read the family at ``path``, in one line: a member without
+    data by its name, else the exception's type and first line (never a traceback's)."""
+    for member in family_members(path):
+        if _data_end(member) == 0:
+            return (f"{member.name} holds no data (empty or all zero): the states it should "
+                    f"hold are missing")
+    lines = [line.strip() for line in str(exc).splitlines()
+             if line.strip() and not line.lstrip().startswith("Traceback")]
+    return f"lasso-python could not read it: {type(exc).__name__}: {(lines or [''])[0]}"
+
+
+# --------------------------------------------------------------------------- the family
+def family_layout(path: str | os.PathLike[str]) -> list[Member]:
+    """The members of the d3plot family at ``path`` (the first file, then ``d3plot01``, ...)
+    with where their states lie; ParseError as :func:`read_d3plot` for a family that cannot
+    be read or whose header does not fit its files."""
+    path = _first_member(Path(path))
+    plot, _ = _lasso_read(path)
+    return _family(path, plot)[0]
+
+
+def _steps_and_times(arrays: dict, ArrayType, nodes: np.ndarray, n_states: int,
+                     notes: list[str]):
+    """(steps, times) of ``n_states`` states (None, None without states); coordinates or times
+    that could not be read are replaced, with a note: the initial geometry, the state index."""
+    if not n_states:
+        return None, None
+    steps = arrays.get(ArrayType.node_displacement)
+    if steps is None or np.shape(steps) != (n_states, *nodes.shape):
+        notes.append("the states hold no readable node coordinates: every state is drawn on "
+                     "the initial geometry")
+        steps = np.broadcast_to(nodes, (n_states, *nodes.shape))
+    times = arrays.get(ArrayType.global_timesteps)
+    if times is None or np.shape(times) != (n_states,):
+        notes.append("the state times could not be read: the states are numbered 0, 1, ... "
+                     "instead")
+        times = np.arange(n_states)
+    return np.asarray(steps, dtype=np.float64), np.asarray(times, dtype=np.float64)
 
 
 def _need(path: Path, arrays, key, warnings: _LassoWarnings):
@@ -222,7 +331,8 @@ def _elements(path: Path, arrays, ArrayType, warnings: _LassoWarnings,
         connectivity = np.concatenate([connectivity, faces])
         part_index = np.concatenate([part_index, face_part_index])
         solid_ids = arrays.get(ArrayType.element_solid_ids)
-        if solid_ids is not None and (element_ids is not None or n_shells == 0):
+        if solid_ids is not None and len(solid_ids) == len(solids) and \
+                (element_ids is not None or n_shells == 0):
             shell_ids = element_ids if element_ids is not None else np.zeros(0, np.int64)
             element_ids = np.concatenate([shell_ids, np.asarray(solid_ids, np.int64)[face_of]])
         else:
@@ -352,21 +462,37 @@ class _LassoWarnings(logging.Handler):
     @property
     def failures(self) -> list[str]:
         """One phrase per section lasso-python gave up on: what it was reading and why (the
-        last line of the traceback it logged)."""
+        last line of the traceback it logged), never the traceback itself. The shell layout
+        check is left out: :func:`_drop_damaged_layouts` reports it."""
         out = []
         for record in self.records:
-            try:
-                text = record.getMessage()
-            except (TypeError, ValueError):  # lasso-python's own message may not format
-                text = f"{record.msg} {record.args}"
+            if str(record.msg).startswith("n_shell_vars != n_shell_vars_computed"):
+                continue
+            text = _record_text(record)
             if record.exc_info and record.exc_info[1] is not None:
                 text += f"\n{type(record.exc_info[1]).__name__}: {record.exc_info[1]}"
             lines = [line.strip() for line in text.splitlines() if line.strip()]
-            what = re.sub(r"^A failure in (.*?) was caught:?$", r"\1", lines[0])
-            why = lines[-1] if len(lines) > 1 else ""
-            out.append(f"{what} ({why})" if why else what)
+            heading = next((i for i, line in enumerate(lines) if line.startswith("Traceback")),
+                           len(lines))
+            what = " ".join(lines[:heading]) or "a section"
+            what = re.sub(r"^A failure in (.*?) was caught:?$", r"\1", what)
+            why = lines[-1] if heading < len(lines) - 1 else ""
+            phrase = f"{what} ({why})" if why else what
+            out.append(phrase.replace("Traceback (most recent call last):", "").strip())
         return out
 
     def summary(self) -> str:
         failures = self.failures
         return f" (lasso-python could not read {'; '.join(failures[:3])})" if failures else ""
+
+
+def _record_text(record: logging.LogRecord) -> str:
+    """The message of a log record; lasso-python's own message may not format (a ``%d`` given
+    a string): then every placeholder takes its argument's text."""
+    try:
+        return record.getMessage()
+    except (TypeError, ValueError, KeyError):
+        args = record.args if isinstance(record.args, tuple) else (record.args,)
+        texts = iter(str(arg) for arg in args)
+        return re.sub(r"%[-#0 +]*\d*(?:\.\d+)?[a-zA-Z]",
+                      lambda m: next(texts, m.group(0)), str(record.msg))
