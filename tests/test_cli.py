@@ -274,7 +274,7 @@ def test_render_refuses_coordinates_too_far_to_resolve(tmp_path, capsys):
     assert "magnitude 1e+20" in err and "translate it nearer the origin" in err
 
 
-def test_a_missing_parameter_is_one_warning_line_and_the_part_still_renders(tmp_path):
+def test_a_missing_parameter_is_one_error_line_and_nothing_is_drawn(tmp_path):
     deck = tmp_path / "part.k"
     deck.write_text(DECK.replace("*NODE", "*PART\np\n         1         1\n*SECTION_SHELL\n"
                                           "         1\n&t\n*NODE"))
@@ -282,10 +282,10 @@ def test_a_missing_parameter_is_one_warning_line_and_the_part_still_renders(tmp_
     result = subprocess.run([sys.executable, "-m", "workbench.cli", "render", str(deck),
                              "--field", "thickness", "--size", "40x30", "-o", str(out)],
                             capture_output=True, text=True)
-    assert result.returncode == 0 and out.exists()
+    assert result.returncode == 2 and not out.exists()
     assert result.stderr.strip().splitlines() == [
-        f"workbench: warning: {deck}:7: *SECTION_SHELL: parameter 't' is not defined by "
-        f"*PARAMETER in this deck or its includes: the thickness is missing"]
+        f"workbench: error: {deck}:7: *SECTION_SHELL: parameter 't' is not defined by "
+        f"*PARAMETER in this deck or its includes (it defines no parameter) in '&t'"]
 
 
 @pytest.mark.parametrize("argv, message", [

@@ -177,7 +177,10 @@ def test_von_mises_matches_principal_stresses(components):
     principal = np.linalg.eigvalsh(np.array([[xx, xy, zx], [xy, yy, yz], [zx, yz, zz]]))
     s1, s2, s3 = principal
     reference = np.sqrt(((s1 - s2) ** 2 + (s2 - s3) ** 2 + (s3 - s1) ** 2) / 2)
-    assert von_mises(np.array(components)) == pytest.approx(reference, rel=1e-7, abs=1e-6)
+    # LAPACK's eigenvalues are exact to a small multiple of the largest component (less so
+    # beside subnormal-sized entries): the tolerance scales with it
+    scale = max(1.0, float(np.abs(components).max()))
+    assert von_mises(np.array(components)) == pytest.approx(reference, rel=1e-7, abs=1e-6 * scale)
 
 
 def test_mid_surface_layer_order():
@@ -197,12 +200,12 @@ def test_fixed_width_blank_fields(tmp_path):
         "       2",  # all coordinates blank
         "       3            1.D2             0.0             0.0       0       0",
         "*ELEMENT_SHELL",
-        "      11               1       2       3       3",  # blank part id -> 0
+        "      11       4       1       2       3",  # blank n4: a triangle
         "*END",
     ])
     mesh = load(path)
     assert mesh.nodes.tolist() == [[1.5, 0.0, -2.0], [0.0, 0.0, 0.0], [100.0, 0.0, 0.0]]
-    assert mesh.parts.tolist() == [0]
+    assert mesh.parts.tolist() == [4]
     assert mesh.is_triangle.tolist() == [True]
 
 
@@ -271,6 +274,8 @@ def test_element_shell_thickness_and_sections(tmp_path):
         "*PART",
         "left part",
         "         1         4         1",
+        "no section",
+        "         2        99         1",
         "*SECTION_SHELL",
         "         4         2",
         "&tsec",
@@ -285,7 +290,7 @@ def test_element_shell_thickness_and_sections(tmp_path):
         "",
         "*ELEMENT_SHELL",
         shell(4, 1, 101, 102, 103, 104),
-        shell(5, 2, 101, 102, 103, 104),  # part 2 has no section
+        shell(5, 2, 101, 102, 103, 104),  # part 2's section 99 is not defined
     ])
     mesh = load(path)
     thickness = mesh.element_fields["thickness"]
@@ -309,6 +314,9 @@ def test_part_titles(tmp_path):
         "        14         1         1",
         "       0.0       0.0",
         "",
+        "*PART",
+        "",
+        "        15",
         "*PART_MOVE",
         "        13       1.0       0.0       0.0",
         "*NODE", *[node(*n) for n in SQUARE],
@@ -376,13 +384,14 @@ def test_random_decks_read_back(tmp_path, data):
                                min_size=m, max_size=m))
     lines.append("*ELEMENT_SHELL")
     for k, cell in enumerate(cells):
-        values = (k * 1000 - 5, k % 3, *cell)
+        values = (k * 1000 - 5, k % 3 + 1, *cell)
         lines.append(",".join(map(str, values)) if free[n + k % n] else shell(*values))
     mesh = load(write(tmp_path, "random.k", lines))
     assert mesh.node_ids.tolist() == node_ids
     assert np.array_equal(mesh.nodes, np.array(xyz, dtype=float))
     assert ids_of(mesh).tolist() == cells
     assert mesh.element_ids.tolist() == [k * 1000 - 5 for k in range(m)]
+    assert mesh.parts.tolist() == [k % 3 + 1 for k in range(m)]
 
 
 # --------------------------------------------------------------------------- refusals
@@ -480,13 +489,12 @@ def test_include_errors(tmp_path):
 def test_unsupported_variants_and_parameters(tmp_path):
     with pytest.raises(ParseError, match="ELEMENT_SHELL_COMPOSITE"):
         load(write(tmp_path, "c.k", ["*ELEMENT_SHELL_COMPOSITE", shell(1, 1, 1, 2, 3, 4)]))
-    with pytest.warns(ParseWarning, match="'tmissing' is not defined") as record:
-        mesh = load(write(tmp_path, "p.k", [
+    with pytest.raises(ParseError, match="'tmissing' is not defined") as info:
+        load(write(tmp_path, "p.k", [
             "*PART", "p", "         1         1", "*SECTION_SHELL", "         1",
             "&tmissing", "*NODE", *[node(*n) for n in SQUARE], "*ELEMENT_SHELL",
             shell(1, 1, 101, 102, 103, 104)]))
-    assert record[0].message.line == 6
-    assert np.isnan(mesh.element_fields["thickness"]).all()  # missing, the geometry drawn
+    assert info.value.line == 6
 
 
 def test_unknown_suffix_and_missing_file(tmp_path):
@@ -595,7 +603,8 @@ def test_trimesh_errors_are_parse_errors(tmp_path):
 # --------------------------------------------------------------------------- integer fields
 def test_integral_floats_in_integer_fields_of_every_card_type_read(tmp_path):
     """Other pre-processors write integer fields as floats (``0.000E+00``, ``8.``); LS-DYNA
-    reads an integral float there, in fixed columns and in comma format alike."""
+    reads an integral float there, in fixed columns and in comma format alike. Ids (node,
+    element and part ids) take integral floats in decimal notation only."""
     path = write(tmp_path, "floats.k", [
         "*KEYWORD",
         "*PART",
@@ -605,7 +614,7 @@ def test_integral_floats_in_integer_fields_of_every_card_type_read(tmp_path):
         "8,2,0.000E+00,0.000E+00,0.000E+00,0.000E+00,0",
         "1.5,1.5,1.5,1.5",
         "*NODE",
-        "  1.01E2             0.0             0.0             0.0",
+        "   101.0             0.0             0.0             0.0",
         "     102            10.0             0.0             0.0",
         "103.0,10.0,10.0,0.0",
         "     104             0.0            10.0             0.0",
@@ -823,8 +832,7 @@ def _sectioned_part(thickness_card: str) -> list[str]:
 
 def test_include_uses_the_parameters_of_the_including_deck(tmp_path):
     """An included file's ``&t`` is defined by the deck that includes it: read through that
-    deck the thickness is there; read alone the geometry still draws, thickness NaN, with one
-    warning naming file, line and parameter."""
+    deck the thickness is there; read alone it is refused, naming file, line and parameter."""
     part = write(tmp_path, "part.k", [*_sectioned_part("&t"), "*NODE",
                                       *[node(*n) for n in SQUARE], "*ELEMENT_SHELL",
                                       shell(1, 1, 101, 102, 103, 104)])
@@ -832,25 +840,21 @@ def test_include_uses_the_parameters_of_the_including_deck(tmp_path):
                                           "*INCLUDE", "part.k", "*END"])
     mesh = load(master)
     assert mesh.element_fields["thickness"].tolist() == [1.25]
-    with pytest.warns(ParseWarning) as record:
-        alone = load(part)
-    assert [str(w.message) for w in record] == [
+    with pytest.raises(ParseError) as info:
+        load(part)
+    assert str(info.value) == (
         f"{part}:6: *SECTION_SHELL: parameter 't' is not defined by *PARAMETER in this deck or "
-        f"its includes: the thickness is missing"]
-    assert (np.array_equal(alone.nodes, mesh.nodes)
-            and np.isnan(alone.element_fields["thickness"]).all())
+        f"its includes (it defines no parameter) in '&t'")
 
 
-def test_rendering_a_missing_thickness_draws_the_base_colour(tmp_path):
+def test_rendering_a_missing_thickness_draws_the_base_colour():
     from workbench.experiment.measure import measure
     from workbench.gl import create_context
     from workbench.paths import Style, make_path
+    from workbench.scene.mesh import FEMesh
 
-    part = write(tmp_path, "part.k", [*_sectioned_part("&t"), "*NODE",
-                                      *[node(*n) for n in SQUARE], "*ELEMENT_SHELL",
-                                      shell(1, 1, 101, 102, 103, 104)])
-    with pytest.warns(ParseWarning):
-        mesh = load(part)
+    mesh = FEMesh(np.array([n[1:] for n in SQUARE[:4]]), np.array([[0, 1, 2, 3]]),
+                  np.array([1]), element_fields={"thickness": np.array([np.nan])})
     ctx = create_context()
     path = make_path("element_color", Style(field="thickness", value_range=(0.0, 1.0)))
     m = measure(ctx, mesh, path, size=(32, 32), timed=False)
@@ -928,8 +932,10 @@ def test_damaged_d3plot_says_what_is_missing_in_one_line_each(tmp_path, d3plot_f
     assert "Traceback" not in result.stderr and lines
     assert all(line.startswith("workbench: warning: " if status == 0 else "workbench: error: ")
                for line in lines)
-    assert all("lasso-python could not read" in line for line in lines)
-    if status == 0:
+    assert any("lasso-python could not read" in line for line in lines)
+    if status == 0:  # the first file alone, cut: no state, and the cut is named
+        assert any("cut inside its geometry" in line for line in lines)
+        assert any("no state read" in line for line in lines)
         with pytest.warns(ParseWarning, match="lasso-python could not read") as record:
             mesh = load(damaged)
         assert any("_read_user_ids" in str(w.message) for w in record)

@@ -15,12 +15,12 @@ from workbench.reliability import (
     OUTCOMES,
     comma_deck,
     default_decks,
+    expected_mesh,
     fixed_deck,
     mesh_problem,
     mutated_deck,
     run_reader_stress,
     same_mesh,
-    strict_count,
     thickness_deck,
 )
 from workbench.reliability import read_outcome as _read
@@ -71,15 +71,91 @@ def test_mutations_are_reproducible_from_seed_and_index():
         [mutated_deck(i, 4, decks).text for i in range(20)]
 
 
-def test_strict_count_of_the_generated_decks(tmp_path):
-    for make in (fixed_deck, comma_deck, thickness_deck):
-        path = tmp_path / "deck.k"
-        path.write_bytes(make())
+def test_the_strict_reference_agrees_with_the_reader_on_every_default_deck(tmp_path):
+    for name, text in default_decks().items():
+        path = tmp_path / f"{name}.k"
+        path.write_bytes(text)
         mesh = read_keyword(path)
-        count = strict_count(make())
-        assert len(count.node_ids) == len(mesh.nodes)
-        assert len(count.element_ids) == len(mesh.elements)
-        assert mesh_problem(mesh, make()) == ""
+        expected = expected_mesh(text)
+        assert len(expected.node_ids) == mesh.n_nodes and \
+            len(expected.element_ids) == mesh.n_elements
+        assert mesh_problem(mesh, text) == "", name
+
+
+def _rebuilt(mesh, **changes):
+    """A copy of ``mesh`` with some arrays replaced (what a broken reader returns)."""
+    from workbench.scene.mesh import FEMesh
+
+    kwargs = dict(nodes=mesh.nodes, elements=mesh.elements, parts=mesh.parts,
+                  element_fields=dict(mesh.element_fields), node_ids=mesh.node_ids,
+                  element_ids=mesh.element_ids, part_names=mesh.part_names, name=mesh.name)
+    kwargs.update(changes)
+    return FEMesh(**kwargs)
+
+
+def _flat_z(mesh):
+    return _rebuilt(mesh, nodes=mesh.nodes * [1.0, 1.0, 0.0])
+
+
+def _triangles(mesh):
+    elements = mesh.elements.copy()
+    elements[:, 3] = elements[:, 2]
+    return _rebuilt(mesh, elements=elements)
+
+
+def _reversed_parts(mesh):
+    return _rebuilt(mesh, parts=mesh.parts[::-1])
+
+
+def _thicker(mesh):
+    fields = dict(mesh.element_fields)
+    fields["thickness"] = fields["thickness"] * 1.001
+    return _rebuilt(mesh, element_fields=fields)
+
+
+def _one_element_less(mesh):
+    keep = slice(0, mesh.n_elements - 1)
+    fields = {k: v[keep] for k, v in mesh.element_fields.items()}
+    return _rebuilt(mesh, elements=mesh.elements[keep], parts=mesh.parts[keep],
+                    element_ids=mesh.element_ids[keep], element_fields=fields)
+
+
+def _renumbered_nodes(mesh):
+    return _rebuilt(mesh, node_ids=np.roll(mesh.node_ids, 1))
+
+
+BROKEN_READERS = {  # a broken reader -> the quantity the suite must name
+    "flattened z": (_flat_z, "coordinates"),
+    "quads as triangles": (_triangles, "connectivity"),
+    "part ids reversed": (_reversed_parts, "part ids"),
+    "thickness off by 0.1 %": (_thicker, "thickness"),
+    "an element dropped": (_one_element_less, "element ids"),
+    "node ids shifted": (_renumbered_nodes, "connectivity"),
+}
+
+
+@pytest.mark.parametrize("broken", sorted(BROKEN_READERS))
+def test_the_suite_fails_on_a_broken_reader_naming_what_differs(broken):
+    """A check that cannot fail is no check: each broken reader makes the suite fail, and its
+    failures name the quantity the reader gets wrong."""
+    damage, quantity = BROKEN_READERS[broken]
+
+    def reader(path):
+        return damage(read_keyword(path))
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        report = run_reader_stress(n=30, seed=3, reader=reader)
+    assert not report.ok
+    originals = [f for f in report.failures if f.kind == "original"]
+    assert originals  # (a flat deck's z is already flat: not every deck need differ)
+    assert all(f.outcome == "wrong mesh" and quantity in f.message for f in originals), \
+        [f.message for f in originals]
+    assert report.totals["wrong mesh"] > 0
+
+
+def test_the_real_reader_passes_the_same_run():
+    assert run_reader_stress(n=30, seed=3).ok
 
 
 def test_wrong_mesh_is_detected(tmp_path):
@@ -89,10 +165,15 @@ def test_wrong_mesh_is_detected(tmp_path):
     lines = fixed_deck().split(b"\n")
     one_element_less = b"\n".join(line for line in lines
                                    if not line.startswith(b"       9       1"))
-    assert "elements read" in mesh_problem(mesh, one_element_less)
+    assert "element ids: 0 missing [], 1 not in the deck [9]" in \
+        mesh_problem(mesh, one_element_less)
+    moved_node = fixed_deck().replace(b"            10.0             0.0",
+                                      b"            11.0             0.0", 1)
+    assert "coordinates of 1 node(s): node 2 read [10.0, 0.0, 0.0], expected [11.0" in \
+        mesh_problem(mesh, moved_node)
     garbled_node = fixed_deck().replace(b"            10.0             0.0",
                                         b"            1x.0             0.0", 1)
-    assert "nodes read" in mesh_problem(mesh, garbled_node)
+    assert "must be refused" in mesh_problem(mesh, garbled_node)
 
 
 def test_a_read_past_the_time_limit_is_a_hang(tmp_path):
@@ -189,4 +270,4 @@ def test_regression_lasso_message_that_does_not_format():
     handler = _LassoWarnings()
     handler.emit(logging.LogRecord("lasso", logging.WARNING, "x", 1, "part %d is broken",
                                    ("seven",), None))
-    assert handler.failures == ["part %d is broken ('seven',)"]
+    assert handler.failures == ["part seven is broken"]  # each placeholder takes its argument

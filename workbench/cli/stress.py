@@ -49,8 +49,11 @@ def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
         "stress", help="reliability suites: mutated decks for the readers, far-offset, soak and "
                        "determinism checks for the render paths",
-        description="readers: mutate keyword decks at random and check every read (identical for "
-                    "benign changes, else ParseError or a mesh consistent with the mutated text). "
+        description="readers: mutate keyword decks at random and check every read against an "
+                    "independent strict decoding of the deck (node ids, coordinates, "
+                    "connectivity, part ids, thickness: identical for benign changes, else "
+                    "ParseError or the mesh the strict decoding gives); damaged d3plots against "
+                    "the undamaged read. "
                     "render: images 10^3 and 10^7 units from the origin equal to those at it, "
                     "prepare/draw/release cycles that keep no GL object and no memory, the same "
                     "image in other processes. all: both. Exit status 1 on any failure.")

@@ -2,12 +2,12 @@
 render paths far from the origin, drawn many times and in other processes.
 
 * :mod:`~workbench.reliability.decks` — the generated keyword decks and their seeded mutations;
-* :mod:`~workbench.reliability.strict` — the independent strict count of a deck's well-formed
-  cards that a read is checked against;
+* :mod:`~workbench.reliability.strict` — the independent strict decoding of a deck that every
+  read is checked against (node ids, coordinates, connectivity, part ids, thickness);
 * :mod:`~workbench.reliability.readers` — the reader suite (:func:`run_reader_stress`) and
   its report;
-* :mod:`~workbench.reliability.d3plot` — damaged copies of the shared d3plot
-  (:func:`run_d3plot_stress`);
+* :mod:`~workbench.reliability.d3plot` — damaged copies of the shared d3plot family, each
+  read compared with the undamaged read, fields included (:func:`run_d3plot_stress`);
 * :mod:`~workbench.reliability.render` — far offsets, the soak and determinism
   (:func:`run_render_stress`);
 * :mod:`~workbench.reliability.faults` — faults injected to show that a check can fail (a
@@ -16,7 +16,16 @@ render paths far from the origin, drawn many times and in other processes.
 ``workbench stress readers|render|all`` runs them (:mod:`workbench.cli.stress`).
 """
 
-from .d3plot import D3PLOT_KINDS, D3plotStressReport, damaged_d3plot, run_d3plot_stress
+from .d3plot import (
+                    D3PLOT_KINDS,
+                    FAMILY_KINDS,
+                    D3plotStressReport,
+                    Damage,
+                    compare_read,
+                    damaged_d3plot,
+                    damaged_family,
+                    run_d3plot_stress,
+)
 from .decks import (
                     BENIGN,
                     BOM,
@@ -26,6 +35,7 @@ from .decks import (
                     comma_deck,
                     default_decks,
                     fixed_deck,
+                    long_deck,
                     mutated_deck,
                     thickness_deck,
 )
@@ -53,13 +63,22 @@ from .render import (
                     run_render_stress,
                     stress_scene,
 )
-from .strict import StrictCount, strict_count
+from .strict import (
+                    BeyondReference,
+                    Expected,
+                    Refused,
+                    StrictDeck,
+                    expected_mesh,
+                    mesh_differences,
+                    strict_decode,
+)
 
-__all__ = ["BENIGN", "BOM", "CHECKED_PATHS", "D3PLOT_KINDS", "D3plotStressReport", "FAILING",
-           "Failure", "HARMFUL", "KINDS", "Mutation", "OFFSETS", "OUTCOMES", "RSS_LIMIT_MIB",
-           "RenderStressReport", "StressReport", "StrictCount", "TIMEOUT_S",
-           "check_determinism", "check_far_offset", "check_soak", "comma_deck",
-           "damaged_d3plot", "default_decks", "fixed_deck", "image_digest", "mesh_problem",
-           "mutated_deck", "read_outcome", "resident_mib", "run_d3plot_stress",
-           "run_reader_stress", "run_render_stress", "same_mesh", "strict_count",
-           "stress_scene", "thickness_deck"]
+__all__ = ["BENIGN", "BeyondReference", "BOM", "check_determinism", "check_far_offset",
+           "check_soak", "CHECKED_PATHS", "comma_deck", "compare_read", "D3PLOT_KINDS",
+           "D3plotStressReport", "Damage", "damaged_d3plot", "damaged_family", "default_decks",
+           "Expected", "expected_mesh", "FAILING", "Failure", "FAMILY_KINDS", "fixed_deck",
+           "HARMFUL", "image_digest", "KINDS", "long_deck", "mesh_differences", "mesh_problem",
+           "mutated_deck", "Mutation", "OFFSETS", "OUTCOMES", "read_outcome", "Refused",
+           "RenderStressReport", "resident_mib", "RSS_LIMIT_MIB", "run_d3plot_stress",
+           "run_reader_stress", "run_render_stress", "same_mesh", "stress_scene", "StressReport",
+           "strict_decode", "StrictDeck", "thickness_deck", "TIMEOUT_S"]

@@ -1,7 +1,8 @@
 """The keyword decks the reader suite mutates and the mutations (:func:`mutated_deck`).
 
-The decks are the shared car deck when present and small generated decks in fixed and comma
-format, with ``*ELEMENT_SHELL_THICKNESS``, ``*PART`` and ``*SECTION_SHELL``. A mutation is
+The decks are the shared car deck when present and small generated decks in fixed, comma and
+long format, with ``*ELEMENT_SHELL_THICKNESS``, ``*PART``, ``*SECTION_SHELL`` and
+``*PARAMETER``. A mutation is
 benign (CRLF line ends, ``$`` comment lines, lower-case keywords, a UTF-8 byte order mark:
 the same mesh must be read) or harmful (lines deleted, duplicated, swapped or garbled, huge or
 non-finite numbers, a deck cut after a card or inside one).
@@ -81,11 +82,30 @@ def thickness_deck() -> bytes:
     return ("\n".join(lines) + "\n").encode()
 
 
+def long_deck() -> bytes:
+    """A long-format deck (``*KEYWORD LONG=Y``: every field 20 columns) with *PARAMETER,
+    *PART, *SECTION_SHELL (thickness by a parameter), *NODE and *ELEMENT_SHELL_THICKNESS."""
+    lines = ["*KEYWORD LONG=Y", "*PARAMETER", f"{'Rtlong':<20}{0.75:>20}", "*PART",
+             "long part", f"{4:>20}{9:>20}{1:>20}", "*SECTION_SHELL", f"{9:>20}{2:>20}",
+             f"{'&tlong':<20}", "*NODE"]
+    lines += [f"{n + 1000:>20}{x + 0.125:>20}{y:>20}{z - 3.5:>20}"
+              for n, x, y, z in _grid_nodes(4, 3)]
+    lines.append("*ELEMENT_SHELL_THICKNESS")
+    for e, a, b, c, d in _grid_quads(4, 3, 500):
+        lines.append("".join(f"{v:>20}" for v in (e, 4, a + 1000, b + 1000, c + 1000,
+                                                    d + 1000)))
+        lines.append("".join(f"{t:>20}" for t in (0.5, 0.0, 0.6, 0.0)))
+    lines.append("*END")
+    return ("\n".join(lines) + "\n").encode()
+
+
 def default_decks() -> dict[str, bytes]:
-    """The decks the suite mutates: the generated ones, and the shared car deck when present."""
+    """The decks the suite mutates: the generated ones (standard, comma and long format), and
+    the shared car deck when present."""
     from ..data import CAR_DECK, shared_file
 
-    decks = {"fixed": fixed_deck(), "comma": comma_deck(), "thickness": thickness_deck()}
+    decks = {"fixed": fixed_deck(), "comma": comma_deck(), "thickness": thickness_deck(),
+             "long": long_deck()}
     car = shared_file(CAR_DECK)
     if car is not None:
         decks["car6"] = car.read_bytes()

@@ -2,17 +2,18 @@
 readers [--n N] [--seed S]``).
 
 Keyword decks (:mod:`workbench.reliability.decks`) are mutated at random, deterministically
-from the seed, and read back with :func:`workbench.scene.readers.keyword.read_keyword` under a
-time limit.
+from the seed, and read back with :func:`workbench.scene.readers.keyword.read_keyword` (or an
+injected ``reader``) under a time limit. Every successful read — of the unmutated decks too —
+is checked against an independent reference, the strict card-by-card decoding of the text
+(:mod:`workbench.reliability.strict`): node ids, coordinates, element ids, connectivity, part
+ids and thickness must all equal it, and a deck it refuses must not be read at all.
 
 * A benign mutation (CRLF line ends, ``$`` comment lines, lower-case keywords, a UTF-8 byte
-  order mark) must read the identical mesh: nodes, elements, parts, node and element ids.
-* Any other mutation must either be refused with :class:`~workbench.scene.readers.ParseError`
-  or read a consistent mesh: finite coordinates, node and element counts equal to the
-  well-formed node and element cards that a strict, independent decoding of the mutated text
-  finds (:func:`~workbench.reliability.strict.strict_count`), and node and element ids all
-  among those cards' ids. A read that differs is a "wrong mesh"; any other exception and any
-  read over the time limit are failures too.
+  order mark) must read the identical mesh.
+* Any other mutation must be refused with :class:`~workbench.scene.readers.ParseError` or read
+  the mesh the reference decodes ("consistent read"). A read that differs is a "wrong mesh"
+  (the failure names each quantity that differs); a deck the reference cannot decode is
+  "unchecked"; any other exception and any read over the time limit are failures too.
 
 Mutation ``i`` of seed ``s`` is drawn from ``random.Random(f"{s}:{i}")``, so every failure
 is reproduced by its seed and index alone (:func:`~workbench.reliability.decks.mutated_deck`).
@@ -32,11 +33,11 @@ import numpy as np
 
 from ..scene.readers import ParseError
 from .decks import BENIGN, KINDS, Mutation, default_decks, mutated_deck
-from .strict import strict_count
+from .strict import BeyondReference, Refused, expected_mesh, mesh_differences
 
-OUTCOMES = ("identical", "parse error", "consistent read", "wrong mesh", "other exception",
-            "hang")
-FAILING = ("wrong mesh", "other exception", "hang")
+OUTCOMES = ("identical", "parse error", "consistent read", "wrong mesh", "unchecked",
+            "other exception", "hang")
+FAILING = ("wrong mesh", "unchecked", "other exception", "hang")
 TIMEOUT_S = 10.0
 
 
@@ -77,31 +78,28 @@ def read_outcome(path: Path, timeout: float, reader=None):
 
 
 def same_mesh(a, b) -> bool:
-    """Whether two meshes have equal nodes, elements, parts, node ids and element ids."""
+    """Whether two meshes have equal nodes, elements, parts, node ids, element ids and element
+    fields (NaN equal to NaN)."""
     pairs = [(a.nodes, b.nodes), (a.elements, b.elements), (a.parts, b.parts),
              (a.node_ids, b.node_ids), (a.element_ids, b.element_ids)]
+    if a.element_fields.keys() != b.element_fields.keys():
+        return False
+    pairs += [(a.element_fields[k], b.element_fields[k]) for k in a.element_fields]
     return all((x is None and y is None) or (x is not None and y is not None
-                                             and np.array_equal(x, y)) for x, y in pairs)
+                                             and np.array_equal(x, y, equal_nan=True))
+               for x, y in pairs)
 
 
 def mesh_problem(mesh, text: bytes) -> str:
-    """Why a read mesh disagrees with the strict decoding of ``text``; "" when it agrees."""
-    expected = strict_count(text)
-    if not np.isfinite(mesh.nodes).all():
-        return "non-finite coordinates"
-    if len(mesh.nodes) != len(expected.node_ids):
-        return f"{len(mesh.nodes)} nodes read, {len(expected.node_ids)} well-formed node cards"
-    if len(mesh.elements) != len(expected.element_ids):
-        return (f"{len(mesh.elements)} elements read, {len(expected.element_ids)} well-formed "
-                "element records")
-    if mesh.node_ids is not None and not set(mesh.node_ids.tolist()) <= set(expected.node_ids):
-        return "node ids that no well-formed node card defines"
-    if mesh.element_ids is not None and \
-            not set(mesh.element_ids.tolist()) <= set(expected.element_ids):
-        return "element ids that no well-formed element record defines"
-    if ((mesh.elements < 0) | (mesh.elements >= len(mesh.nodes))).any():
-        return "an element names a node that does not exist"
-    return ""
+    """What a read mesh gets wrong against the strict decoding of the deck ``text`` (each
+    quantity that differs, or that the deck must be refused); "" when it agrees. Raises
+    :class:`~workbench.reliability.strict.BeyondReference` for a deck the decoding cannot
+    judge."""
+    try:
+        expected = expected_mesh(text)
+    except Refused as exc:
+        return f"read a deck that must be refused ({exc})"
+    return "; ".join(mesh_differences(mesh, expected))
 
 
 # --------------------------------------------------------------------------- the run
@@ -155,29 +153,46 @@ class StressReport:
         return "\n".join(rows)
 
 
-def _outcome(mutation: Mutation, original, path: Path, timeout: float) -> tuple[str, str]:
+def _checked(mesh, text: bytes) -> tuple[str, str]:
+    """(outcome, why it fails or "") of a successful read of ``text`` against the reference."""
+    try:
+        problem = mesh_problem(mesh, text)
+    except BeyondReference as exc:
+        return "unchecked", f"the strict reference does not decode {exc}"
+    return ("wrong mesh", problem) if problem else ("consistent read", "")
+
+
+def _outcome(mutation: Mutation, original, path: Path, timeout: float,
+             reader) -> tuple[str, str]:
     """(outcome, why it fails or "") of reading one mutated deck written to ``path``."""
     path.write_bytes(mutation.text)
-    mesh, outcome, message = read_outcome(path, timeout)
+    mesh, outcome, message = read_outcome(path, timeout, reader)
     if mesh is None:
         if mutation.kind in BENIGN and outcome == "parse error":
             return outcome, f"a benign change was refused: {message}"
         return outcome, message if outcome in FAILING else ""
-    if same_mesh(mesh, original):
+    outcome, problem = _checked(mesh, mutation.text)
+    if outcome != "consistent read":
+        return outcome, problem
+    if original is not None and same_mesh(mesh, original):
         return "identical", ""
     if mutation.kind in BENIGN:
         return "wrong mesh", "a benign change read a different mesh"
-    problem = mesh_problem(mesh, mutation.text)
-    return ("wrong mesh", problem) if problem else ("consistent read", "")
+    return outcome, ""
 
 
-def run_reader_stress(n: int, seed: int, decks=None, timeout: float = TIMEOUT_S) -> StressReport:
+def run_reader_stress(n: int, seed: int, decks=None, timeout: float = TIMEOUT_S,
+                      reader=None) -> StressReport:
     """Read ``n`` mutated decks (drawn from ``seed``) and count the outcomes per mutation kind.
 
     ``decks`` maps names to deck texts (bytes) or paths; by default :func:`default_decks`.
+    ``reader`` (a function of a path returning an FEMesh; default the keyword reader) is what is
+    checked: each unmutated deck must read and agree with the strict reference (a failure of
+    kind "original" otherwise), then every mutation is read and checked.
     """
     from ..scene.readers.keyword import read_keyword
 
+    reader = reader or read_keyword
     decks = {name: Path(d).read_bytes() if isinstance(d, (str, Path)) else bytes(d)
              for name, d in (decks or default_decks()).items()}
     counts = {kind: dict.fromkeys(OUTCOMES, 0) for kind in KINDS}
@@ -188,13 +203,17 @@ def run_reader_stress(n: int, seed: int, decks=None, timeout: float = TIMEOUT_S)
         for name, text in decks.items():
             path = Path(folder) / f"{name}.k"
             path.write_bytes(text)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                originals[name] = read_keyword(path)
+            mesh, outcome, message = read_outcome(path, timeout, reader)
+            if mesh is not None:
+                outcome, message = _checked(mesh, text)
+            if outcome != "consistent read":
+                failures.append(Failure(seed, -1, "original", name, 0, "unmutated", outcome,
+                                        message))
+            originals[name] = mesh
         target = Path(folder) / "mutated.k"
         for index in range(n):
             mutation = mutated_deck(index, seed, decks)
-            outcome, why = _outcome(mutation, originals[mutation.deck], target, timeout)
+            outcome, why = _outcome(mutation, originals[mutation.deck], target, timeout, reader)
             counts[mutation.kind][outcome] += 1
             if why and (outcome in FAILING or mutation.kind in BENIGN):
                 failures.append(Failure(seed, index, mutation.kind, mutation.deck,

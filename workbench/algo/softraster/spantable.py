@@ -198,21 +198,27 @@ def _load(path: Path, size: int) -> tuple[np.ndarray, np.ndarray] | None:
     return (lo, hi) if ok else None
 
 
+def _refuse_non_regular(path: Path) -> Path:
+    """``path`` where it is a regular file or absent; ValueError for anything else (a symbolic
+    link, folder, FIFO, device), which the cache never replaces."""
+    if path.is_symlink() or (path.exists() and not path.is_file()):
+        raise ValueError(f"{path} exists and is not a regular file")
+    return path
+
+
 def _save(path: Path, lo: np.ndarray, hi: np.ndarray) -> bool:
     """Write the table atomically (temporary file in the same folder, then ``os.replace``);
     False with a warning where the folder cannot be written or ``path`` exists and is not a
     regular file."""
-    from ...experiment.targets import output_target
-
     meta = np.array([FORMAT_VERSION, lo.shape[0] // 2, _crc(lo, hi)], np.int64)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        output_target(path)
+        _refuse_non_regular(path)
         fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
         try:
             with os.fdopen(fd, "wb") as f:
                 np.savez(f, lo=lo, hi=hi, meta=meta)
-            os.replace(tmp, output_target(path))
+            os.replace(tmp, _refuse_non_regular(path))
         finally:  # also on KeyboardInterrupt: no temporary file stays behind
             if os.path.exists(tmp):
                 os.unlink(tmp)

@@ -26,7 +26,8 @@ class KeywordDeck(Protocol):
     imported here: :mod:`~workbench.scene.readers.keyword` imports this module). Per block in
     reading order: the node ids and coordinates, the shell and solid ids, part ids, node ids
     and the shells' nodal thickness, each with the chunk of lines it came from; the parts and
-    sections by id, the parameters, the keywords skipped (name → count) and the master file."""
+    sections by id, the parameters, the keywords skipped (name → data cards) and the master
+    file. Thick shells are read as solids; ``solid_keywords`` tells each solid block's keyword."""
 
     master: Path
     node_ids: list[np.ndarray]
@@ -41,6 +42,7 @@ class KeywordDeck(Protocol):
     solid_parts: list[np.ndarray]
     solid_nodes: list[np.ndarray]
     solid_chunks: list[_Chunk]
+    solid_keywords: list[str]
     parts: dict[int, Any]
     sections: dict[object, Any]
     parameters: _Parameters
@@ -53,8 +55,10 @@ def deck_mesh(deck: KeywordDeck, units: str, all_faces: bool = False) -> FEMesh:
     ``all_faces``), with ids, parts, part titles and the element field ``"thickness"``.
 
     Refused: a deck without shell or solid elements, a node or element id defined twice, an
-    element naming an undefined node, a part id beyond 32 bits, a solid of an unknown node
-    pattern, and what :class:`FEMesh` refuses.
+    element naming an undefined node, a part id beyond 32 bits, a part id that no ``*PART``
+    defines (in a deck that defines parts; a deck without any ``*PART`` is a mesh file, whose
+    part ids are used as they are), a solid of an unknown node pattern, and what
+    :class:`FEMesh` refuses.
     """
     n_shells = sum(len(ids) for ids in deck.shell_ids)
     if n_shells + sum(len(ids) for ids in deck.solid_ids) == 0:
@@ -66,9 +70,15 @@ def deck_mesh(deck: KeywordDeck, units: str, all_faces: bool = False) -> FEMesh:
     xyz = np.concatenate(deck.node_xyz) if deck.node_xyz else np.zeros((0, 3))
     order, sorted_ids = _unique_or_raise(node_ids, deck.node_chunks, "node")
     element_ids = np.concatenate([*deck.shell_ids, *deck.solid_ids])
-    # shells and solids number their elements apart, as LS-DYNA's element types do
+    # shells, solids and thick shells number their elements apart, as LS-DYNA's types do
     _unique_or_raise(element_ids[:n_shells], deck.shell_chunks, "element")
-    _unique_or_raise(element_ids[n_shells:], deck.solid_chunks, "solid element")
+    for keyword in ("ELEMENT_SOLID", "ELEMENT_TSHELL"):
+        blocks = [i for i, k in enumerate(deck.solid_keywords) if k == keyword]
+        if blocks:
+            _unique_or_raise(np.concatenate([deck.solid_ids[i] for i in blocks]),
+                             [deck.solid_chunks[i] for i in blocks],
+                             "solid element" if keyword == "ELEMENT_SOLID" else "thick shell")
+    _check_parts_defined(deck)
 
     shell_ids = element_ids[:n_shells]
     pids = np.concatenate(deck.shell_parts) if n_shells else np.zeros(0, np.int64)
@@ -183,6 +193,29 @@ def _check_part_ids(pids: np.ndarray, chunks: list[_Chunk], keyword: str) -> Non
         raise src.error(f"part id {int(pids[too_big][0])} does not fit in 32 bits", row, keyword)
 
 
+def _check_parts_defined(deck) -> None:
+    """ParseError at the first element whose part id no ``*PART`` defines, when the deck
+    defines parts (a deck that defines none is a mesh file read without its parts)."""
+    groups = [(deck.shell_parts, deck.shell_chunks, "ELEMENT_SHELL"),
+              (deck.solid_parts, deck.solid_chunks, "ELEMENT_SOLID")]
+    if not deck.parts:
+        return
+    defined = np.array(sorted(deck.parts), np.int64)
+    for parts, chunks, keyword in groups:
+        if not parts:
+            continue
+        pids = np.concatenate(parts)
+        undefined = ~np.isin(pids, defined)
+        if undefined.any():
+            first = int(np.argmax(undefined))
+            src, row = _locate(chunks, first)
+            missing = np.unique(pids[undefined])
+            shown = ", ".join(str(int(p)) for p in defined[:8]) + (" ..." * (len(defined) > 8))
+            raise src.error(f"part id {int(pids[first])} is not defined by any *PART "
+                            f"({len(missing)} undefined part id(s); defined: {shown})", row,
+                            keyword)
+
+
 def _unique_or_raise(ids: np.ndarray, chunks: list[_Chunk], what: str):
     """(order, sorted ids) of ``ids``; a repeated id raises ParseError at its second definition."""
     order = np.argsort(ids, kind="stable")
@@ -194,7 +227,8 @@ def _unique_or_raise(ids: np.ndarray, chunks: list[_Chunk], what: str):
         first = int(order[np.searchsorted(sorted_ids, ids[second])])
         src0, row0 = _locate(chunks, first)
         src, row = _locate(chunks, second)
-        keyword = {"node": "NODE", "element": "ELEMENT_SHELL"}.get(what, "ELEMENT_SOLID")
+        keyword = {"node": "NODE", "element": "ELEMENT_SHELL",
+                   "thick shell": "ELEMENT_TSHELL"}.get(what, "ELEMENT_SOLID")
         raise src.error(f"{what} id {int(ids[second])} is defined twice (first at "
                         f"{src0.path.name}:{row0 + 1}); {len(repeated)} repeated id(s)", row,
                         keyword)

@@ -57,6 +57,10 @@ class _Source:
                 line = data.count(b"\n", 0, stray) + 1
                 raise ParseError(path, "a carriage return inside a line (a line end of another "
                                  "system, or a damaged file)", line=line)
+        nul = data.find(b"\x00")
+        if nul >= 0:
+            raise ParseError(path, "a NUL byte (binary data, or a damaged file)",
+                             line=data.count(b"\n", 0, nul) + 1)
         # a file that does not end with a line end may have been cut off: _table checks its
         # last card
         self.unterminated = bool(data) and not data.endswith(b"\n")
@@ -105,6 +109,22 @@ class _Block:
     def blank(self, row) -> bool:
         return not self.src.lines[row].strip()
 
+    def refuse_if_cut(self, row: int, widths, used: int) -> None:
+        """Refuse the card at ``row`` when it is the file's last line, no line end follows it,
+        and the file may end inside the first ``used`` fields read from it: fixed columns
+        shorter than those fields, or comma-separated fields with no comma after the last one
+        read (``5,0.,0.,17`` may be the start of ``5,0.,0.,1778``: nothing tells them apart)."""
+        if not self.src.unterminated or row != len(self.src.lines) - 1:
+            return
+        line = self.src.lines[row].rstrip()
+        if b"," in line:
+            complete = len(line.split(b",")) > used
+        else:
+            complete = len(line) >= _layout(widths[:used], self.fmt)[1][-1]
+        if not complete:
+            raise self.error("the file ends inside this card (no line end after it, and the "
+                             "last field read may be cut short)", row)
+
     def trimmed(self, period: int) -> np.ndarray:
         """The data rows less trailing blank lines, as many as keep the count off a multiple of
         ``period`` (a blank card is valid data; a stray blank line before the next keyword is not).
@@ -120,7 +140,7 @@ class _Block:
 @dataclass(frozen=True)
 class _Field:
     index: int  # position of the field on its card
-    kind: str  # "i" integer, "f" float
+    kind: str  # "i" integer, "id" integer written as one (an id), "f" float
     what: str  # what was expected, for messages
 
 
@@ -142,15 +162,20 @@ def _card_fields(line: bytes, widths, fmt: str) -> list[bytes]:
 def _convert(text: bytes, kind: str):
     """One field's value (blank = 0); ValueError when it is not a number of that kind.
 
-    An integer field also takes an integral float in any notation (``0.000E+00``, ``8.``), as
-    LS-DYNA reads it; a fractional or non-finite one is refused. Underscores (which Python's
-    number parsing would accept as digit separators) are refused in every field."""
+    An integer field ("i") also takes an integral float in any notation (``0.000E+00``,
+    ``8.``), as LS-DYNA reads it; a fractional or non-finite one is refused. An id field ("id":
+    node, element and part ids) takes integral floats in decimal notation only (``101.0``, as
+    other pre-processors write ids), never an exponent, so that ``1e1`` is no node 10.
+    Underscores (which Python's number parsing would accept as digit separators) are refused in
+    every field."""
     text = text.strip()
     if not text:
-        return 0 if kind == "i" else 0.0
+        return 0.0 if kind == "f" else 0
     if b"_" in text:
         raise ValueError(text)
-    if kind == "i":
+    if kind == "id" and any(c in text for c in b"eEdD"):
+        raise ValueError(text)
+    if kind in ("i", "id"):
         if text.lstrip(b"+-").isdigit():
             value = int(text)
         else:
@@ -188,15 +213,16 @@ def _fixed_column(chars: np.ndarray, start: int, width: int, kind: str,
     """Convert columns ``start:start+width`` of the (n, W) byte array; ValueError when one fails.
 
     Blank fields (spaces, or NUL padding past the end of a short line) read as 0, a Fortran
-    ``D`` exponent as ``E``, and an integer field takes an integral float (``0.000E+00``); all
-    three are only looked for when the plain conversion fails. Underscores are refused
-    (``underscores=False``: the caller knows there are none).
+    ``D`` exponent as ``E``, and an integer field takes an integral float (``0.000E+00``; an id
+    field, ``kind`` "id", without an exponent only); all three are only looked for when the
+    plain conversion fails. Underscores are refused (``underscores=False``: the caller knows
+    there are none).
     """
     sub = np.ascontiguousarray(chars[:, start:start + width])
     if underscores and (sub == ord("_")).any():
         raise ValueError("underscore in a numeric field")
     text = sub.view(f"S{width}").ravel()
-    dtype = np.int64 if kind == "i" else np.float64
+    dtype = np.float64 if kind == "f" else np.int64
     try:
         return text.astype(dtype)
     except ValueError:
@@ -206,6 +232,10 @@ def _fixed_column(chars: np.ndarray, start: int, width: int, kind: str,
         if width not in _BLANK_FIELD:
             _BLANK_FIELD[width] = np.frombuffer(b" " * (width - 1) + b"0", np.uint8)
         sub[blank] = _BLANK_FIELD[width]
+    if kind == "id":
+        letters = (sub == ord("e")) | (sub == ord("E")) | (sub == ord("d")) | (sub == ord("D"))
+        if letters.any():
+            raise ValueError("an id written with an exponent")
     exponent = (sub == ord("D")) | (sub == ord("d"))
     if exponent.any():
         sub[exponent] = ord("E")
@@ -241,16 +271,16 @@ def _table(block: _Block, rows: np.ndarray, widths, fields: list[_Field],
             keep[blank] = False
             rows, chars = rows[keep], chars[keep]
             lines = [line for line, k in zip(lines, keep.tolist()) if k]
-    out = [np.zeros(len(rows), np.int64 if f.kind == "i" else np.float64) for f in fields]
+    out = [np.zeros(len(rows), np.float64 if f.kind == "f" else np.int64) for f in fields]
     if len(rows) == 0:
         return rows, out
-    if block.src.unterminated and int(rows[-1]) == len(block.src.lines) - 1:
-        _check_complete(block, int(rows[-1]), widths, fields, span)
+    block.refuse_if_cut(int(rows[-1]), widths, max(f.index for f in fields) + 1)
     raw = chars.tobytes()
-    if raw.find(b",") < 0:  # memchr: cheaper than a per-row test when none
+    # a comma anywhere on the line makes the card comma-separated, also past the fields read
+    if b"\n".join(lines).find(b",") < 0:  # memchr: cheaper than a per-row test when none
         free = np.zeros(len(rows), bool)
     else:
-        free = (chars == ord(",")).any(axis=1)
+        free = np.array([b"," in line for line in lines], bool)
     fixed = ~free
     underscores = raw.find(b"_") >= 0
     try:
@@ -276,19 +306,6 @@ def _refuse_zero_ids(block: _Block, ids: np.ndarray, rows: np.ndarray, what: str
     """ParseError at the first card whose id is 0 (a blank field reads as 0)."""
     if not ids.all():
         raise block.error(f"expected {what}, got a blank or 0", int(rows[np.argmin(ids != 0)]))
-
-
-def _check_complete(block: _Block, row: int, widths, fields: list[_Field], span: int) -> None:
-    """Refuse the file's last card when the file ends inside it: no line end after it, and
-    fewer columns (or comma-separated fields) than the fields read from it."""
-    line = block.src.lines[row].rstrip()
-    if b"," in line:
-        complete = len(line.split(b",")) > max(f.index for f in fields)
-    else:
-        complete = len(line) >= span
-    if not complete:
-        raise block.error("the file ends inside this card (no line end after it): "
-                          "it was cut off", row)
 
 
 # --------------------------------------------------------------------------- records

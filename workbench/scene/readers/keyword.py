@@ -8,11 +8,14 @@ What is read:
   repeats its third node (``n3 == n4``, or n4 left blank); its nodes n5..n8 (8-node shells) are
   not kept. The mean nodal thickness (thickness cards, else the part's ``*SECTION_SHELL`` T1..T4)
   becomes the element field ``"thickness"`` (NaN where neither gives one);
-* ``*ELEMENT_SOLID``: element id, part id and n1..n8 on one card, or (the two-card layout of
-  newer decks) element id and part id, then n1..n8 on the next card; tetrahedra, pentahedra and
-  hexahedra by LS-DYNA's repeated-node conventions. Solids are drawn by their boundary faces
-  (faces used by one solid only; every face with ``all_faces``), each face keeping its solid's
-  id in ``element_ids`` and its part (:mod:`workbench.scene.solids`); their thickness is NaN;
+* ``*ELEMENT_SOLID`` (and its options ``_H8TOH20``, ``_H8TOH27``, ``_H8TOH64``,
+  ``_TET4TOTET10``, whose cards are the same), ``*ELEMENT_TSHELL`` (thick shells, read as the
+  8-node solids they are): element id, part id and n1..n8 on one card, or (the two-card layout
+  of newer decks) element id and part id, then n1..n8 on the next card; tetrahedra (n5..n8
+  repeating n4, or blank), pentahedra and hexahedra by LS-DYNA's repeated-node conventions.
+  They are drawn by their boundary faces (faces used by one solid only; every face with
+  ``all_faces``), each face keeping its element's id in ``element_ids`` and its part
+  (:mod:`workbench.scene.solids`); their thickness is NaN;
 * ``*PART`` (title line, then the card with pid and secid; several parts per keyword), the
   part-definition options (``_CONTACT``, ``_PRINT``, ...), titles becoming ``part_names``;
 * ``*SECTION_SHELL`` (and ``_TITLE``) T1..T4, with ``&name`` references to ``*PARAMETER`` values;
@@ -24,13 +27,20 @@ standard, I10 (``*KEYWORD I10=Y`` or a ``%`` after a keyword) and long (``*KEYWO
 ``+`` after a keyword; all fields 20 wide) formats are read; an ``*INCLUDE`` is read in the
 master deck's format unless its keyword names another one (``%``, ``+``, ``-``). Lines starting
 with ``$`` are comments; keywords are case-insensitive; any other keyword is skipped with its
-data. Node and element ids may be any integers; they are kept in ``node_ids`` / ``element_ids``
-and mapped to indices. Coordinates are taken as they are (millimetres by default).
+data, and every other ``*ELEMENT_...`` keyword (beams, SPH particles, discrete elements ...)
+is named in one :class:`~workbench.scene.readers.errors.ParseWarning` with its count. Node and
+element ids may be any integers (written as integers, or integral decimals such as ``101.0``;
+never with an exponent); they are kept in ``node_ids`` / ``element_ids`` and mapped to
+indices. Coordinates are taken as they are (millimetres by default).
 
 Refused with :class:`~workbench.scene.readers.errors.ParseError` (file, 1-based line, card text
-and what was expected): a malformed card, an element that names an undefined node, duplicate
-node or element ids, a deck without shell or solid elements, an undefined parameter, a missing
-or cyclic include, and the variants that would change the geometry if ignored
+and what was expected): a malformed card, a NUL byte, the file's last card when the file may
+end inside it (no line end after it, and fewer columns, or no comma after the last field read),
+an element that names an undefined node, a blank, negative or undefined part id (a deck without
+any ``*PART`` is a mesh file whose part ids are kept), duplicate node or element ids, a deck
+without shell or solid elements, an undefined parameter, a missing or cyclic include or one
+nested deeper than :data:`MAX_INCLUDE_DEPTH` files, and the variants that would change the
+geometry if ignored
 (``*INCLUDE_TRANSFORM``, ``*ELEMENT_SHELL_COMPOSITE``, ...). Large blocks are converted column by
 column with numpy; the per-card Python path only runs for free-format cards and to locate an
 error.
@@ -45,6 +55,7 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -59,12 +70,12 @@ from .cards import (
     _Chunk,
     _convert,
     _Field,
-    _layout,
     _refuse_zero_ids,
     _shown,
     _Source,
     _table,
 )
+from .errors import ParseWarning
 from .parameters import _Parameters
 
 # Card layouts in standard-format column widths; I10 widens fields under 10 to 10, long to 20.
@@ -77,6 +88,14 @@ _THICKNESS_OPTIONS = {"THICKNESS", "BETA", "MCID"}
 _PART_EXTRA_CARDS = {"CONTACT": 1, "PRINT": 1, "ATTACHMENT-NODES": 1, "REPOSITION": 1,
                      "AVERAGED": 0}
 _PART_SINGLE = {"INERTIA", "COMPOSITE", "LONG", "TSHELL"}
+# *ELEMENT_SOLID options whose cards are those of *ELEMENT_SOLID (the solver adds the nodes of
+# a higher-order element; the corners are drawn)
+_SOLID_AS_LINEAR = {"ELEMENT_SOLID_H8TOH20", "ELEMENT_SOLID_H8TOH27", "ELEMENT_SOLID_H8TOH64",
+                    "ELEMENT_SOLID_TET4TOTET10"}
+# element keywords not drawn whose records are one card each (others are counted in cards)
+_ONE_CARD_ELEMENTS = {"ELEMENT_BEAM", "ELEMENT_SPH", "ELEMENT_DISCRETE", "ELEMENT_MASS",
+                      "ELEMENT_SEATBELT", "ELEMENT_PLOTEL"}
+MAX_INCLUDE_DEPTH = 64
 _INCLUDE_REFUSED = ("INCLUDE_TRANSFORM", "INCLUDE_AUTO_OFFSET", "INCLUDE_NASTRAN",
                     "INCLUDE_BINARY")
 _KEYWORD_LINE = re.compile(r"\*\s*([A-Za-z0-9_]+)\s*([%+-])?(.*)$")
@@ -93,7 +112,12 @@ def read_keyword(path: str | os.PathLike[str], units: str = "mm",
     """
     deck = _Deck(Path(path))
     deck.read_file(Path(path), None)
-    return deck_mesh(deck, units, all_faces)
+    mesh = deck_mesh(deck, units, all_faces)
+    for name, cards in sorted(deck.skipped.items()):
+        what = f"{cards} element(s)" if name in _ONE_CARD_ELEMENTS else f"{cards} card(s)"
+        warnings.warn(ParseWarning(deck.master, f"{what} not drawn: *{name} is not read"),
+                      stacklevel=2)
+    return mesh
 
 
 # --------------------------------------------------------------------------- the deck
@@ -132,10 +156,11 @@ class _Deck:
     solid_parts: list[np.ndarray] = field(default_factory=list)
     solid_nodes: list[np.ndarray] = field(default_factory=list)
     solid_chunks: list[_Chunk] = field(default_factory=list)
+    solid_keywords: list[str] = field(default_factory=list)  # ELEMENT_SOLID or ELEMENT_TSHELL
     parts: dict[int, _Part] = field(default_factory=dict)
     sections: dict[object, _Section] = field(default_factory=dict)
     parameters: _Parameters = field(default_factory=_Parameters)
-    skipped: dict[str, int] = field(default_factory=dict)
+    skipped: dict[str, int] = field(default_factory=dict)  # keyword -> data cards not read
 
     # ------------------------------------------------------------- files and blocks
     def read_file(self, path: Path, fmt: str | None) -> None:
@@ -171,12 +196,14 @@ class _Deck:
             self._nodes(block)
         elif name.startswith("ELEMENT_SHELL"):
             self._shells(block)
-        elif name == "ELEMENT_SOLID":
+        elif name in ("ELEMENT_SOLID", "ELEMENT_TSHELL") or name in _SOLID_AS_LINEAR:
             self._solids(block)
         elif name.startswith("ELEMENT_SOLID"):
-            raise block.error(f"*{name} is not supported (read is *ELEMENT_SOLID)")
+            raise block.error(f"*{name} is not supported (read are *ELEMENT_SOLID and its "
+                              f"options {', '.join(sorted(o[14:] for o in _SOLID_AS_LINEAR))})")
         elif name.startswith("ELEMENT_"):
-            self.skipped[name] = self.skipped.get(name, 0) + 1
+            cards = sum(not block.blank(r) for r in block.rows.tolist())
+            self.skipped[name] = self.skipped.get(name, 0) + cards
         elif name == "PART" or name.startswith("PART_"):
             self._parts(block)
         elif name == "SECTION_SHELL" or name.startswith("SECTION_SHELL_"):
@@ -199,6 +226,9 @@ class _Deck:
     def _include(self, block: _Block, suffix: str | None) -> None:
         include_fmt = _SUFFIX_FORMAT[suffix] if suffix else self.default_fmt
         for text, row in _file_names(block, with_rows=True):
+            if len(self.reading) >= MAX_INCLUDE_DEPTH:
+                raise block.error(f"includes nested deeper than {MAX_INCLUDE_DEPTH} files "
+                                  f"(a chain of includes that does not end?)", row)
             target = self._resolve(block.src.path.parent, text)
             if target is None:
                 raise block.error(f"included file {text!r} not found", row)
@@ -223,7 +253,7 @@ class _Deck:
     # ------------------------------------------------------------- nodes and shells
     def _nodes(self, block: _Block) -> None:
         rows, (ids, x, y, z) = _table(block, block.rows, _NODE, [
-            _Field(0, "i", "an integer node id"), _Field(1, "f", "3 coordinates"),
+            _Field(0, "id", "an integer node id"), _Field(1, "f", "3 coordinates"),
             _Field(2, "f", "3 coordinates"), _Field(3, "f", "3 coordinates")], drop_blank=True)
         _refuse_zero_ids(block, ids, rows, "a node id")
         xyz = np.column_stack([x, y, z])
@@ -235,31 +265,39 @@ class _Deck:
         self.node_chunks.append(_Chunk(block.src, rows))
 
     def _solids(self, block: _Block) -> None:
-        """*ELEMENT_SOLID: one card (eid, pid, n1..n8) or two (eid, pid; n1..n8) per solid,
-        the layout told by the first card (nodes on it or not)."""
+        """*ELEMENT_SOLID (and its options in ``_SOLID_AS_LINEAR``) and *ELEMENT_TSHELL: one
+        card (eid, pid, n1..n8) or two (eid, pid; n1..n8) per element, the layout told by the
+        first card (nodes on it or not). A tetrahedron may leave n5..n8 blank."""
         rows = np.array([r for r in block.rows.tolist() if not block.blank(r)], np.int64)
         if len(rows) == 0:
             return
         first = _card_fields(block.src.lines[int(rows[0])], _SHELL, block.fmt)
         two_cards = not any(t.strip() for t in first[2:])
-        ids_fields = [_Field(0, "i", "an integer element id"), _Field(1, "i", "an integer part id")]
+        ids_fields = [_Field(0, "id", "an integer element id"),
+                      _Field(1, "id", "an integer part id")]
         if two_cards:
             if len(rows) % 2:
                 raise block.error("expected two cards per solid (eid pid; n1..n8), the block "
                                   "ends after one", int(rows[-1]))
             cards, values = _table(block, rows[0::2], _SHELL, ids_fields)
             _, nodes = _table(block, rows[1::2], (8,) * 8,
-                              [_Field(i, "i", "8 integer node ids") for i in range(8)])
+                              [_Field(i, "id", "8 integer node ids") for i in range(8)])
         else:
             cards, values = _table(block, rows, _SHELL, [
-                *ids_fields, *[_Field(i, "i", "8 integer node ids") for i in range(2, 10)]])
+                *ids_fields, *[_Field(i, "id", "8 integer node ids") for i in range(2, 10)]])
             values, nodes = values[:2], values[2:]
         ids = values[0]
         _refuse_zero_ids(block, ids, cards, "an element id")
+        _refuse_bad_part_ids(block, values[1], cards)
+        nodes = np.column_stack(nodes)
+        tetrahedra = (nodes[:, 4:] == 0).all(axis=1) & (nodes[:, :4] != 0).all(axis=1)
+        nodes[tetrahedra, 4:] = nodes[tetrahedra, 3:4]  # n5..n8 blank: n4 repeated
         self.solid_ids.append(ids)
         self.solid_parts.append(values[1])
-        self.solid_nodes.append(np.column_stack(nodes))
+        self.solid_nodes.append(nodes)
         self.solid_chunks.append(_Chunk(block.src, cards))
+        self.solid_keywords.append("ELEMENT_TSHELL" if block.keyword == "ELEMENT_TSHELL"
+                                   else "ELEMENT_SOLID")
 
     def _shells(self, block: _Block) -> None:
         options = set(filter(None, block.keyword[len("ELEMENT_SHELL"):].split("_")))
@@ -281,11 +319,12 @@ class _Deck:
                               f"after {len(rows) % per_element}", start)
         cards = rows[::per_element]
         cards, values = _table(block, cards, _SHELL, [
-            _Field(0, "i", "an integer element id"), _Field(1, "i", "an integer part id"),
-            *[_Field(i, "i", "4 integer node ids") for i in range(2, 6)]],
+            _Field(0, "id", "an integer element id"), _Field(1, "id", "an integer part id"),
+            *[_Field(i, "id", "4 integer node ids") for i in range(2, 6)]],
             drop_blank=per_element == 1)
         ids, pids = values[0], values[1]
         _refuse_zero_ids(block, ids, cards, "an element id")
+        _refuse_bad_part_ids(block, pids, cards)
         nodes = np.column_stack(values[2:6])
         thickness = np.full((len(cards), 4), np.nan)
         if has_thickness:
@@ -317,9 +356,10 @@ class _Deck:
                 raise block.error("expected a part card (pid, secid, mid, ...) after the title",
                                   int(rows[start]) if len(rows) else None)
             title_row, card_row = int(rows[start]), int(rows[start + 1])
+            block.refuse_if_cut(card_row, _TEN, 2)
             texts = _card_fields(block.src.lines[card_row], _TEN, block.fmt)
             try:
-                pid = _convert(texts[0], "i")
+                pid = _convert(texts[0], "id")
             except ValueError:
                 raise block.error(f"expected an integer part id, got {_shown(texts[0])!r}",
                                   card_row) from None
@@ -339,6 +379,7 @@ class _Deck:
                 raise block.error("expected two section cards (secid ...; t1 t2 t3 t4 ...)",
                                   int(rows[min(at, len(rows) - 1)]))
             first, second = int(rows[at]), int(rows[at + 1])
+            block.refuse_if_cut(second, _TEN, 4)
             texts = _card_fields(block.src.lines[first], _TEN, block.fmt)
             values = []
             for i, name in ((1, "ELFORM"), (3, "NIP"), (6, "ICOMP")):
@@ -357,6 +398,15 @@ class _Deck:
                 break
 
 
+def _refuse_bad_part_ids(block: _Block, pids: np.ndarray, rows: np.ndarray) -> None:
+    """ParseError at the first element card whose part id is blank, 0 or negative."""
+    bad = pids <= 0
+    if bad.any():
+        i = int(np.argmax(bad))
+        got = "a blank or 0" if pids[i] == 0 else str(int(pids[i]))
+        raise block.error(f"expected a positive part id, got {got}", int(rows[i]))
+
+
 def _first_break(block: _Block, rows: np.ndarray, per_element: int) -> tuple[int, str] | None:
     """(line, what was expected) of the first card of a multi-card element block whose kind
     breaks the record layout — an element card (integer element and part ids) where a
@@ -372,24 +422,14 @@ def _first_break(block: _Block, rows: np.ndarray, per_element: int) -> tuple[int
 
 
 def _eight_node(block: _Block, cards: np.ndarray) -> int | None:
-    """The line of the first element card with a node among n5..n8, or None."""
+    """The line of the first element card with a node among n5..n8, or None; ParseError at
+    a card whose n5..n8 are not integers."""
     if len(cards) == 0:
         return None
-    _, starts = _layout(_SHELL, block.fmt)
-    lines = block.src.pick(cards)
-    chars = np.array(lines, dtype=f"S{starts[10]}").view(np.uint8).reshape(len(lines), -1)
-    tail = chars[:, starts[6]:]
-    suspect = np.flatnonzero(((tail > 32) & (tail != ord("0"))).any(axis=1))
-    for i in suspect.tolist():
-        texts = _card_fields(lines[i], _SHELL, block.fmt)[6:10]
-        try:
-            if any(_convert(t, "i") for t in texts):
-                return int(cards[i])
-        except ValueError:
-            shown = ", ".join(repr(_shown(t)) for t in texts)
-            raise block.error(f"expected integer node ids n5..n8, got {shown}",
-                              int(cards[i])) from None
-    return None
+    _, tail = _table(block, cards, _SHELL, [_Field(i, "id", "integer node ids n5..n8")
+                                            for i in range(6, 10)])
+    named = (np.column_stack(tail) != 0).any(axis=1)
+    return int(cards[np.argmax(named)]) if named.any() else None
 
 
 def _keyword_format(options: str, current: str) -> str:

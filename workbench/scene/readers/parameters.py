@@ -4,27 +4,23 @@ references of section thicknesses to them.
 A ``*PARAMETER`` card holds pairs of a name (prefixed R, I or C for its type; R when none)
 and a value; ``*PARAMETER_EXPRESSION`` holds a name and an arithmetic expression, evaluated
 when the parameter is first used (:class:`_Expression`). Names are case-insensitive. Refused
-with :class:`~workbench.scene.readers.errors.ParseError`: a value that is no number, an
-expression that is not arithmetic of numbers and parameters, a parameter defined through
-itself, and a text parameter used as a number. A parameter that no card of the deck defines
-is a missing thickness (NaN) with a :class:`~workbench.scene.readers.errors.ParseWarning`.
+with :class:`~workbench.scene.readers.errors.ParseError` (file, line, parameter): a value that is
+no finite number, an expression that is not arithmetic of numbers and parameters, one beyond
+the bounds of :class:`_Expression` (length, nesting, exponent, time) or whose value is not
+finite, a parameter defined through itself, a text parameter used as a number, and a parameter
+that no card of the deck or its includes defines (an include read on its own cannot use the
+parameters of the deck that includes it).
 """
 
 from __future__ import annotations
 
-import ast
 import math
-import operator
-import warnings
-from dataclasses import dataclass
+import re
+import time
+from dataclasses import dataclass, field
 
 from .cards import _TEN, _Block, _card_fields, _convert, _shown, _Source, field_width
-from .errors import ParseError, ParseWarning
-
-
-class _Undefined(LookupError):
-    """A parameter that no *PARAMETER of the deck defines (its name in ``args[0]``)."""
-
+from .errors import ParseError
 
 _FUNCTIONS = {"sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin,
               "acos": math.acos, "atan": math.atan, "atan2": math.atan2, "sqrt": math.sqrt,
@@ -32,52 +28,262 @@ _FUNCTIONS = {"sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.as
               "max": max, "mod": math.fmod, "int": lambda x: float(math.trunc(x)),
               "nint": lambda x: float(round(x)), "sign": math.copysign,
               "sinh": math.sinh, "cosh": math.cosh, "tanh": math.tanh}
-_OPERATORS = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
-              ast.Div: operator.truediv, ast.Pow: operator.pow, ast.USub: operator.neg,
-              ast.UAdd: operator.pos}
+
+MAX_TERMS = 1_000  # numbers and names in one expression
+MAX_CHARACTERS = 10_000
+MAX_DEPTH = 32  # levels of parentheses, function calls, signs and powers
+MAX_DECADES = 308  # a power whose result would exceed about 10**308 (the float range)
+MAX_SECONDS = 1.0  # evaluating one expression
+
+_OPERAND = re.compile(r"(?:\d+\.?\d*|\.\d+)(?:[eEdD][+-]?\d+)?|[A-Za-z_][A-Za-z0-9_]*")
+_TOKEN = re.compile(r"\s*(?:(?P<number>(?:\d+\.?\d*|\.\d+)(?:[eEdD][+-]?\d+)?)"
+                    r"|&?(?P<name>[A-Za-z_][A-Za-z0-9_]*)|(?P<op>\*\*|[-+*/^(),]))")
+_SHOWN = 80  # characters of a long expression shown in a message
+
+
+def _count(n: int) -> str:
+    return f"{n:,}".replace(",", " ")
+
+
+def _abridged(text: str) -> str:
+    if len(text) <= _SHOWN:
+        return text
+    return f"{text[:_SHOWN]}… ({_count(len(text))} characters)"
+
+
+class _Refused(Exception):
+    """An expression the parser refuses; ``args[0]`` is the whole message."""
+
+
+class _Parser:
+    """Recursive descent over the tokens of an expression, into a postfix program of steps
+    ``("number", value, text)``, ``("name", name)``, ``("negate",)``, ``("binary", op)`` and
+    ``("call", function, n_arguments)``. Precedence as in Python: ``**`` (or ``^``, right to
+    left, binding tighter than a sign on its left) over ``* /`` over ``+ -``. Recursion goes one
+    level deeper only at parentheses, calls, signs and exponents, at most :data:`MAX_DEPTH`."""
+
+    def __init__(self, tokens: list[tuple[str, str]]):
+        self.tokens, self.at, self.depth, self.program = tokens, 0, 0, []
+
+    def parse(self) -> list[tuple]:
+        self.sum()
+        if self.at < len(self.tokens):
+            raise _Refused(f"expected an operator, got {self.tokens[self.at][1]!r}")
+        return self.program
+
+    def peek(self) -> str | None:
+        return self.tokens[self.at][1] if self.at < len(self.tokens) else None
+
+    def take(self, expected: str | None = None) -> tuple[str, str]:
+        if self.at >= len(self.tokens):
+            raise _Refused("the expression ends early" if expected is None
+                           else f"expected {expected!r} at the end")
+        token = self.tokens[self.at]
+        if expected is not None and token[1] != expected:
+            raise _Refused(f"expected {expected!r}, got {token[1]!r}")
+        self.at += 1
+        return token
+
+    def deeper(self, part) -> None:
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise _Refused(f"expression nested too deeply: more than {MAX_DEPTH} levels of "
+                           f"parentheses, calls, signs and powers")
+        part()
+        self.depth -= 1
+
+    def sum(self) -> None:
+        self.product()
+        while self.peek() in ("+", "-"):
+            op = self.take()[1]
+            self.product()
+            self.program.append(("binary", op))
+
+    def product(self) -> None:
+        self.signed()
+        while self.peek() in ("*", "/"):
+            op = self.take()[1]
+            self.signed()
+            self.program.append(("binary", op))
+
+    def signed(self) -> None:
+        if self.peek() in ("+", "-"):
+            op = self.take()[1]
+            self.deeper(self.signed)
+            if op == "-":
+                self.program.append(("negate",))
+        else:
+            self.power()
+
+    def power(self) -> None:
+        self.atom()
+        if self.peek() in ("**", "^"):
+            self.take()
+            self.deeper(self.signed)
+            self.program.append(("binary", "**"))
+
+    def atom(self) -> None:
+        kind, text = self.take()
+        if kind == "number":
+            self.program.append(("number", float(text.replace("D", "E").replace("d", "e")),
+                                 text))
+        elif kind == "name" and self.peek() == "(":
+            function = text.lower()
+            if function not in _FUNCTIONS:
+                raise _Refused(f"{text!r} is no function of an expression (known: "
+                               f"{', '.join(_FUNCTIONS)})")
+            self.take()
+            arguments = []
+
+            def listed():
+                self.sum()
+                arguments.append(1)
+                while self.peek() == ",":
+                    self.take()
+                    self.sum()
+                    arguments.append(1)
+
+            self.deeper(listed)
+            self.take(")")
+            self.program.append(("call", function, len(arguments)))
+        elif kind == "name":
+            self.program.append(("number", math.pi, text) if text.lower() == "pi"
+                                else ("name", text))
+        elif text == "(":
+            self.deeper(self.sum)
+            self.take(")")
+        else:
+            raise _Refused(f"expected a number, a parameter or '(', got {text!r}")
 
 
 @dataclass
 class _Expression:
-    """A ``*PARAMETER_EXPRESSION`` right-hand side: arithmetic (+ − * / ** or ^) of numbers,
-    other parameters (by name, or ``&name``) and the functions of :data:`_FUNCTIONS`."""
+    """A ``*PARAMETER_EXPRESSION`` right-hand side: arithmetic (+ − * / ** or ^, parentheses)
+    of numbers, other parameters (by name, or ``&name``), ``pi`` and the functions of
+    :data:`_FUNCTIONS`; parsed by :class:`_Parser`, never by Python's ``eval``.
 
+    Refused with ParseError naming file, line and parameter: more than :data:`MAX_TERMS`
+    numbers and names or :data:`MAX_CHARACTERS` characters, nesting deeper than
+    :data:`MAX_DEPTH`, a power whose result would exceed about 1e308 (:data:`MAX_DECADES`;
+    checked before it is computed), a step whose value is not finite, an evaluation longer
+    than :data:`MAX_SECONDS`, and anything else that does not evaluate (an unknown function,
+    division by zero, a domain error)."""
+
+    name: str
     text: str
     src: _Source
     row: int
+    _program: list[tuple] | None = field(default=None, repr=False)
+
+    def fail(self, what: str) -> ParseError:
+        """A ParseError at this expression's line about parameter ``name``."""
+        return ParseError(self.src.path, f"parameter {self.name!r}: {what}", line=self.row + 1,
+                          card=_abridged(self.src.card(self.row)),
+                          keyword="PARAMETER_EXPRESSION")
+
+    @property
+    def program(self) -> list[tuple]:
+        """The postfix steps of :class:`_Parser`, the bounds on length and nesting checked."""
+        if self._program is None:
+            self._program = self._compile()
+        return self._program
+
+    @property
+    def uses(self) -> list[str]:
+        """The names of the parameters the expression uses, as written."""
+        return [step[1] for step in self.program if step[0] == "name"]
+
+    def _compile(self) -> list[tuple]:
+        text = self.text
+        terms = len(_OPERAND.findall(text))
+        if terms > MAX_TERMS:
+            raise self.fail(f"expression too long: {_count(terms)} terms, at most "
+                            f"{_count(MAX_TERMS)}")
+        if len(text) > MAX_CHARACTERS:
+            raise self.fail(f"expression too long: {_count(len(text))} characters, at most "
+                            f"{_count(MAX_CHARACTERS)}")
+        level = deepest = 0
+        for character in text:
+            if character == "(":
+                level += 1
+                deepest = max(deepest, level)
+            elif character == ")":
+                level -= 1
+        if deepest > MAX_DEPTH:
+            raise self.fail(f"expression nested too deeply: {_count(deepest)} levels of "
+                            f"parentheses, at most {MAX_DEPTH}")
+        tokens, at = [], 0
+        while at < len(text):
+            match = _TOKEN.match(text, at)
+            if match is None:
+                if not text[at:].strip():
+                    break
+                raise self.fail(f"cannot evaluate the expression {_abridged(text)!r}: "
+                                f"unexpected {text[at:].lstrip()[0]!r}")
+            tokens.append((match.lastgroup, match.group(match.lastgroup)))
+            at = match.end()
+        try:
+            return _Parser(tokens).parse()
+        except _Refused as refused:
+            message = refused.args[0]
+            if not message.startswith("expression nested"):
+                message = f"cannot evaluate the expression {_abridged(text)!r}: {message}"
+            raise self.fail(message) from None
 
     def evaluate(self, lookup) -> float:
-        """The float value, names resolved by ``lookup(name)``; ParseError for anything else
-        (unknown functions, text, division by zero), naming the expression's line."""
-        source = self.text.replace("&", "").replace("^", "**")
+        """The finite float value, each parameter name resolved by ``lookup(name)`` (a float,
+        or a text for a text parameter); ParseError as the class says."""
+        deadline = time.monotonic() + MAX_SECONDS
+        stack: list[float] = []
         try:
-            tree = ast.parse(source, mode="eval")
-            return float(self._value(tree.body, lookup))
-        except _Undefined:
-            raise
+            for step in self.program:
+                if time.monotonic() > deadline:
+                    raise self.fail(f"evaluating the expression took more than "
+                                    f"{MAX_SECONDS:g} s")
+                kind = step[0]
+                if kind == "number":
+                    value, shown = step[1], step[2]
+                elif kind == "name":
+                    value, shown = lookup(step[1]), f"parameter {step[1]!r}"
+                    if not isinstance(value, float):
+                        raise self.fail(f"parameter {step[1]!r} is a text, not a number")
+                elif kind == "negate":
+                    value, shown = -stack.pop(), "a negation"
+                elif kind == "call":
+                    arguments = stack[len(stack) - step[2]:]
+                    del stack[len(stack) - step[2]:]
+                    value = float(_FUNCTIONS[step[1]](*arguments))
+                    shown = f"{step[1]}({', '.join(f'{a:g}' for a in arguments)})"
+                else:
+                    right, left = stack.pop(), stack.pop()
+                    value = self._binary(step[1], left, right)
+                    shown = f"{left:g} {step[1]} {right:g}"
+                if not math.isfinite(value):
+                    raise self.fail(f"the value is not finite: {shown} is {value}")
+                stack.append(value)
         except ParseError:
             raise
-        except (SyntaxError, ValueError, TypeError, ZeroDivisionError, OverflowError) as exc:
-            raise self.src.error(f"cannot evaluate the expression {self.text!r}: {exc}",
-                                 self.row, "PARAMETER_EXPRESSION") from None
+        except (ValueError, TypeError, ZeroDivisionError, OverflowError) as exc:
+            raise self.fail(f"cannot evaluate the expression {_abridged(self.text)!r}: "
+                            f"{exc}") from None
+        return stack[0]
 
-    def _value(self, node, lookup):
-        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)):
-            return node.value
-        if isinstance(node, ast.Name):
-            if node.id.lower() == "pi":
-                return math.pi
-            return lookup(node.id)
-        if isinstance(node, ast.BinOp) and type(node.op) in _OPERATORS:
-            return _OPERATORS[type(node.op)](self._value(node.left, lookup),
-                                             self._value(node.right, lookup))
-        if isinstance(node, ast.UnaryOp) and type(node.op) in _OPERATORS:
-            return _OPERATORS[type(node.op)](self._value(node.operand, lookup))
-        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
-                and node.func.id.lower() in _FUNCTIONS and not node.keywords:
-            return _FUNCTIONS[node.func.id.lower()](*(self._value(a, lookup) for a in node.args))
-        raise ValueError(f"{ast.unparse(node)!r} is not arithmetic of numbers and parameters")
-
+    def _binary(self, op: str, left: float, right: float) -> float:
+        if op == "+":
+            return left + right
+        if op == "-":
+            return left - right
+        if op == "*":
+            return left * right
+        if op == "/":
+            return left / right
+        if left != 0.0 and abs(left) != 1.0:
+            decades = right * math.log10(abs(left))
+            if decades > MAX_DECADES:
+                size = f"about 1e{decades:.0f}" if decades < 1e15 else "far beyond that"
+                raise self.fail(f"exponent too large: {left:g} ** {right:g} is {size}, at "
+                                f"most about 1e{MAX_DECADES}")
+        return math.pow(left, right)
 
 
 class _Parameters:
@@ -86,10 +292,11 @@ class _Parameters:
 
     def __init__(self):
         self.values: dict[str, object] = {}
+        self.folded: dict[str, str] = {}  # lower-case name -> name as defined
 
     def read(self, block: _Block, expressions: bool) -> None:
         """Add the parameters of a ``*PARAMETER`` block, or with ``expressions`` of a
-        ``*PARAMETER_EXPRESSION`` block; ParseError at a value that is no number."""
+        ``*PARAMETER_EXPRESSION`` block; ParseError at a value that is no finite number."""
         for row in block.rows.tolist():
             line = block.src.lines[row]
             if not line.strip():
@@ -100,9 +307,7 @@ class _Parameters:
                 else:
                     width = field_width(10, block.fmt)
                     head, expression = line[:width], line[width:]
-                names = [head]
-                values = [_Expression(expression.decode("utf-8", "replace").strip(),
-                                      block.src, row)]
+                names, values = [head], [expression]
             else:
                 texts = _card_fields(line, _TEN, block.fmt)
                 names, values = texts[0::2], texts[1::2]
@@ -115,59 +320,106 @@ class _Parameters:
                     name = name[1:].strip()
                 else:
                     kind = "R"
-                if isinstance(value, _Expression):
-                    self.values[name] = value  # evaluated when used
+                if expressions:  # evaluated when used
+                    value = _Expression(name, value.decode("utf-8", "replace").strip(),
+                                        block.src, row)
                 elif kind == "C":
-                    self.values[name] = value.decode("utf-8", "replace").strip()
+                    value = value.decode("utf-8", "replace").strip()
                 else:
+                    text = value
                     try:
-                        self.values[name] = _convert(value, "f")
+                        value = _convert(text, "f")
                     except ValueError:
                         raise block.error(f"expected a number for parameter {name!r}, got "
-                                          f"{_shown(value)!r}", row) from None
+                                          f"{_shown(text)!r}", row) from None
+                    if not math.isfinite(value):
+                        raise block.error(f"expected a finite number for parameter {name!r}, "
+                                          f"got {_shown(text)!r}", row)
+                self.values[name] = value
+                self.folded[name.lower()] = name
 
     def thickness(self, text: bytes, src: _Source, row: int) -> float:
-        """A section thickness field: a number or a (signed) ``&name`` reference, evaluated
-        when its parameter is an expression. A parameter defined nowhere (an include read on its
-        own, whose including deck defines it) is NaN with a :class:`ParseWarning` naming file,
-        line and parameter: the geometry is still drawn, the thickness is missing."""
+        """A section thickness field (mm): a finite number or a (signed) ``&name`` reference,
+        evaluated when its parameter is an expression; ParseError naming file and line for
+        anything else, a parameter defined nowhere included."""
         text = text.strip()
         sign = -1.0 if text.startswith(b"-") else 1.0
         if text.lstrip(b"+-").startswith(b"&"):
             name = text.lstrip(b"+-")[1:].decode("utf-8", "replace").strip()
-            try:
-                value = self.value(name, src, row, ())
-            except _Undefined as undefined:
-                warnings.warn(ParseWarning(src.path, f"parameter {undefined.args[0]!r} is not "
-                                           f"defined by *PARAMETER in this deck or its includes: "
-                                           f"the thickness is missing", row + 1,
-                                           "SECTION_SHELL"), stacklevel=2)
-                return float("nan")
-            return sign * value
+            if not name:
+                raise src.error("expected a parameter name after '&'", row, "SECTION_SHELL")
+            return sign * self.value(name, src, row)
         try:
-            return _convert(text, "f")
+            number = _convert(text, "f")
         except ValueError:
             raise src.error(f"expected a thickness, got {_shown(text)!r}", row,
                             "SECTION_SHELL") from None
+        if not math.isfinite(number):
+            raise src.error(f"expected a finite thickness, got {_shown(text)!r}", row,
+                            "SECTION_SHELL")
+        return number
 
-    def value(self, name: str, src: _Source, row: int, chain: tuple) -> float:
+    def value(self, name: str, src: _Source, row: int) -> float:
         """The number parameter ``name`` stands for (names are case-insensitive), evaluating
-        ``*PARAMETER_EXPRESSION`` arithmetic; _Undefined for a name defined nowhere, ParseError
-        for a text parameter, a bad expression or a cycle."""
-        if name not in self.values:
-            folded = {k.lower(): k for k in self.values}
-            if name.lower() not in folded:
-                raise _Undefined(name)
-            name = folded[name.lower()]
-        value = self.values[name]
-        if isinstance(value, _Expression):
-            if name in chain:
-                raise value.src.error(f"parameter {name!r} is defined through itself: "
-                                      f"{' -> '.join((*chain, name))}", value.row,
-                                      "PARAMETER_EXPRESSION")
-            value = value.evaluate(lambda n: self.value(n, src, row, (*chain, name)))
-            self.values[name] = value
+        ``*PARAMETER_EXPRESSION`` arithmetic; ParseError at line ``row`` of ``src`` for a name
+        defined nowhere or a text parameter, at the expression's line for a bad expression or
+        a cycle."""
+        key = self._key(name)
+        if key is None:
+            raise src.error(self._undefined(name), row, "SECTION_SHELL")
+        if isinstance(self.values[key], _Expression):
+            self._evaluate(key)
+        value = self.values[key]
         if not isinstance(value, float):
-            raise src.error(f"parameter {name!r} is not a number", row, "SECTION_SHELL")
+            raise src.error(f"parameter {key!r} is a text, not a number", row, "SECTION_SHELL")
         return value
 
+    def _key(self, name: str) -> str | None:
+        if name in self.values:
+            return name
+        return self.folded.get(name.lower())
+
+    def _undefined(self, name: str) -> str:
+        defined = list(self.values)
+        if not defined:
+            known = "it defines no parameter"
+        else:
+            known = "defined: " + ", ".join(repr(n) for n in defined[:5])
+            if len(defined) > 5:
+                known += f" and {_count(len(defined) - 5)} more"
+        return (f"parameter {name!r} is not defined by *PARAMETER in this deck or its "
+                f"includes ({known})")
+
+    def _evaluate(self, root: str) -> None:
+        """Replace the expression of ``root``, and first those of the parameters it uses,
+        by their values: depth first with an explicit stack, so that a long chain of
+        parameters defined through parameters needs no recursion."""
+        path = [root]  # each waits for the parameters its expression uses
+        on_path = {root}
+        progress = [0]  # how many of its uses are resolved
+        while path:
+            name = path[-1]
+            expression = self.values[name]
+            uses = expression.uses
+            while progress[-1] < len(uses):
+                used = uses[progress[-1]]
+                key = self._key(used)
+                if key is None:
+                    raise expression.fail(self._undefined(used))
+                if isinstance(self.values[key], _Expression):
+                    if key in on_path:
+                        cycle = self.values[key]
+                        raise cycle.src.error(
+                            f"parameter {key!r} is defined through itself: "
+                            f"{' -> '.join((*path[path.index(key):], key))}", cycle.row,
+                            "PARAMETER_EXPRESSION")
+                    break
+                progress[-1] += 1
+            if progress[-1] < len(uses):
+                path.append(key)
+                on_path.add(key)
+                progress.append(0)
+                continue
+            self.values[name] = expression.evaluate(lambda n: self.values[self._key(n)])
+            on_path.discard(path.pop())
+            progress.pop()
