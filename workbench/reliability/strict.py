@@ -454,5 +454,5 @@ def mesh_differences(mesh, expected: Expected) -> list[str]:
         if not same.all():
             k = int(np.argmin(same))
             out.append(f"thickness of {int((~same).sum())} element(s): element {int(eids[k])} "
-                       f"read {read_t[k]!r}, expected {expected.thickness[k]!r}")
+                       f"read {float(read_t[k])!r}, expected {float(expected.thickness[k])!r}")
     return out
