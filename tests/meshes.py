@@ -134,3 +134,20 @@ def barycentric_grid(n: int) -> tuple[np.ndarray, np.ndarray]:
     i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1))
     keep = i + j <= n
     return i[keep] / n, j[keep] / n
+
+
+def write_keyword_deck(mesh, file, parts: bool = False) -> None:
+    """Write ``mesh`` as a standard-format keyword deck (ids from 1); with ``parts`` a *PART
+    per part id (title ``part <id>``) and their *SECTION_SHELL 1 (1.0 thick)."""
+    lines = ["*KEYWORD"]
+    if parts:
+        for pid in sorted(set(mesh.parts.tolist())):
+            lines += ["*PART", f"part {pid}", f"{pid:10d}{1:10d}"]
+        lines += ["*SECTION_SHELL", "         1", "       1.0       1.0       1.0       1.0"]
+    lines.append("*NODE")
+    lines += [f"{i + 1:8d}{p[0]:16.8f}{p[1]:16.8f}{p[2]:16.8f}" for i, p in enumerate(mesh.nodes)]
+    lines.append("*ELEMENT_SHELL")
+    lines += [f"{i + 1:8d}{pid:8d}" + "".join(f"{n + 1:8d}" for n in e)
+              for i, (e, pid) in enumerate(zip(mesh.elements, mesh.parts))]
+    lines.append("*END")
+    file.write_text("\n".join(lines) + "\n")

@@ -8,6 +8,7 @@ import math
 import re
 
 import pytest
+from meshes import write_keyword_deck
 
 from workbench.algo.explode import occlusion_ratio
 from workbench.cli import main
@@ -146,19 +147,6 @@ def test_a_far_node_no_element_uses_does_not_stop_the_render(ctx, tmp_path):
 FRAME = re.compile(r"frame +(\d+)/(\d+): offset \S+, r \S+ \((\d+) of (\d+) px visible\)")
 
 
-def _write_deck(mesh, file) -> None:
-    lines = ["*KEYWORD"]
-    for pid in sorted(set(mesh.parts.tolist())):
-        lines += ["*PART", f"part {pid}", f"{pid:10d}{1:10d}"]
-    lines += [*SECTION, "*NODE"]
-    lines += [f"{i + 1:8d}{p[0]:16.8f}{p[1]:16.8f}{p[2]:16.8f}" for i, p in enumerate(mesh.nodes)]
-    lines.append("*ELEMENT_SHELL")
-    lines += [f"{i + 1:8d}{pid:8d}" + "".join(f"{n + 1:8d}" for n in e)
-              for i, (e, pid) in enumerate(zip(mesh.elements, mesh.parts))]
-    lines.append("*END")
-    file.write_text("\n".join(lines) + "\n")
-
-
 def _explode(deck, out, frames: int, capsys) -> tuple[list[tuple[int, int]], str]:
     """((p_occ, p_unocc) per frame as printed, the last line) of a run at view 30,25 with
     ratio exponent 1 (the thesis's: several frames to the reveal)."""
@@ -180,7 +168,7 @@ def _first_revealed(counts: list[tuple[int, int]]) -> int | None:
 @pytest.fixture
 def box_deck(tmp_path):
     deck = tmp_path / "box.k"
-    _write_deck(box_in_box(1.0, 0.2), deck)
+    write_keyword_deck(box_in_box(1.0, 0.2), deck, parts=True)
     return deck
 
 
@@ -205,7 +193,7 @@ def test_explode_says_when_the_focus_was_not_revealed(ctx, box_deck, tmp_path, c
 def test_explode_refuses_a_focus_without_pixels(ctx, tmp_path, capsys):
     """The inner box, 2e-6 wide, lies between the pixel centres of a 96 x 80 image."""
     deck = tmp_path / "tiny.k"
-    _write_deck(box_in_box(1.0, 1e-6), deck)
+    write_keyword_deck(box_in_box(1.0, 1e-6), deck, parts=True)
     out = tmp_path / "tiny.gif"
     assert main(["explode", str(deck), "--focus", "7", "--view", "0,0", "--frames", "5",
                  "--size", "96x80", "-o", str(out)]) == 2

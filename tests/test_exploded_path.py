@@ -3,6 +3,7 @@ occlusion counts, reveal, picking after the explosion, the animation, the CLI an
 
 import numpy as np
 import pytest
+from meshes import write_keyword_deck
 from PIL import Image
 
 from workbench.algo.explode import cull_back_faces
@@ -201,19 +202,9 @@ def test_ghosted_front_half_is_translucent(prepared):
     assert (ghost[:, : SIZE[0] // 2 - 20] == opaque[:, : SIZE[0] // 2 - 20]).all()
 
 
-def _write_k(mesh, file):
-    lines = ["*KEYWORD", "*NODE"]
-    lines += [f"{i + 1:8d}{p[0]:16.8f}{p[1]:16.8f}{p[2]:16.8f}" for i, p in enumerate(mesh.nodes)]
-    lines.append("*ELEMENT_SHELL")
-    lines += [f"{i + 1:8d}{pid:8d}" + "".join(f"{n + 1:8d}" for n in e)
-              for i, (e, pid) in enumerate(zip(mesh.elements, mesh.parts))]
-    lines.append("*END")
-    file.write_text("\n".join(lines) + "\n")
-
-
 def test_cli_writes_gif(ctx, mesh, tmp_path, capsys):
     deck = tmp_path / "box.k"
-    _write_k(mesh, deck)
+    write_keyword_deck(mesh, deck)
     out = tmp_path / "out.gif"
     status = main(["explode", str(deck), "--focus", "7", "--view", "0,0", "--plane", "x",
                    "--frames", "12", "--size", "96x80", "-o", str(out)])
@@ -234,7 +225,7 @@ def test_cli_writes_gif(ctx, mesh, tmp_path, capsys):
 
 def test_cli_refuses_missing_part(ctx, mesh, tmp_path, capsys):
     deck = tmp_path / "box.k"
-    _write_k(mesh, deck)
+    write_keyword_deck(mesh, deck)
     status = main(["explode", str(deck), "--focus", "9", "-o", str(tmp_path / "x.gif")])
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1
