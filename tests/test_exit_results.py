@@ -71,7 +71,6 @@ def test_a_sweep_point_that_draws_nothing_fails_with_that_reason(ctx, monkeypatc
 
 
 # ------------------------------------------------------------------------------- render
-SECTION = ["*SECTION_SHELL", "         1", "       1.0       1.0       1.0       1.0"]
 PLATE_AND_FAR_STRIP = """*KEYWORD
 *PART
 plate
