@@ -165,3 +165,60 @@ def test_software_domains_composite_to_the_one_process_image(client, by, domains
     assert np.array_equal(frame.depth, everything.depth)
     assert np.array_equal(frame.triangle, everything.triangle)
     assert stats.bytes_moved > 0 and stats.workers == 2
+
+
+@pytest.mark.parametrize("method", ["tree", "swap"])
+def test_chunked_domains_composite_to_the_one_process_image(client, tmp_path, method):
+    """Each worker loads only its domains of a chunked scene on disk; the composite equals the
+    one-process image, and every worker reports its peak memory."""
+    from workbench.experiment.bigscene import run_chunked_sortlast, write_semicylinders_chunked
+
+    folder = write_semicylinders_chunked(tmp_path / "scene", 4, 12, bands=6)
+    image, run = run_chunked_sortlast(client, folder, (160, 120), method=method,
+                                      view=(20.0, 10.0))
+    assert run.equal and run.triangles == 4 * 2 * 12 * 12 and run.domains == 4
+    assert run.workers == 2 and run.bytes_moved > 0
+    assert len(run.peak_mib) == 2 and all(v > 50 for v in run.peak_mib.values())
+    assert (image[..., :3] < 250).any(axis=-1).sum() > 5000
+
+
+def test_chunked_sortlast_on_a_scheduler_and_workers_started_apart(tmp_path):
+    """The chunked scene rendered on a scheduler and two workers started as their own
+    processes (the command-line tools of distributed), as on a real cluster."""
+    import json
+    import subprocess
+    import sys
+    import time
+
+    from workbench.experiment.bigscene import run_chunked_sortlast, write_semicylinders_chunked
+
+    folder = write_semicylinders_chunked(tmp_path / "scene", 3, 8, bands=4)
+    scheduler_file = tmp_path / "scheduler.json"
+    started = []
+    try:
+        started.append(subprocess.Popen(
+            [sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
+             "--port", "0", "--no-dashboard", "--scheduler-file", str(scheduler_file)],
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        deadline = time.monotonic() + 60
+        while not scheduler_file.exists():
+            assert time.monotonic() < deadline and started[0].poll() is None
+            time.sleep(0.1)
+        time.sleep(0.2)  # the file is complete once its JSON parses
+        address = json.loads(scheduler_file.read_text())["address"]
+        started.append(subprocess.Popen(
+            [sys.executable, "-m", "distributed.cli.dask_worker", address, "--host",
+             "127.0.0.1", "--nworkers", "2", "--nthreads", "1", "--no-dashboard"],
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        with Client(address, timeout=30) as remote:
+            remote.wait_for_workers(2, timeout=60)
+            _, run = run_chunked_sortlast(remote, folder, (96, 80), method="tree")
+        assert run.equal and run.workers == 2 and run.domains == 3
+    finally:
+        for proc in reversed(started):
+            proc.terminate()
+            try:
+                proc.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()

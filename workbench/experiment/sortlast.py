@@ -97,6 +97,40 @@ class SoftwareDomains:
 _PREPARED: dict = {}
 
 
+@dataclass(frozen=True)
+class ChunkDomains:
+    """A picklable ``render_domain`` for :func:`render_sortlast` over a chunked scene on disk
+    (:mod:`workbench.paths.chunked`): called with a domain number, a worker loads only that
+    domain's files from ``folder`` and draws it with ``camera``, ``size`` (W, H) and raster
+    ``options`` — no worker holds the whole scene. ``folder`` must be readable by every
+    worker (a shared file system on a real cluster)."""
+
+    folder: str
+    camera: Camera
+    size: tuple[int, int]
+    options: RasterOptions | None = None
+
+    def __call__(self, index: int) -> Frame:
+        from ..paths.chunked import ChunkedScene
+
+        chunk = ChunkedScene(self.folder).load(int(index))
+        return chunk.render(self.camera, self.size, self.options)
+
+
+def peak_memory_mib(client: Client) -> dict[str, float]:
+    """Peak resident memory (MiB) of every worker process of ``client``'s cluster so far, by
+    worker address (``getrusage``'s maximum resident set size)."""
+    return client.run(_peak_rss_mib)
+
+
+def _peak_rss_mib() -> float:
+    import resource
+    import sys
+
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / (1024 * 1024) if sys.platform == "darwin" else peak / 1024
+
+
 @sizeof.register(Frame)
 def _sizeof_frame(frame: Frame) -> int:
     """A frame's size to Dask (memory accounting, placement, transfer logs): its array bytes."""
@@ -137,15 +171,16 @@ def render_sortlast(client: Client, render_domain: Callable[[np.ndarray], Frame]
     """Render each domain with ``render_domain`` on the cluster of ``client`` and composite
     the frames by ``method`` (``"tree"``: binary tree; ``"swap"``: binary swap) on the workers.
 
-    ``render_domain`` is a picklable callable taking one int64 array of triangle indices and
-    returning that domain's :class:`Frame` of the whole image; ``domains`` lists the arrays
-    (e.g. from :func:`workbench.scene.domains.split_domains`), frame i coming from domain i.
+    ``render_domain`` is a picklable callable taking one domain and returning that domain's
+    :class:`Frame` of the whole image; ``domains`` lists them, frame i coming from domain i:
+    int64 arrays of triangle indices (e.g. from :func:`workbench.scene.domains.split_domains`,
+    for :class:`SoftwareDomains`) or domain numbers (for :class:`ChunkDomains`).
     Returns the composite — exactly ``functools.reduce(composite, frames)`` — and its
     :class:`SortLastStats`.
 
-    Refused (ValueError): an unknown ``method``; no domains; a domain that is not a 1-D array
-    of integers; domain frames of different sizes. An error raised by ``render_domain``
-    reaches the caller as raised.
+    Refused (ValueError): an unknown ``method``; no domains; a domain that is neither a 1-D
+    array of integers nor an integer; domain frames of different sizes. An error raised by
+    ``render_domain`` reaches the caller as raised.
     """
     if method not in METHODS:
         raise ValueError(f"unknown compositing method {method!r}: expected one of "
@@ -189,7 +224,11 @@ def render_sortlast(client: Client, render_domain: Callable[[np.ndarray], Frame]
     return result, stats
 
 
-def _domain(d, i: int) -> np.ndarray:
+def _domain(d, i: int):
+    """A domain as ``render_domain`` takes it: an int64 array of triangle indices, or a domain
+    number (a chunked scene's, :class:`ChunkDomains`)."""
+    if isinstance(d, (int, np.integer)) and not isinstance(d, bool):
+        return int(d)
     a = np.asarray(d)
     if a.ndim != 1 or not (np.issubdtype(a.dtype, np.integer) or a.size == 0):
         raise ValueError(f"domain {i} must be a 1-D array of triangle indices, got "

@@ -17,6 +17,7 @@ rasterizer is orthographic, as es2008's), MSAA samples.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -39,6 +40,23 @@ DEFAULT_OPTIONS = RasterOptions()  # frozen: one instance serves as every path's
 SHADING_OF = {"position": "constant", "flat": "flat", "gouraud": "gouraud",
               "vertex_color": "vertex_color", "pixel_color": "pixel_color",
               "element_color": "element_color"}
+
+
+@dataclass(eq=False)
+class RasterInputs:
+    """The arrays a software path rasterizes (see :meth:`SoftwarePath.raster_inputs`):
+    ``coordinates`` (V, 3) float64 drawn vertex positions (model units), ``normals`` (V, 3)
+    float32 or None, ``values`` (V,) normalised field or None, ``triangle_values`` (K,) or None,
+    ``triangles`` (K, 3) int64 into the vertices, the ``shading`` and the model-space
+    ``clip_planes`` (P, 4)."""
+
+    coordinates: np.ndarray
+    normals: np.ndarray | None
+    values: np.ndarray | None
+    triangle_values: np.ndarray | None
+    triangles: np.ndarray
+    shading: Shading
+    clip_planes: np.ndarray
 
 
 class SoftwareTarget:
@@ -210,6 +228,19 @@ class SoftwarePath(RenderPath):
                           normals=self._normals, values=self._values, triangle_values=tv,
                           clip_planes=self._planes, background=background)
         return frame
+
+    def raster_inputs(self) -> RasterInputs:
+        """What :meth:`draw` rasterizes at the current step, for writing it elsewhere
+        (:func:`workbench.paths.chunked.write_chunked`): float64 drawn vertex coordinates,
+        normals, values, triangles, shading and model-space clip planes."""
+        if self.mesh is None:
+            raise ValueError(f"software path {self.name!r} is not prepared")
+        shown = self.data.shown_coordinates(self.step)
+        coordinates = shown if self.data.vertex_node is None else shown[self.data.vertex_node]
+        return RasterInputs(np.ascontiguousarray(coordinates, np.float64), self._normals,
+                            self._values, self._triangle_values, self._triangles,
+                            self._shading, np.array(self.style.clip_planes,
+                                                    np.float64).reshape(-1, 4))
 
     def release(self) -> None:
         self.mesh = None
