@@ -17,6 +17,7 @@ from distributed import Client, LocalCluster
 from workbench.algo.softraster.composite import binary_swap, binary_tree, swap_plan, tree_plan
 from workbench.algo.softraster.frame import Frame
 from workbench.experiment.sortlast import SortLastStats, render_sortlast
+from workbench.scene.generators import semicylinders
 
 # the workers cannot import this test module: ship its functions by value
 cloudpickle.register_pickle_by_value(sys.modules[__name__])
@@ -149,7 +150,6 @@ def test_software_domains_composite_to_the_one_process_image(client, by, domains
     from workbench.experiment.sortlast import SoftwareDomains
     from workbench.paths import Style
     from workbench.scene.domains import split_domains
-    from workbench.scene.generators import semicylinders
 
     mesh = semicylinders(4, 12)
     size = (160, 120)
@@ -222,3 +222,43 @@ def test_chunked_sortlast_on_a_scheduler_and_workers_started_apart(tmp_path):
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait()
+
+
+@pytest.mark.parametrize("name,style", [("pixel_color", {"field": "distance", "bands": 6}),
+                                        ("gouraud", {}), ("flat", {})])
+@pytest.mark.parametrize("method", ["tree", "swap"])
+def test_gl_domains_composite_to_the_one_context_image(client, name, style, method):
+    """Each worker draws its domains through its own EGL context and reads back colour, depth
+    and the winning triangle: the composite is the image one context draws, pixel for pixel."""
+    from workbench.experiment.measure import default_camera
+    from workbench.experiment.sortlast import GLDomains
+    from workbench.paths import Style
+    from workbench.scene.domains import split_domains
+
+    mesh = semicylinders(8, 12)
+    size = (160, 120)
+    camera = default_camera(mesh, size, view=(20.0, 10.0), up="y")
+    render_domain = GLDomains("semicylinders:12", name, Style(**style), camera, size)
+    _, path, target, _ = render_domain.prepared()
+    target.use()
+    target.clear()
+    path.draw()  # the whole scene through one context, as render and measure draw it
+    reference = target.read()
+    frame, stats = render_sortlast(client, render_domain, split_domains(path.mesh, 4),
+                                   method=method)
+    assert (reference[..., :3] < 250).any(axis=-1).sum() > 5000
+    assert np.array_equal(frame.color, reference)
+    assert stats.workers == 2 and stats.bytes_moved > 0
+
+
+def test_gl_domains_refuse_strips_and_wire_frames():
+    from workbench.experiment.measure import default_camera
+    from workbench.experiment.sortlast import GLDomains
+    from workbench.paths import Style
+
+    mesh = semicylinders(8, 4)
+    camera = default_camera(mesh, (64, 48))
+    for style in (Style(strips="triangle"), Style(wireframe=True)):
+        render_domain = GLDomains("semicylinders:4", "gouraud", style, camera, (64, 48))
+        with pytest.raises(ValueError, match="domains of a triangle list"):
+            render_domain(np.arange(10))

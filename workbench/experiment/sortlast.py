@@ -98,6 +98,68 @@ _PREPARED: dict = {}
 
 
 @dataclass(frozen=True)
+class GLDomains:
+    """A picklable ``render_domain`` for :func:`render_sortlast` drawn by OpenGL: each worker
+    process opens its own headless (EGL) context, loads ``scene`` once and prepares GL mesh
+    path ``path`` with ``style`` and ``camera`` at ``size`` (W, H); a domain (indices into the
+    path's triangle list) is drawn alone into a colour and depth target, then its triangles
+    again into an integer target that records which triangle won each pixel
+    (:meth:`~workbench.paths.mesh.MeshPath.draw_triangles`). The frame holds the read-back
+    colour, the window depth (24-bit, as the paths draw) and the global triangle indices, so
+    frames composite by depth, ties to the lower index, to the image one context draws. Paths
+    drawn as strips, with a wire frame or a hidden range are refused."""
+
+    scene: str
+    path: str
+    style: Style | None
+    camera: Camera
+    size: tuple[int, int]
+    quick: bool = False
+
+    def prepared(self):
+        """(context, prepared GL path, colour framebuffer, id framebuffer) of this process."""
+        key = ("gl", self.scene, self.path, repr(self.style), repr(self.camera),
+               tuple(self.size), self.quick)
+        held = _PREPARED.get(key)
+        if held is None:
+            from ..gl import Framebuffer
+            from ..gl.context import create_context
+            from ..paths import make_path
+            from ..scene.builtin import fresh_scene
+            from ..scene.needs import derive
+
+            _PREPARED.clear()
+            mesh = fresh_scene(self.scene, self.quick)
+            ctx = create_context()
+            path = make_path(self.path, self.style)
+            derive(mesh, path.needs, path.style)
+            path.prepare(ctx, mesh, self.camera)
+            target = Framebuffer(ctx, self.size)
+            ids = ctx.framebuffer(color_attachments=[ctx.renderbuffer(self.size, 1,
+                                                                      dtype="u4")],
+                                  depth_attachment=ctx.depth_renderbuffer(self.size))
+            held = _PREPARED[key] = (ctx, path, target, ids)
+        return held
+
+    def __call__(self, ids: np.ndarray) -> Frame:
+        ctx, path, target, id_target = self.prepared()
+        ids = np.asarray(ids, np.int64)
+        target.use()
+        target.clear()
+        path.draw_triangles(ids)
+        color, depth = target.read(), target.read_depth()
+        id_target.use()
+        id_target.clear(depth=1.0)
+        path.draw_triangles(ids, triangle_ids=True)
+        width, height = self.size
+        won = np.frombuffer(id_target.read(components=1, dtype="u4"), np.uint32)
+        won = won.reshape(height, width)[::-1].astype(np.int64)
+        triangle = np.where(won > 0, ids[np.maximum(won - 1, 0)] if len(ids) else -1, -1)
+        depth = np.where(won > 0, depth, np.float32(1.0)).astype(np.float32)
+        return Frame(color, depth, triangle.astype(np.int64))
+
+
+@dataclass(frozen=True)
 class ChunkDomains:
     """A picklable ``render_domain`` for :func:`render_sortlast` over a chunked scene on disk
     (:mod:`workbench.paths.chunked`): called with a domain number, a worker loads only that

@@ -192,6 +192,7 @@ class MeshPath(GLPath):
             uploaded += self._colormap_texture(ctx, data.scale)
         self._vao = self._keep(ctx.vertex_array(self._program, content, self._index,
                                                 index_element_size=4))
+        self._content, self._id_program = content, None
         if "base_color" in self._uniforms(self._program):
             self._program["base_color"].value = style.base_color
         if data.edges is not None:
@@ -246,4 +247,55 @@ class MeshPath(GLPath):
     def draw(self) -> None:
         self.ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
         self._render(self.mode)
+
+    # ------------------------------------------------------------------ sort-last domains
+    def draw_triangles(self, ids: np.ndarray, triangle_ids: bool = False) -> None:
+        """Draw only the triangles ``ids`` (indices into the triangle list, drawn in that
+        order) in the style's GL state: one domain of a sort-last run. With ``triangle_ids``
+        each fragment writes, instead of its colour, the position in ``ids`` of its triangle
+        plus one (an unsigned integer target; 0 where nothing is drawn), through the same
+        placement and clip planes, so the same triangle wins each pixel as in the colour pass.
+
+        Refused (ValueError): a strip layout (a triangle is no index range of it) and a line
+        pass or an alpha test (their fragments are not the triangles')."""
+        self._require_prepared()
+        data = self.data
+        if data.primitive != "triangles" or self._line_vao is not None or \
+                self.style.hide_range is not None:
+            raise ValueError(f"path {self.name!r} draws domains of a triangle list without a "
+                             f"wire frame or hidden range (strips {self.style.strips!r})")
+        index = np.ascontiguousarray(data.triangle_list()[np.asarray(ids, np.int64)],
+                                     np.int32)
+        if not len(index):
+            return
+        ctx = self.ctx
+        buffer = ctx.buffer(index.tobytes())
+        if triangle_ids:
+            program = self._triangle_id_program()
+            vao = ctx.vertex_array(program, [(self._positions, "3f", "position")], buffer,
+                                   index_element_size=4)
+        else:
+            vao = ctx.vertex_array(self._program, self._content, buffer, index_element_size=4)
+        vao_before, line_before = self._vao, self._line_vao
+        try:
+            self._vao = vao
+            ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
+            self._render(moderngl.TRIANGLES)
+        finally:
+            self._vao, self._line_vao = vao_before, line_before
+            vao.release()
+            buffer.release()
+
+    def _triangle_id_program(self) -> moderngl.Program:
+        """The program of :meth:`draw_triangles` with ``triangle_ids``, its placement and clip
+        uniforms copied from the path's program."""
+        if self._id_program is None:
+            self._id_program = self._keep(load_program(
+                self.ctx, "position.vert.glsl", "triangle_id.frag.glsl",
+                defines={"NUM_CLIP": len(self.style.clip_planes)}))
+        program = self._id_program
+        for name in ("mvp", "view", "clip_planes"):
+            if name in self._uniforms(program) and name in self._uniforms(self._program):
+                program[name].value = self._program[name].value
+        return program
 
