@@ -149,10 +149,16 @@ def test_cli_sort_last_render_equals_the_one_process_render(tmp_path, capsys):
     assert np.array_equal(np.asarray(Image.open(one)), np.asarray(Image.open(many)))
 
 
-def test_cli_sort_last_needs_the_software_rasterizer(tmp_path, capsys):
-    code = main(["render", "semicylinders:8", "-o", str(tmp_path / "x.png"), "--domains", "2"])
-    err = capsys.readouterr().err
-    assert code == 2 and "--rasterizer software" in err and len(err.strip().splitlines()) == 1
+def test_cli_sort_last_of_gl_domains_writes_the_plain_gl_image(tmp_path, capsys):
+    from PIL import Image
+
+    one, many = tmp_path / "one.png", tmp_path / "many.png"
+    common = ["render", "semicylinders:8", "--field", "distance", "--bands", "6", "--raw",
+              "--size", "160x120"]
+    assert main([*common, "-o", str(one)]) == 0
+    assert main([*common, "-o", str(many), "--domains", "3", "--workers", "2"]) == 0
+    assert "3 domains by space on 2 workers" in capsys.readouterr().out
+    assert np.array_equal(np.asarray(Image.open(one)), np.asarray(Image.open(many)))
 
 
 def test_flat_differs_only_where_gl_itself_draws_two_colours(ctx, sheets):

@@ -290,26 +290,33 @@ def cmd_render(args) -> int:
 
 
 def _render_sortlast(args, mesh, path, camera, size) -> int:
-    """``render --domains D``: the mesh split into D domains, drawn by the software rasterizer
-    on Dask workers and composited by depth (sort-last), written like a plain render."""
+    """``render --domains D``: the mesh split into D domains, drawn on Dask workers by the
+    software rasterizer or (``--rasterizer gl``) each worker's own EGL context, composited by
+    depth (sort-last) and written like a plain render."""
     from ..experiment.cluster import sweep_cluster
-    from ..experiment.sortlast import SoftwareDomains, render_sortlast
+    from ..experiment.sortlast import GLDomains, SoftwareDomains, render_sortlast
     from ..scene.domains import split_domains
 
-    if args.rasterizer != "software":
-        raise ValueError("--domains draws the domains with the software rasterizer: add "
-                         "--rasterizer software")
     if args.all_faces:
         raise ValueError("--domains loads the scene again on each worker; --all-faces is not "
                          "passed on")
     domains = split_domains(mesh, args.domains, by=args.split)
-    render_domain = SoftwareDomains(args.mesh, path.name, path.style, camera, size, path.options)
+    gl = args.rasterizer == "gl"
+    if gl:
+        render_domain = GLDomains(args.mesh, path.name, path.style, camera, size)
+    else:
+        render_domain = SoftwareDomains(args.mesh, path.name, path.style, camera, size,
+                                        path.options)
+    # GLDomains opens its own context in each worker process
     with sweep_cluster(args.workers, args.scheduler, gl=False) as cluster:
         frame, stats = render_sortlast(cluster.client, render_domain, domains,
                                        method=args.composite)
     _check_drawn(frame.color, mesh, camera, size, args.step)
     out = Path(args.output)
-    path.prepare(None, mesh, camera)  # the colour scale of the bar
+    if gl:
+        path.scale = path.check_mesh(mesh)  # the colour scale of the bar
+    else:
+        path.prepare(None, mesh, camera)
     _write_image(out, frame.color, path, args.field, args,
                  f"{mesh.name} ({path.name}, {args.domains} domains)")
     print(f"{out}: {mesh.name}, {len(mesh.triangles)} triangles in {args.domains} domains "
