@@ -262,3 +262,28 @@ def test_gl_domains_refuse_strips_and_wire_frames():
         render_domain = GLDomains("semicylinders:4", "gouraud", style, camera, (64, 48))
         with pytest.raises(ValueError, match="domains of a triangle list"):
             render_domain(np.arange(10))
+
+
+@pytest.mark.parametrize("method,factors", [("active-tree", None), ("active-swap", None),
+                                            ("radix", None), ("radix", (2, 3)),
+                                            ("radix", (3, 2))])
+@pytest.mark.parametrize("domains", [1, 5, 6])
+def test_active_pixel_schedules_on_the_cluster_equal_the_reduction(client, method, factors,
+                                                                    domains):
+    """Drawn pixels only, as encoded pieces between the workers: exactly the reduction of the
+    frames, with fewer bytes than whole frames."""
+    import functools
+
+    from workbench.algo.softraster.composite import composite
+
+    if factors is not None and np.prod(factors) != domains:
+        pytest.skip("radix factors of another domain count")
+    parts = interleaved(domains)
+    frame, stats = render_sortlast(client, render_rects, parts, method=method, factors=factors)
+    expected = functools.reduce(composite, [render_rects(p) for p in parts])
+    assert np.array_equal(frame.color, expected.color)
+    assert np.array_equal(frame.depth, expected.depth)
+    assert np.array_equal(frame.triangle, expected.triangle)
+    if domains > 1:
+        _, full = render_sortlast(client, render_rects, parts, method="swap")
+        assert 0 < stats.schedule_bytes < full.schedule_bytes

@@ -15,6 +15,11 @@ one; a task run elsewhere (also by work stealing) shows as extra ``bytes_moved``
   two merge tasks (each rank composites the half it keeps with the half it receives), after a
   fold of whole frames when the domain count is not a power of two; a final gather task on
   rank 0's worker assembles the image from every rank's region.
+* ``"active-tree"``, ``"active-swap"``, ``"radix"``: each rank first turns its frame into its
+  drawn pixels on its own worker (:class:`~workbench.algo.softraster.active.ActivePixels`);
+  the same exchanges (radix-k: :func:`~workbench.algo.softraster.active_schedules.radix_plan`)
+  send encoded pieces (bounding box and runs of drawn pixels), merged in domain order; rank 0
+  paints every rank's part over its own frame. ``schedule_bytes`` is the pieces' bytes.
 
 The two phases do not overlap: compositing starts once every frame exists, so that render and
 composite times are measured apart. The result equals ``functools.reduce(composite, frames)``
@@ -33,6 +38,7 @@ import numpy as np
 from dask.sizeof import sizeof
 from distributed import Client, wait
 
+from ..algo.softraster.active import EncodedPiece
 from ..algo.softraster.composite import (
     Region,
     assemble,
@@ -50,7 +56,7 @@ if TYPE_CHECKING:
     from ..paths.software import SoftwarePath
     from ..paths.style import Style
 
-METHODS = ("tree", "swap")
+METHODS = ("tree", "swap", "active-tree", "active-swap", "radix")
 KEY_PREFIX = "sortlast"
 
 
@@ -199,6 +205,12 @@ def _sizeof_frame(frame: Frame) -> int:
     return int(frame.nbytes)
 
 
+@sizeof.register(EncodedPiece)
+def _sizeof_piece(piece: EncodedPiece) -> int:
+    """An encoded piece's size to Dask: its encoded bytes."""
+    return int(piece.nbytes)
+
+
 @dataclass
 class SortLastStats:
     """One sort-last run: ``domains`` frames composited by ``method`` (``"tree"`` or
@@ -229,9 +241,13 @@ class SortLastStats:
 
 def render_sortlast(client: Client, render_domain: Callable[[np.ndarray], Frame],
                     domains: Sequence[np.ndarray], method: str = "tree",
-                    ) -> tuple[Frame, SortLastStats]:
+                    factors: Sequence[int] | None = None) -> tuple[Frame, SortLastStats]:
     """Render each domain with ``render_domain`` on the cluster of ``client`` and composite
-    the frames by ``method`` (``"tree"``: binary tree; ``"swap"``: binary swap) on the workers.
+    the frames by ``method`` on the workers: ``"tree"`` (binary tree) and ``"swap"`` (binary
+    swap) send whole (sub-)frames; ``"active-tree"``, ``"active-swap"`` and ``"radix"``
+    (radix-k with round sizes ``factors``, default direct send) send only drawn pixels, as
+    encoded pieces (:mod:`workbench.algo.softraster.active`), each rank's pixels staying on
+    its worker.
 
     ``render_domain`` is a picklable callable taking one domain and returning that domain's
     :class:`Frame` of the whole image; ``domains`` lists them, frame i coming from domain i:
@@ -275,14 +291,23 @@ def render_sortlast(client: Client, render_domain: Callable[[np.ndarray], Frame]
         raise ValueError(f"domain frames differ in size: {sorted(set(sizes))} "
                          f"(rows, columns, channels)")
     height, width, _ = sizes[0]
-    schedule = _tree if method == "tree" else _swap
-    final, schedule_pixels = schedule(client, run, frames, where, height, width)
-    result = final.result()
-    done = time.perf_counter()
+    if method in ("tree", "swap"):
+        schedule = _tree if method == "tree" else _swap
+        final, schedule_pixels = schedule(client, run, frames, where, height, width)
+        result = final.result()
+        done = time.perf_counter()
+        schedule_bytes = schedule_pixels * bytes_per_pixel(result)
+    else:
+        final, pieces = _active(client, run, frames, where, height, width, method, factors)
+        result = final.result()
+        done = time.perf_counter()
+        schedule_bytes = sum(client.gather([client.submit(_piece_bytes, piece, pure=False,
+                                                          key=f"{run}-bytes-{i}")
+                                            for i, piece in enumerate(pieces)]))
 
     moved = client.run(_received_bytes, run)
     stats = SortLastStats(len(arrays), method, len(set(where)), rendered - start, done - rendered,
-                          int(sum(moved.values())), schedule_pixels * bytes_per_pixel(result))
+                          int(sum(moved.values())), int(schedule_bytes))
     return result, stats
 
 
@@ -345,7 +370,113 @@ def _swap(client, run, frames, where, height, width):
     return final, plan.bytes_moved(1)
 
 
+def _active(client, run, frames, where, height, width, method, factors):
+    """Active-pixel schedules (:mod:`workbench.algo.softraster.active`): every rank turns its
+    frame into its drawn pixels on its own worker; what travels are encoded pieces. Returns
+    the final frame's future and the futures of every piece sent."""
+    from ..algo.softraster.active import ActivePixels
+    from ..algo.softraster.active_schedules import radix_plan
+
+    pieces = []
+
+    def submit(fn, *args, key, rank_domain):
+        return client.submit(fn, *args, key=f"{run}-{method}-{key}", pure=False,
+                             workers=[where[rank_domain]], allow_other_workers=True)
+
+    def send(held_of, rank_domain, region, key):
+        piece = submit(_pack, held_of, region, key=f"{key}-pack", rank_domain=rank_domain)
+        pieces.append(piece)
+        return piece
+
+    held = {d: submit(ActivePixels.from_frame, f, key=f"active-d{d}", rank_domain=d)
+            for d, f in enumerate(frames)}
+    ranks = list(range(len(frames)))
+    if method == "active-tree":
+        for k, pairs in enumerate(tree_plan(len(frames)).rounds):
+            for receiver, sender in pairs:
+                piece = send(held.pop(sender), sender, None, f"round{k}-d{sender}")
+                held[receiver] = submit(_merge_in, held[receiver], None, piece,
+                                        key=f"round{k}-merge-d{receiver}",
+                                        rank_domain=receiver)
+        parts, ranks = {0: held[0]}, [0]  # the tree ends on rank 0: nothing to gather
+    elif method == "active-swap":
+        plan = swap_plan(len(frames), height, width)
+        for keeper, sender in plan.fold:
+            piece = send(held.pop(sender), sender, None, f"fold-d{sender}")
+            held[keeper] = submit(_merge_in, held[keeper], None, piece,
+                                  key=f"fold-merge-d{keeper}", rank_domain=keeper)
+        ranks = list(plan.ranks)
+        for k, exchanges in enumerate(plan.rounds):
+            for e in exchanges:
+                low_d, high_d = ranks[e.lower], ranks[e.upper]
+                to_low = send(held[high_d], high_d, e.lower_keeps, f"round{k}-d{high_d}")
+                to_high = send(held[low_d], low_d, e.upper_keeps, f"round{k}-d{low_d}")
+                held[low_d] = submit(_merge_in, held[low_d], e.lower_keeps, to_low,
+                                     key=f"round{k}-merge-d{low_d}", rank_domain=low_d)
+                held[high_d] = submit(_merge_upper, to_high, held[high_d], e.upper_keeps,
+                                      key=f"round{k}-merge-d{high_d}", rank_domain=high_d)
+        parts = {d: held[d] for d in ranks}
+    else:
+        plan = radix_plan(len(frames), height, width, factors)
+        for k, groups in enumerate(plan.rounds):
+            new = {}
+            for g in groups:
+                for j, part in enumerate(g.parts):
+                    receiver = g.members[j]
+                    received = [send(held[m], m, part, f"round{k}-d{m}-to-d{receiver}")
+                                for m in g.members if m != receiver]
+                    new[receiver] = submit(_merge_group, j, part, held[receiver], *received,
+                                           key=f"round{k}-merge-d{receiver}",
+                                           rank_domain=receiver)
+            held.update(new)
+        parts = {d: held[d] for d in ranks}
+    first = ranks[0]
+    gathered = [send(parts[d], d, None, f"gather-d{d}") for d in ranks[1:]]
+    final = submit(_paint, frames[0], parts[first], *gathered, key="paint", rank_domain=0)
+    return final, pieces
+
+
 # ------------------------------------------------------------------------ worker-side tasks
+def _pack(pixels, region):
+    """The encoded piece a rank sends: its drawn pixels (in ``region`` where given)."""
+    return (pixels if region is None else pixels.cut(region)).pack()
+
+
+def _merge_in(own, region, piece):
+    """A rank's drawn pixels (cut to ``region`` where given) merged with a piece received from
+    a later domain: the lower domain first."""
+    from ..algo.softraster.active import merge
+
+    return merge(own if region is None else own.cut(region), piece.unpack())
+
+
+def _merge_upper(piece, own, region):
+    """The upper rank of a swap pair: the piece of the lower domain first, then its own part."""
+    from ..algo.softraster.active import merge
+
+    return merge(piece.unpack(), own.cut(region))
+
+
+def _merge_group(j: int, part, own, *pieces):
+    """Radix-k member ``j`` of its group: the group's parts of ``part`` in member order, its own
+    in place ``j``."""
+    from ..algo.softraster.active import merge_ordered
+
+    items = [p.unpack() for p in pieces]
+    items.insert(j, own.cut(part))
+    return merge_ordered(items)
+
+
+def _paint(frame0: Frame, own, *pieces) -> Frame:
+    """Rank 0's final frame: every rank's drawn pixels painted over frame 0."""
+    from ..algo.softraster.active import paint
+
+    return paint(frame0, [own] + [p.unpack() for p in pieces])
+
+
+def _piece_bytes(piece) -> int:
+    return int(piece.nbytes)
+
 def _ensure_sizeof() -> None:
     """Run on every worker: importing this module registers the frame size with Dask."""
 
