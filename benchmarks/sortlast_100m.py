@@ -6,13 +6,13 @@ as a chunked scene, one domain per sheet (:func:`workbench.experiment.bigscene.
 write_semicylinders_chunked`; the writer holds one sheet at a time); start a LocalCluster of
 ``--workers`` worker processes (one thread each); render at ``--size`` with ``--method``
 compositing (:func:`~workbench.experiment.bigscene.run_chunked_sortlast`; a small scene of as
-many domains first, so that the workers' kernels are compiled and their memory after it is the
-fixed overhead), then render the
+many domains first, so that the workers' kernels are compiled), then render the
 reference in this process domain by domain and compare. Printed: triangles, write time, render
 and composite time, triangles/s, bytes moved, each worker's peak resident memory next to the
 largest domain's in-memory size and the memory of an idle worker (the fixed overhead), the
-reference time and whether the images are equal. The scene folder is removed at the end unless
-``--keep``.
+reference time and whether the images are equal. Peak memory is each worker's high-water mark,
+reset after the warm-up (the idle memory then is the fixed overhead). The scene folder is removed
+at the end unless ``--keep`` (or ``--reuse``: render a scene already written to ``--folder``).
 
 Run alone (it times): ``.venv/bin/python benchmarks/sortlast_100m.py [--n 2500] [--sheets 8]``.
 """
@@ -37,6 +37,8 @@ def main(argv=None) -> int:
     parser.add_argument("--path", default="pixel_color")
     parser.add_argument("--folder", help="where to write the scene (default: a temporary one)")
     parser.add_argument("--keep", action="store_true", help="keep the scene folder")
+    parser.add_argument("--reuse", action="store_true",
+                        help="render the scene already in --folder (written when absent); keeps it")
     args = parser.parse_args(argv)
     size = tuple(int(v) for v in args.size.lower().split("x"))
 
@@ -44,7 +46,7 @@ def main(argv=None) -> int:
     from distributed import Client, LocalCluster
 
     from workbench.experiment.bigscene import run_chunked_sortlast, write_semicylinders_chunked
-    from workbench.experiment.sortlast import peak_memory_mib
+    from workbench.experiment.sortlast import reset_peak_memory
 
     root = Path(args.folder) if args.folder else Path(tempfile.mkdtemp(prefix="sortlast-100m-"))
     folder = root / "scene"
@@ -54,8 +56,11 @@ def main(argv=None) -> int:
         def written(k: int) -> None:
             print(f"  sheet {k} written ({time.perf_counter() - start:.0f} s)", flush=True)
 
-        write_semicylinders_chunked(folder, args.sheets, args.n, path=args.path,
-                                    progress=written)
+        if args.reuse and (folder / "scene.json").is_file():
+            print(f"  reusing the scene in {folder}")
+        else:
+            write_semicylinders_chunked(folder, args.sheets, args.n, path=args.path,
+                                        progress=written, replace=args.reuse)
         write_s = time.perf_counter() - start
         disk = sum(f.stat().st_size for f in folder.rglob("*") if f.is_file())
         with dask.config.set({"distributed.worker.profile.enabled": False}):
@@ -69,7 +74,7 @@ def main(argv=None) -> int:
             write_semicylinders_chunked(root / "warm-up", args.sheets, 8, path=args.path)
             run_chunked_sortlast(client, root / "warm-up", size, method=args.method,
                                  reference=False)
-            idle = peak_memory_mib(client)
+            idle = reset_peak_memory(client)
             image, run = run_chunked_sortlast(client, folder, size, method=args.method)
         overhead = max(idle.values())
         print(f"| triangles | {run.triangles:,} |")
@@ -89,7 +94,7 @@ def main(argv=None) -> int:
         print(f"| reference (one process, domain by domain) | {run.reference_s:.1f} s |")
         print(f"| images equal | {run.equal} |")
     finally:
-        if not args.keep:
+        if not (args.keep or args.reuse):
             shutil.rmtree(root if not args.folder else folder, ignore_errors=True)
     return 0 if run.equal else 1
 

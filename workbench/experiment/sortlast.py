@@ -186,17 +186,47 @@ class ChunkDomains:
 
 
 def peak_memory_mib(client: Client) -> dict[str, float]:
-    """Peak resident memory (MiB) of every worker process of ``client``'s cluster so far, by
-    worker address (``getrusage``'s maximum resident set size)."""
+    """Peak resident memory (MiB) of every worker process of ``client``'s cluster since it
+    started or since :func:`reset_peak_memory`, by worker address: the process's own
+    high-water mark (``VmHWM``; ``getrusage``'s maximum where there is no ``/proc``, which a
+    process may inherit from the one that started it)."""
     return client.run(_peak_rss_mib)
+
+
+def reset_peak_memory(client: Client) -> dict[str, float]:
+    """Reset every worker's high-water mark to its present resident memory (Linux
+    ``/proc/self/clear_refs``); that memory (MiB) by worker address."""
+    return client.run(_reset_peak_rss)
+
+
+def _status_mib(field: str) -> float | None:
+    try:
+        for line in open("/proc/self/status"):
+            if line.startswith(field + ":"):
+                return int(line.split()[1]) / 1024
+    except OSError:
+        return None
+    return None
 
 
 def _peak_rss_mib() -> float:
     import resource
     import sys
 
+    peak = _status_mib("VmHWM")
+    if peak is not None:
+        return peak
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     return peak / (1024 * 1024) if sys.platform == "darwin" else peak / 1024
+
+
+def _reset_peak_rss() -> float:
+    try:
+        with open("/proc/self/clear_refs", "w") as f:
+            f.write("5")
+    except OSError:
+        pass
+    return _status_mib("VmRSS") or float("nan")
 
 
 @sizeof.register(Frame)
