@@ -90,10 +90,11 @@ ALL = 1e9
 
 # ----------------------------------------------------------------------------- the API
 def test_tools_and_availability():
-    assert TOOLS == ("libigl", "open3d", "trimesh", "coal")
+    assert TOOLS == ("libigl", "open3d", "trimesh", "coal", "fcpw")
     tools = available_tools()
     assert set(tools) <= set(TOOLS)
-    assert {"libigl", "open3d", "trimesh"} <= set(tools)  # the project's own dependencies
+    # the project's own dependencies
+    assert {"libigl", "open3d", "trimesh", "coal", "fcpw"} <= set(tools)
 
 
 @pytest.mark.parametrize("tool", ["scipy", "", "LIBIGL", None])
@@ -212,6 +213,29 @@ def test_open3d_float32_error_grows_with_the_coordinates(panels, exact):
     assert err_raw > 100 * err_local and err_raw > 1e-3
 
 
+def test_fcpw_float32_with_the_cutoff_as_search_radius(panels, exact):
+    """fcpw: float32 errors of the order of the coordinates' float32 rounding, the cut-off
+    handed over as its search radius, reading the results out timed apart."""
+    need("fcpw")
+    result = reference_part_distances("fcpw", panels, ALL)
+    assert result.available and result.queries == panels.n_nodes
+    assert "float32" in result.constraints and "search radius = the cut-off" in result.constraints
+    assert "std::threads" in result.constraints
+    scale = np.abs(panels.nodes - panels.nodes.mean(axis=0)).max() + exact.max()
+    err = np.abs(result.distance - exact).max()
+    assert 0 < err <= 4 * EPS32 * scale  # float32: not exact, but close
+    assert result.seconds_extract > 0 and result.seconds_query > 0
+    summary = compare_with_exact(exact, result, tolerance=1e-9)
+    assert summary["off"] > 0  # float32 shows at 1e-9 mm
+    # with a cut-off between the distances: what is beyond the radius is not found
+    cut = reference_part_distances("fcpw", panels, 2.0)
+    beyond, within = exact > 2.0 + 1e-3, exact <= 2.0 - 1e-3
+    assert beyond.sum() >= 20 and within.sum() >= 20
+    assert np.isinf(cut.distance[beyond]).all()
+    np.testing.assert_allclose(cut.distance[within], exact[within], rtol=0,
+                               atol=4 * EPS32 * scale)
+
+
 @pytest.mark.parametrize("tool", TOOLS)
 def test_beyond_cutoff_is_inf(tool, panels, exact):
     need(tool)
@@ -257,7 +281,7 @@ def test_absent_tool_is_a_result_with_the_reason(monkeypatch):
 
 
 def test_failing_tool_is_a_result(monkeypatch):
-    def broken(self, structure, points):
+    def broken(self, structure, points, cutoff):
         raise RuntimeError("boom")
 
     monkeypatch.setattr(distance_refs._Libigl, "query", broken)

@@ -13,9 +13,11 @@ from test_hierarchy import mesh_options, random_mesh
 from workbench.algo.distance import points_triangles_distance
 from workbench.algo.hierarchy import local_origin
 from workbench.algo.part_distance import (
+    batched_part_distances,
     brute_force_part_distances,
     connectivity,
     node_parts,
+    own_part_sets,
     part_distances,
 )
 from workbench.scene.mesh import FEMesh
@@ -129,6 +131,106 @@ def test_time_steps():
     assert not np.array_equal(r0.distance, r1.distance)
 
 
+# --------------------------------------------------------------------------- batched
+def assert_batched_exact(mesh, r, expected, step=0):
+    """The batched search's distances equal the brute force's to the last bit; the part named
+    is the brute force's or, on a tie, another part at exactly that distance."""
+    bd, bp = expected
+    np.testing.assert_array_equal(r.distance, bd)
+    assert ((r.other_part >= 0) == np.isfinite(r.distance)).all()
+    assert ((r.other_element >= 0) == np.isfinite(r.distance)).all()
+    np.testing.assert_array_equal(mesh.parts[r.other_element[r.other_element >= 0]],
+                                  r.other_part[r.other_part >= 0])
+    tr = mesh.triangulation
+    coords = mesh.coordinates(step)
+    local = coords - local_origin(coords, np.unique(mesh.elements))  # as the brute force
+    for i in np.flatnonzero(r.other_part != bp):
+        tri = tr.triangles[mesh.parts[tr.element_of] == r.other_part[i]]
+        assert points_triangles_distance(local[i:i + 1], local[tri]).min() == bd[i]
+
+
+@settings(max_examples=60, deadline=None)
+@given(mesh_options, st.sampled_from([0.05, 0.2, 1.0, 5.0]), st.sampled_from([1, 4, 16]))
+def test_batched_equals_brute_force_to_the_last_bit(options, cutoff, leaf):
+    mesh = random_mesh(**options)
+    r = batched_part_distances(mesh, cutoff, leaf_size=leaf)
+    assert_batched_exact(mesh, r, brute_force_part_distances(mesh, cutoff))
+    assert r.kind == "batched" and r.nodes_queried == len(np.unique(mesh.elements))
+    # the crash2000 hierarchy computes the same float64 distances
+    np.testing.assert_array_equal(r.distance, part_distances(mesh, cutoff).distance)
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.integers(0, 10**6))
+def test_batched_touching_coplanar_shared_degenerate_far(seed):
+    mesh = random_mesh(seed, 4, touching=True, coplanar=True, shared=True, degenerate=True,
+                       single=True, unused=True)
+    for m in (mesh, mesh.translated([1e6, -1e6, 1e6])):
+        assert_batched_exact(m, batched_part_distances(m, 1.0), brute_force_part_distances(m, 1.0))
+
+
+def test_batched_refined_steps_and_threads():
+    from workbench.scene.generators import refine
+
+    mesh = refine(random_mesh(3, 4, touching=True, coplanar=True, shared=True), 4)
+    rng = np.random.default_rng(1)
+    steps = np.stack([mesh.nodes, mesh.nodes + rng.normal(size=mesh.nodes.shape) * 0.05])
+    moving = FEMesh(nodes=mesh.nodes, elements=mesh.elements, parts=mesh.parts, steps=steps)
+    r = batched_part_distances(moving, 0.3, step=1)
+    assert_batched_exact(moving, r, brute_force_part_distances(moving, 0.3, step=1), step=1)
+    assert np.isfinite(r.distance).sum() > 100
+    assert r.bv_tests > 0 and r.element_tests > 0 and r.n_bvs > 0 and r.query_s > 0
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        return
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = batched_part_distances(moving, 0.3, step=1)
+    finally:
+        numba.set_num_threads(before)
+    np.testing.assert_array_equal(one.distance, r.distance)
+    np.testing.assert_array_equal(one.other_element, r.other_element)
+    assert (one.bv_tests, one.element_tests) == (r.bv_tests, r.element_tests)
+
+
+@settings(max_examples=30, deadline=None)
+@given(mesh_options)
+def test_own_part_sets_are_node_parts(options):
+    mesh = random_mesh(**options)
+    node_set, set_ptr, set_parts = own_part_sets(mesh)
+    ptr, own = node_parts(mesh)
+    ids = np.unique(mesh.parts)
+    for i in range(mesh.n_nodes):
+        expected = own[ptr[i]:ptr[i + 1]]
+        if len(expected) == 0:
+            assert node_set[i] == -1
+            continue
+        s = node_set[i]
+        np.testing.assert_array_equal(ids[set_parts[set_ptr[s]:set_ptr[s + 1]]], expected)
+    # sets are distinct, the single parts first
+    sets = [tuple(set_parts[set_ptr[s]:set_ptr[s + 1]]) for s in range(len(set_ptr) - 1)]
+    assert len(set(sets)) == len(sets)
+    assert sets[:len(ids)] == [(p,) for p in range(len(ids))]
+
+
+def test_batched_refusals():
+    mesh = random_mesh(1, 2)
+    for bad in (0.0, -1.0, np.nan, np.inf, "x", None):
+        with pytest.raises(ValueError, match="finite number > 0"):
+            batched_part_distances(mesh, bad)
+    for bad in (0, -2, 2.5):
+        with pytest.raises(ValueError, match="leaf_size"):
+            batched_part_distances(mesh, 1.0, leaf_size=bad)
+    with pytest.raises(ValueError, match="step"):
+        batched_part_distances(mesh, 1.0, step=3)
+    steps = np.stack([mesh.nodes, mesh.nodes])
+    steps[1, mesh.elements[-1, 2]] = np.nan
+    moving = FEMesh(nodes=mesh.nodes, elements=mesh.elements, parts=mesh.parts, steps=steps)
+    batched_part_distances(moving, 1.0, step=0)
+    with pytest.raises(ValueError, match="non-finite"):
+        batched_part_distances(moving, 1.0, step=1)
+
+
 # --------------------------------------------------------------------------- counters
 def test_counters_of_table_2():
     mesh = random_mesh(7, 4, touching=True)
@@ -211,6 +313,13 @@ def test_car_every_node_equals_brute_force(car_distances, kind, leaf):
     assert r.nodes_queried == mesh.n_nodes
     if leaf == 10:  # crash2000: the plane test avoids most exact distances in big leaves
         assert r.plane_skips > 0.5 * r.leaf_elements
+
+
+def test_car_batched_equals_brute_force(car_distances):
+    mesh, expected = car_distances
+    r = batched_part_distances(mesh, 1.5)
+    assert_batched_exact(mesh, r, expected)
+    assert np.isfinite(r.distance).sum() > 100
 
 
 def test_car_far_from_the_origin(car_distances):

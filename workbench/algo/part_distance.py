@@ -11,9 +11,12 @@ the number of bounding volumes, point/box tests, point/element tests and seconds
 * :func:`connectivity` -- for every pair of parts the smallest node-to-element distance between
   them when it is within a given distance, and how many nodes are that close: the connectivity
   matrix the paper suggests for checking a model's assembly.
+* :func:`batched_part_distances` -- the same distances through one 4-wide triangle tree
+  searched by groups of nearby nodes (:mod:`workbench.algo.bvh_batch`): equal to the others to
+  the last bit, several times faster on large models, without the Table 2 counters.
 * :func:`brute_force_part_distances` -- the reference: every node against every triangle.
 
-Conventions, shared by all three:
+Conventions, shared by all four:
 
 * An element is the triangles :attr:`FEMesh.triangles` gives it (quads split along the shorter
   diagonal); a topologically degenerate element (fewer than three distinct nodes, or a node at
@@ -40,9 +43,11 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from ..scene.needs import derived_item
+from .bvh_batch import LEAF_SIZE, BatchedTriangleTree
 from .distance import points_triangles_distance
 from .hierarchy import (
     KINDS,
@@ -53,8 +58,9 @@ from .hierarchy import (
     used_nodes,
 )
 
-__all__ = ["Connectivity", "PartDistances", "brute_force_part_distances", "connectivity",
-           "node_parts", "part_distances", "flange_distances"]
+__all__ = ["Connectivity", "PartDistances", "batched_part_distances",
+           "brute_force_part_distances", "connectivity", "flange_distances", "node_parts",
+           "own_part_sets", "part_distances"]
 
 
 @dataclass
@@ -164,6 +170,73 @@ def node_parts(mesh) -> tuple[np.ndarray, np.ndarray]:
     return ptr, ids[part].astype(np.int64)
 
 
+def own_part_sets(mesh, element_part: np.ndarray | None = None):
+    """Each node's own parts as one of the distinct sets they form: ``(node_set, set_ptr,
+    set_parts)``.
+
+    ``node_set`` (N,) int64: the set of node i, -1 for a node no element uses; set s holds the
+    part *indices* (into the sorted distinct part ids, as ``element_part`` gives them)
+    ``set_parts[set_ptr[s]:set_ptr[s + 1]]``, sorted. Sets 0 .. P - 1 are the single parts
+    (set p = {p}); the sets of nodes shared by several parts follow. ``element_part`` (M,)
+    the part index of each element (computed when not given).
+    """
+    if element_part is None:
+        element_part = np.searchsorted(distinct(mesh.parts), mesh.parts)
+    element_part = np.ascontiguousarray(element_part, dtype=np.int64)
+    elements = np.ascontiguousarray(mesh.elements)
+    n_parts = int(element_part.max()) + 1 if len(element_part) else 0
+    node_set, multi, other = _first_parts(elements, element_part, mesh.n_nodes)
+    set_ptr = np.arange(n_parts + 1, dtype=np.int64)
+    set_parts = np.arange(n_parts, dtype=np.int64)
+    if other.any():
+        # the parts of a node of several: the one it holds, and those of the elements found
+        # with another
+        e = np.flatnonzero(other)
+        corner = elements[e].astype(np.int64)
+        corner_part = np.broadcast_to(element_part[e][:, None], corner.shape)
+        node = np.flatnonzero(multi)
+        key = np.unique(np.r_[node * n_parts + node_set[node],
+                              (corner * n_parts + corner_part)[multi[corner]]])
+        node, part = key // n_parts, key % n_parts
+        starts = np.flatnonzero(np.r_[True, node[1:] != node[:-1]])
+        sizes = np.diff(np.r_[starts, len(node)])
+        rows = np.full((len(starts), int(sizes.max())), -1, np.int64)
+        rows[np.repeat(np.arange(len(starts)), sizes),
+             np.arange(len(node)) - np.repeat(starts, sizes)] = part
+        if rows.shape[1] * np.log2(n_parts + 1) < 62:  # each row as one integer: quicker
+            code = ((rows + 1) * (n_parts + 1) ** np.arange(rows.shape[1])).sum(axis=1)
+            _, first, inverse = np.unique(code, return_index=True, return_inverse=True)
+            sets = rows[first]
+        else:
+            sets, inverse = np.unique(rows, axis=0, return_inverse=True)
+        node_set[node[starts]] = n_parts + inverse.ravel()
+        sizes = (sets >= 0).sum(axis=1)
+        set_ptr = np.concatenate([set_ptr, n_parts + np.cumsum(sizes)])
+        set_parts = np.concatenate([set_parts, sets[sets >= 0]])
+    return node_set, set_ptr, set_parts
+
+
+@numba.njit(cache=True)
+def _first_parts(elements, element_part, n_nodes):
+    """(the part index of each node's first element (-1 unused), whether the node has
+    several, whether each element holds a node whose first part is not the element's): one
+    pass, element by element. An element with the node's first part is not flagged, and
+    needs not be: that part is the node's first."""
+    part = np.full(n_nodes, -1, np.int64)
+    multi = np.zeros(n_nodes, np.bool_)
+    other = np.zeros(len(elements), np.bool_)
+    for e in range(len(elements)):
+        q = element_part[e]
+        for j in range(elements.shape[1]):
+            v = elements[e, j]
+            if part[v] < 0:
+                part[v] = q
+            elif part[v] != q:
+                multi[v] = True
+                other[e] = True
+    return part, multi, other
+
+
 def _csr_rows(ptr: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For the CSR rows ``rows``: (position in ``rows``, index into the CSR values) of every
     entry, row by row."""
@@ -208,6 +281,66 @@ def part_distances(mesh, cutoff: float, *, kind: str = "aabb", leaf_size: int = 
     return PartDistances(r.distance, r.part, r.element, h.n_bvs, h.n_top_bvs, r.bv_tests,
                          r.element_tests, r.plane_skips, r.leaf_elements, int(active.sum()),
                          h.build_s, query_s, kind, int(leaf_size), cutoff)
+
+
+def batched_part_distances(mesh, cutoff: float, *, step: int = 0,
+                           leaf_size: int = LEAF_SIZE) -> PartDistances:
+    """:func:`part_distances` through one 4-wide triangle tree searched by groups of nearby
+    nodes (:class:`~workbench.algo.bvh_batch.BatchedTriangleTree`): the same distances, exact
+    float64 to the last bit, and the same conventions (module notes), at a fraction of the
+    time on large models.
+
+    ``leaf_size`` most triangle references per leaf; ``step`` the time step measured. The
+    counters differ in meaning from the crash2000 hierarchy's: ``n_bvs`` the boxes of the tree,
+    ``bv_tests`` box-against-box and box-against-node tests, ``element_tests`` exact
+    point/triangle distances (``leaf_elements`` the same, no plane skips); ``kind`` is
+    "batched". ``build_s`` covers the local coordinates, the triangles' parts and the tree;
+    ``query_s`` each node's own parts, the grouping and the search. Refusals as in
+    :func:`part_distances`.
+    """
+    cutoff, step, coords, used = _check(mesh, cutoff, "aabb", leaf_size, step)
+    n = mesh.n_nodes
+    n_used = len(used)
+    tr = mesh.triangulation
+    if tr.n_triangles == 0:
+        return PartDistances(np.full(n, np.inf), np.full(n, -1, np.int64),
+                             np.full(n, -1, np.int64), 0, 0, 0, 0, 0, 0, n_used, 0.0, 0.0,
+                             "batched", int(leaf_size), cutoff)
+    t0 = time.perf_counter()
+    ids = distinct(mesh.parts)
+    element_part = np.searchsorted(ids, mesh.parts).astype(np.int64)
+    local = coords - local_origin(coords, used)
+    corners = local[np.asarray(tr.triangles, dtype=np.int64)]
+    tree = BatchedTriangleTree(corners, element_part[tr.element_of], leaf_size=int(leaf_size))
+    t1 = time.perf_counter()
+    node_set, set_ptr, set_parts = own_part_sets(mesh, element_part)
+    d2, tri, counts = tree.nearest(local, node_set, set_ptr, set_parts, cutoff)
+    distance, element, other = _results(d2, tri, tr.element_of, element_part,
+                                        ids.astype(np.int64))
+    query_s = time.perf_counter() - t1
+    return PartDistances(distance, other, element, tree.n_boxes, 0, counts["box_tests"],
+                         counts["triangle_tests"], 0, counts["triangle_tests"], n_used,
+                         t1 - t0, query_s, "batched", int(leaf_size), cutoff)
+
+
+@numba.njit(cache=True)
+def _results(d2, tri, element_of, element_part, part_ids):
+    """(distance, element, part id) of each node from its squared distance and triangle."""
+    n = len(d2)
+    distance = np.empty(n)
+    element = np.empty(n, np.int64)
+    other = np.empty(n, np.int64)
+    for i in range(n):
+        t = tri[i]
+        if t >= 0:
+            distance[i] = np.sqrt(d2[i])
+            element[i] = element_of[t]
+            other[i] = part_ids[element_part[element_of[t]]]
+        else:
+            distance[i] = np.inf
+            element[i] = -1
+            other[i] = -1
+    return distance, element, other
 
 
 @derived_item("part_distances", key=lambda cutoff, step=0: (float(cutoff), int(step)),
