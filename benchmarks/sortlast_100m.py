@@ -71,7 +71,8 @@ def main(argv=None) -> int:
             client.wait_for_workers(args.workers, timeout=120)
             # a small scene first: the workers compile their kernels, and their memory after
             # it is the fixed overhead
-            write_semicylinders_chunked(root / "warm-up", args.sheets, 8, path=args.path)
+            write_semicylinders_chunked(root / "warm-up", args.sheets, 8, path=args.path,
+                                        replace=True)
             run_chunked_sortlast(client, root / "warm-up", size, method=args.method,
                                  reference=False)
             idle = reset_peak_memory(client)
