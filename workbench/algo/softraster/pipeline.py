@@ -48,7 +48,7 @@ from types import SimpleNamespace
 import numba
 import numpy as np
 
-from . import kernels
+from . import fused, kernels
 from .frame import Frame
 from .rule import GL_SUBPIXEL_BITS, check_bits
 
@@ -105,7 +105,9 @@ class RasterOptions:
     ``subpixel_bits``: 8 as llvmpipe, 0 for the table; ``threads``: numba threads (None: all);
     ``tile``: screen tile edge in pixels (a power of two); ``session``: triangles per session;
     ``early_depth``: skip generating fragments that already fail the depth test (the image
-    is the same; es2008 generates them all)."""
+    is the same; es2008 generates them all); ``fused``: the half-space generator runs set-up,
+    coverage, depth test and shading per tile in one compiled loop (:mod:`.fused`; the same
+    image, no sessions) instead of the steps; the span table always runs the steps."""
 
     generator: str = "halfspace"
     table_size: int = 10
@@ -114,6 +116,7 @@ class RasterOptions:
     tile: int = 64
     session: int = 1 << 16
     early_depth: bool = True
+    fused: bool = True
 
     def __post_init__(self) -> None:
         if self.generator not in GENERATORS:
@@ -264,10 +267,15 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
             (_interpreted() if not vectorized else _null(_compiled())) as k:
         stats.threads = threads
         clock = _Clock(stats.seconds)
+        fuse = options.fused and options.generator == "halfspace"
         lit = _transform_and_light(k, pos, tris, view, proj, (width, height), options.subpixel_bits,
                                    shading, look, normals, values, triangle_values, planes,
-                                   workspace)
+                                   workspace, flat_light=not fuse)
         clock.lap("transform and light")
+        if fuse:
+            fused.draw(tris, ids, lit, frame, color32, options, look, shading, threads, stats,
+                       clock, vectorized, workspace)
+            return frame, stats
         sessions = _Sessions(k, tris, ids, lit, frame, color32, options, table, shading, look,
                              threads, stats, clock)
         for k0 in range(0, len(tris), options.session):
@@ -341,7 +349,9 @@ class _Lit:
     """The transform-and-light step's output. Per vertex: window positions ``fx``, ``fy``
     (fixed point) and depth ``fz``, ``ok`` (placed), ``attr`` (V, n_attr) the shading
     attributes, ``clipd`` (V, P) the clip distances. Per triangle where the shading uses them
-    (else one entry): ``tri_light`` the flat light, ``tri_s`` the texture coordinate."""
+    (else one entry): ``tri_light`` the flat light (one entry where it is left to the fused
+    draw), ``tri_s`` the texture coordinate. ``pos32`` and ``view32``: the float32 vertices and
+    view the flat light is computed from."""
 
     fx: np.ndarray
     fy: np.ndarray
@@ -352,13 +362,16 @@ class _Lit:
     clipd: np.ndarray
     tri_light: np.ndarray
     tri_s: np.ndarray
+    pos32: np.ndarray
+    view32: np.ndarray
 
 
 def _transform_and_light(k, pos, tris, view, proj, size, bits: int, shading: Shading,
                          look: _Look, normals, values, triangle_values, planes,
-                         workspace) -> _Lit:
+                         workspace, flat_light: bool = True) -> _Lit:
     """The first step, all vertices once: float32 placement and snapping, per-vertex or flat
-    lighting and colour look-up, the clip distances (see :func:`render` for the arguments)."""
+    lighting (unless not ``flat_light``) and colour look-up, the clip distances (see
+    :func:`render` for the arguments)."""
     width, height = size
     kind, code = shading.kind, look.code
     rel32 = pos if pos.dtype == np.float32 else pos.astype(np.float32)
@@ -382,9 +395,11 @@ def _transform_and_light(k, pos, tris, view, proj, size, bits: int, shading: Sha
             normals32 = normals32.astype(np.float32)
         k.light_vertices(code, np.ascontiguousarray(view[:3, :3], np.float32), normals32,
                          s, look.texels, look.texf, shading.linear, look.missing, attr)
-    tri_light = np.zeros(len(tris) if kind in ("flat", "element_color") else 1, np.float32)
-    if kind in ("flat", "element_color"):
-        k.light_triangles(rel32, tris, view.astype(np.float32), fx, fy, bits, tri_light)
+    flat = flat_light and kind in ("flat", "element_color")
+    tri_light = np.zeros(len(tris) if flat else 1, np.float32)
+    view32 = view.astype(np.float32)
+    if flat:
+        k.light_triangles(rel32, tris, view32, fx, fy, bits, tri_light)
     tri_s = np.zeros(1, np.float32)
     if kind == "element_color":
         tv = np.asarray(triangle_values, np.float64)
@@ -395,7 +410,7 @@ def _transform_and_light(k, pos, tris, view, proj, size, bits: int, shading: Sha
         p32, w32 = planes[:, :3].astype(np.float32), planes[:, 3].astype(np.float32)
         clipd = np.ascontiguousarray((rel32 @ p32.T) + w32, np.float32)
     return _Lit(fx=fx, fy=fy, fz=fz, ok=ok, attr=attr, n_attr=n_attr, clipd=clipd,
-                tri_light=tri_light, tri_s=tri_s)
+                tri_light=tri_light, tri_s=tri_s, pos32=rel32, view32=view32)
 
 
 @dataclass
