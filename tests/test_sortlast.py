@@ -185,43 +185,15 @@ def test_chunked_domains_composite_to_the_one_process_image(client, tmp_path, me
 def test_chunked_sortlast_on_a_scheduler_and_workers_started_apart(tmp_path):
     """The chunked scene rendered on a scheduler and two workers started as their own
     processes (the command-line tools of distributed), as on a real cluster."""
-    import json
-    import subprocess
-    import sys
-    import time
+    from clusters import scheduler_and_workers
 
     from workbench.experiment.bigscene import run_chunked_sortlast, write_semicylinders_chunked
 
     folder = write_semicylinders_chunked(tmp_path / "scene", 3, 8, bands=4)
-    scheduler_file = tmp_path / "scheduler.json"
-    started = []
-    try:
-        started.append(subprocess.Popen(
-            [sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
-             "--port", "0", "--no-dashboard", "--scheduler-file", str(scheduler_file)],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        deadline = time.monotonic() + 60
-        while not scheduler_file.exists():
-            assert time.monotonic() < deadline and started[0].poll() is None
-            time.sleep(0.1)
-        time.sleep(0.2)  # the file is complete once its JSON parses
-        address = json.loads(scheduler_file.read_text())["address"]
-        started.append(subprocess.Popen(
-            [sys.executable, "-m", "distributed.cli.dask_worker", address, "--host",
-             "127.0.0.1", "--nworkers", "2", "--nthreads", "1", "--no-dashboard"],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        with Client(address, timeout=30) as remote:
-            remote.wait_for_workers(2, timeout=60)
-            _, run = run_chunked_sortlast(remote, folder, (96, 80), method="tree")
-        assert run.equal and run.workers == 2 and run.domains == 3
-    finally:
-        for proc in reversed(started):
-            proc.terminate()
-            try:
-                proc.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+    with scheduler_and_workers(tmp_path) as address, Client(address, timeout=30) as remote:
+        remote.wait_for_workers(2, timeout=60)
+        _, run = run_chunked_sortlast(remote, folder, (96, 80), method="tree")
+    assert run.equal and run.workers == 2 and run.domains == 3
 
 
 @pytest.mark.parametrize("name,style", [("pixel_color", {"field": "distance", "bands": 6}),

@@ -271,42 +271,18 @@ def test_on_a_scheduler_and_workers_started_apart(tmp_path):
         field = "distance"
         size = "64x48"
     """)
-    scheduler_file = tmp_path / "scheduler.json"
-    started = []
-    try:
-        started.append(subprocess.Popen(
-            [sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
-             "--port", "0", "--no-dashboard", "--scheduler-file", str(scheduler_file)],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        deadline = time.monotonic() + 60
-        while not scheduler_file.exists():
-            assert time.monotonic() < deadline and started[0].poll() is None
-            time.sleep(0.1)
-        time.sleep(0.2)  # the file is complete once its JSON parses
-        address = json.loads(scheduler_file.read_text())["address"]
-        assert address.startswith("tcp://127.0.0.1:")
-        started.append(subprocess.Popen(
-            [sys.executable, "-m", "distributed.cli.dask_worker", address, "--host",
-             "127.0.0.1", "--nworkers", "2", "--nthreads", "1", "--no-dashboard"],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        from distributed import Client
+    from clusters import scheduler_and_workers
+    from distributed import Client
 
+    with scheduler_and_workers(tmp_path) as address:
         with Client(address, timeout=30) as client:
             client.wait_for_workers(2, timeout=60)
         out = tmp_path / "out"
         result = run_sweep(load_config(config_path), out, scheduler=address, progress=False)
-        assert (result.computed, result.failed, result.workers) == (4, 0, 2)
-        rows = read_table(out / "table.csv")
-        assert all(r["workers"] == 2 and r["host"] and r["wall_ms"] > 0 for r in rows)
-        assert [r["mean_diff_255"] > 0 for r in rows] == [True, True, False, False]
-    finally:
-        for proc in reversed(started):
-            proc.terminate()
-            try:
-                proc.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+    assert (result.computed, result.failed, result.workers) == (4, 0, 2)
+    rows = read_table(out / "table.csv")
+    assert all(r["workers"] == 2 and r["host"] and r["wall_ms"] > 0 for r in rows)
+    assert [r["mean_diff_255"] > 0 for r in rows] == [True, True, False, False]
 
 
 def test_simplification_point_on_the_semicylinders():
