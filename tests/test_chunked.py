@@ -66,6 +66,7 @@ def test_a_chunked_scene_draws_the_one_process_image(tmp_path, mesh, name, by, c
     frame = render_chunked(scene, camera, SIZE)
     assert (whole.triangle >= 0).sum() > 5000
     assert frames_equal(frame, whole)
+    assert all(scene.domain_nbytes(i) == scene.load(i).nbytes for i in range(count))
 
 
 def test_clip_planes_travel_with_the_scene(tmp_path, mesh):

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from PIL import Image
+from test_cli import DECK
 
 from workbench.cli import main
 from workbench.experiment import EXPERIMENTS, experiment, run_experiment
@@ -23,16 +24,6 @@ from workbench.experiment.tables import (
 from workbench.experiment.targets import output_folder, output_target
 from workbench.sweep import load_config, run_sweep
 
-DECK = """*KEYWORD
-*NODE
-       1             0.0             0.0             0.0
-       2           100.0             0.0             0.0
-       3           100.0           100.0             0.0
-       4             0.0           100.0             0.0
-*ELEMENT_SHELL
-       1       1       1       2       3       4
-*END
-"""
 OUTSIDE_BYTES = b"not to be touched\n"
 
 

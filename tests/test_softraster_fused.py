@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from test_softraster import pixel_projection
 
 from workbench.algo.softraster import SHADINGS, Frame, RasterOptions, Shading, render
 from workbench.algo.softraster import fused as fused_module
@@ -15,16 +16,6 @@ from workbench.paths import SoftwareRasterizer, Style
 from workbench.scene.generators import crash_sequence, stamped_panels
 
 SIZES = [(64, 48), (97, 61), (160, 120)]
-
-
-def pixel_projection(width: int, height: int) -> np.ndarray:
-    """Orthographic projection putting model (x, y, z) at image (x, y) pixels, depth z."""
-    proj = np.zeros((4, 4))
-    proj[0, 0], proj[0, 3] = 2.0 / width, -1.0
-    proj[1, 1], proj[1, 3] = -2.0 / height, 1.0
-    proj[2, 2], proj[2, 3] = 2.0, -1.0
-    proj[3, 3] = 1.0
-    return proj
 
 
 def random_scene(seed: int, size, count: int) -> dict:

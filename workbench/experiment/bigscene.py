@@ -120,17 +120,8 @@ def run_chunked_sortlast(client, folder: str | Path, size: tuple[int, int] = (10
                                                         options),
                                    list(range(len(scene))), method=method)
     peaks = peak_memory_mib(client)
-    entries = scene.manifest["domains"]
-    largest = max(range(len(scene)), key=lambda i: entries[i]["triangles"])
-    chunk = scene.load(largest)
-    per_vertex = sum(a.nbytes for a in (chunk.coordinates, chunk.normals, chunk.values)
-                     if a is not None) / max(1, entries[largest]["vertices"])
-    per_triangle = sum(a.nbytes for a in (chunk.triangles, chunk.ids, chunk.triangle_values)
-                       if a is not None) / max(1, entries[largest]["triangles"])
-    sizes = [(e["vertices"] * per_vertex + e["triangles"] * per_triangle) / 2**20
-             for e in entries]
-    domain_mib = sizes[largest]
-    del chunk
+    sizes = [scene.domain_nbytes(i) / 2**20 for i in range(len(scene))]
+    domain_mib = max(sizes)
     # domain i goes to the i-th worker in address order (render_sortlast's placement)
     addresses = sorted(peaks)
     share_mib = {a: sum(sizes[i] for i in range(len(sizes)) if i % len(addresses) == k)

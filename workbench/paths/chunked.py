@@ -67,8 +67,10 @@ def write_chunked(path: SoftwarePath, domains: Sequence[np.ndarray], folder: str
     Refused (ValueError): an unprepared path, domains that are no partition of the path's
     triangles, an existing ``folder`` without ``replace`` (or one that is not a chunked scene).
     """
+    if path.mesh is None:
+        raise ValueError(f"software path {path.name!r} is not prepared")
     domains = [np.asarray(d, np.int64) for d in domains]
-    _check_partition(domains, path.raster_inputs().triangles.shape[0])
+    _check_partition(domains, path.triangles)
     with ChunkWriter(folder, replace) as writer:
         for ids in domains:
             writer.add(path, ids)
@@ -99,6 +101,7 @@ class ChunkWriter:
         self.folder = folder
         self.staging = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", dir=folder.parent))
         self.name = name
+        self._inputs = None  # (path, its raster inputs) of the last add
         self.header: dict | None = None
         self.entries: list[dict] = []
         self.lo = np.full(3, np.inf)
@@ -116,7 +119,9 @@ class ChunkWriter:
     def add(self, path: SoftwarePath, ids: np.ndarray | None = None, first_id: int = 0) -> None:
         """Write the triangles ``ids`` (default all) of the prepared ``path`` as the next
         domain, with global indices ``ids + first_id``."""
-        inputs = path.raster_inputs()
+        if self._inputs is None or self._inputs[0] is not path:  # one path, several domains
+            self._inputs = (path, path.raster_inputs())
+        inputs = self._inputs[1]
         header = _header(path, inputs)
         if self.header is None:
             self.header = header
@@ -301,6 +306,18 @@ class ChunkedScene:
         """(lo, hi) float64 corners of the whole scene (model units)."""
         lo, hi = self.manifest["bounds"]
         return np.array(lo, np.float64), np.array(hi, np.float64)
+
+    def domain_nbytes(self, index: int) -> int:
+        """Bytes domain ``index`` takes in memory once loaded (:attr:`DomainChunk.nbytes`),
+        from the manifest's counts and the columns its files hold (no data read)."""
+        import pyarrow.parquet as pq
+
+        entry, folder = self.manifest["domains"][index], _domain_folder(self.folder, index)
+        vertex_columns = set(pq.read_schema(folder / "vertices.parquet").names)
+        triangle_columns = set(pq.read_schema(folder / "triangles.parquet").names)
+        per_vertex = 24 + 12 * ("nx" in vertex_columns) + 8 * ("value" in vertex_columns)
+        per_triangle = 24 + 8 + 8 * ("value" in triangle_columns)  # a, b, c and id: int64
+        return entry["vertices"] * per_vertex + entry["triangles"] * per_triangle
 
     def load(self, index: int) -> DomainChunk:
         """Domain ``index`` read from its Parquet files; ValueError when they do not match the

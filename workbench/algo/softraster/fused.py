@@ -48,7 +48,7 @@ import numpy as np
 from numba import prange
 
 from . import kernels
-from .kernels import CONSTANT, ELEMENT_COLOR, FLAT, GOURAUD, MISSING_S, VERTEX_COLOR
+from .kernels import CONSTANT, ELEMENT_COLOR, FLAT, GOURAUD, MISSING_S, VERTEX_COLOR, _flat_light
 
 DROPPED, SEVERAL = -1, -2  # tile codes of a triangle: drawn nowhere, in more than one tile
 BOX_PIXEL_WORK = 1  # work estimate of a tile: per box pixel tested …
@@ -202,33 +202,6 @@ def place(tris, fx, fy, fz, bits, width, height, shift, tiles_x, code, fill, mem
 
 
 # ----------------------------------------------------------------------------- tiles
-@numba.njit(cache=True, inline="always")
-def _flat_light(pos, view, fx, fy, inv, a, b, c):
-    """The flat light of triangle (a, b, c), as :func:`.kernels.light_triangles` computes it
-    (the same arithmetic)."""
-    x1, y1 = (fx[b] - fx[a]) * inv, (fy[b] - fy[a]) * inv
-    x2, y2 = (fx[c] - fx[a]) * inv, (fy[c] - fy[a]) * inv
-    det = x1 * y2 - y1 * x2
-    if det == 0:
-        return np.float32(0.25)
-    eye = kernels._eye
-    ea0, ea1, ea2 = eye(view, pos, a, 0), eye(view, pos, a, 1), eye(view, pos, a, 2)
-    e1x = np.float64(eye(view, pos, b, 0)) - ea0
-    e1y = np.float64(eye(view, pos, b, 1)) - ea1
-    e1z = np.float64(eye(view, pos, b, 2)) - ea2
-    e2x = np.float64(eye(view, pos, c, 0)) - ea0
-    e2y = np.float64(eye(view, pos, c, 1)) - ea1
-    e2z = np.float64(eye(view, pos, c, 2)) - ea2
-    gxx, gyx = (e1x * y2 - e2x * y1) / det, (e2x * x1 - e1x * x2) / det
-    gxy, gyy = (e1y * y2 - e2y * y1) / det, (e2y * x1 - e1y * x2) / det
-    gxz, gyz = (e1z * y2 - e2z * y1) / det, (e2z * x1 - e1z * x2) / det
-    nx = gxy * gyz - gxz * gyy
-    ny = gxz * gyx - gxx * gyz
-    nz = gxx * gyy - gxy * gyx
-    len2 = nx * nx + ny * ny + nz * nz
-    return np.float32(0.25 + 0.75 * abs(nz) / np.sqrt(len2)) if len2 > 0 else np.float32(0.25)
-
-
 @numba.njit(cache=True, inline="always")
 def _triangle_color(kind, light, s, base, missing, texels, texf, linear, alpha_test):
     """(packed RGBA8, visible) of a triangle of one colour (constant; flat or element colour

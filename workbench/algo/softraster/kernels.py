@@ -152,28 +152,33 @@ def light_triangles(pos, tris, view, fx, fy, bits, out):
     ``out`` (K,) float32 (0.25 for a triangle without area)."""
     inv = 1.0 / (1 << bits)
     for k in prange(tris.shape[0]):
-        a, b, c = tris[k, 0], tris[k, 1], tris[k, 2]
-        x1, y1 = (fx[b] - fx[a]) * inv, (fy[b] - fy[a]) * inv
-        x2, y2 = (fx[c] - fx[a]) * inv, (fy[c] - fy[a]) * inv
-        det = x1 * y2 - y1 * x2
-        if det == 0:
-            out[k] = np.float32(0.25)
-            continue
-        ea0, ea1, ea2 = _eye(view, pos, a, 0), _eye(view, pos, a, 1), _eye(view, pos, a, 2)
-        e1x = np.float64(_eye(view, pos, b, 0)) - ea0
-        e1y = np.float64(_eye(view, pos, b, 1)) - ea1
-        e1z = np.float64(_eye(view, pos, b, 2)) - ea2
-        e2x = np.float64(_eye(view, pos, c, 0)) - ea0
-        e2y = np.float64(_eye(view, pos, c, 1)) - ea1
-        e2z = np.float64(_eye(view, pos, c, 2)) - ea2
-        gxx, gyx = (e1x * y2 - e2x * y1) / det, (e2x * x1 - e1x * x2) / det
-        gxy, gyy = (e1y * y2 - e2y * y1) / det, (e2y * x1 - e1y * x2) / det
-        gxz, gyz = (e1z * y2 - e2z * y1) / det, (e2z * x1 - e1z * x2) / det
-        nx = gxy * gyz - gxz * gyy
-        ny = gxz * gyx - gxx * gyz
-        nz = gxx * gyy - gxy * gyx
-        len2 = nx * nx + ny * ny + nz * nz
-        out[k] = np.float32(0.25 + 0.75 * abs(nz) / np.sqrt(len2)) if len2 > 0 else np.float32(0.25)
+        out[k] = _flat_light(pos, view, fx, fy, inv, tris[k, 0], tris[k, 1], tris[k, 2])
+
+
+@numba.njit(cache=True, inline="always")
+def _flat_light(pos, view, fx, fy, inv, a, b, c):
+    """The flat light of triangle (a, b, c) (:func:`light_triangles`); ``inv`` is one over the
+    sub-pixel scale of the snapped ``fx``, ``fy``."""
+    x1, y1 = (fx[b] - fx[a]) * inv, (fy[b] - fy[a]) * inv
+    x2, y2 = (fx[c] - fx[a]) * inv, (fy[c] - fy[a]) * inv
+    det = x1 * y2 - y1 * x2
+    if det == 0:
+        return np.float32(0.25)
+    ea0, ea1, ea2 = _eye(view, pos, a, 0), _eye(view, pos, a, 1), _eye(view, pos, a, 2)
+    e1x = np.float64(_eye(view, pos, b, 0)) - ea0
+    e1y = np.float64(_eye(view, pos, b, 1)) - ea1
+    e1z = np.float64(_eye(view, pos, b, 2)) - ea2
+    e2x = np.float64(_eye(view, pos, c, 0)) - ea0
+    e2y = np.float64(_eye(view, pos, c, 1)) - ea1
+    e2z = np.float64(_eye(view, pos, c, 2)) - ea2
+    gxx, gyx = (e1x * y2 - e2x * y1) / det, (e2x * x1 - e1x * x2) / det
+    gxy, gyy = (e1y * y2 - e2y * y1) / det, (e2y * x1 - e1y * x2) / det
+    gxz, gyz = (e1z * y2 - e2z * y1) / det, (e2z * x1 - e1z * x2) / det
+    nx = gxy * gyz - gxz * gyy
+    ny = gxz * gyx - gxx * gyz
+    nz = gxx * gyy - gxy * gyx
+    len2 = nx * nx + ny * ny + nz * nz
+    return np.float32(0.25 + 0.75 * abs(nz) / np.sqrt(len2)) if len2 > 0 else np.float32(0.25)
 
 
 # ----------------------------------------------------------------------------- clip triangle
