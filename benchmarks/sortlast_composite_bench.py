@@ -4,12 +4,15 @@ The es2008 scene (1 M triangles, ``--n``² quads per sheet) is split into ``--do
 domains (default 8), rendered at ``--size`` (default 1000×1000) by the software rasterizer on
 ``--workers`` worker processes (default 2, one thread each), and composited on the workers by
 every schedule of :func:`workbench.experiment.sortlast.render_sortlast`: ``tree`` and
-``swap`` (whole frames, as before), ``active-tree``, ``active-swap`` and ``radix`` (direct
-send, and 2×4). The schedules are interleaved over ``--repeat`` rounds (default 5); per
-schedule the median composite time with its range, the bytes that moved between workers and
-the bytes the schedule sends, and whether the image equals the one-process frame. Then the same
-domains drawn by GL (each worker's own EGL context) and composited by ``active-swap``, against
-the image one context draws.
+``swap`` (whole frames, as before), ``active-tree``, ``active-swap``, ``radix`` (direct
+send, and 2×4) and ``local`` (each worker's domains composited there, one piece sent per
+other worker). The client fetches the final colour (``color_only``, what a display needs) or
+the whole frame (colour, depth, triangle indices: the fetched column). The schedules are
+interleaved over ``--repeat`` rounds (default 5); per schedule the median composite time with
+its range, the bytes that moved between workers and the bytes the schedule sends, and whether
+the image equals the one-process frame. Then the same domains drawn by GL (each worker's own
+EGL context) and composited by ``local`` and ``active-swap``, against the image one context
+draws.
 
 Run alone (it times): ``.venv/bin/python benchmarks/sortlast_composite_bench.py``.
 """
@@ -22,8 +25,10 @@ import statistics
 
 import numpy as np
 
-SCHEDULES = (("tree", None), ("swap", None), ("active-tree", None), ("active-swap", None),
-             ("radix", None), ("radix", (2, 4)))
+SCHEDULES = (("tree", None, False), ("swap", None, False), ("tree", None, True),
+             ("swap", None, True), ("active-tree", None, True), ("active-swap", None, True),
+             ("radix", None, True), ("radix", (2, 4), True), ("local", None, True),
+             ("local", None, False))
 
 
 def main(argv=None) -> int:
@@ -58,19 +63,24 @@ def main(argv=None) -> int:
     results: dict[str, list] = {}
     with cluster, Client(cluster) as client:
         client.wait_for_workers(args.workers, timeout=120)
-        render_sortlast(client, software, domains, method="tree")  # workers load the scene
+        for method, factors, color_only in SCHEDULES:  # load the scene, compile the kernels
+            render_sortlast(client, software, domains, method=method, factors=factors,
+                            color_only=color_only)
         for _ in range(args.repeat):
-            for method, factors in SCHEDULES:
-                frame, stats = render_sortlast(client, software, domains, method=method,
-                                               factors=factors)
-                name = method + ("" if factors is None else " " + "x".join(map(str, factors)))
-                equal = (np.array_equal(frame.color, reference.color)
-                         and np.array_equal(frame.triangle, reference.triangle))
+            for method, factors, color_only in SCHEDULES:
+                out, stats = render_sortlast(client, software, domains, method=method,
+                                             factors=factors, color_only=color_only)
+                name = (method + ("" if factors is None else " " + "x".join(map(str, factors)))
+                        + (" | colour" if color_only else " | frame"))
+                color = out if color_only else out.color
+                equal = np.array_equal(color, reference.color) and (
+                    color_only or (np.array_equal(out.triangle, reference.triangle)
+                                   and np.array_equal(out.depth, reference.depth)))
                 results.setdefault(name, []).append((stats.composite_s, stats.bytes_moved,
                                                      stats.schedule_bytes, equal))
-        base = statistics.median(r[1] for r in results["swap"])
-        print("| schedule | composite s, median [min, max] | moved MiB | of swap's | "
-              "schedule MiB | equal |\n|---|---|---:|---:|---:|---|")
+        base = statistics.median(r[1] for r in results["swap | frame"])
+        print("| schedule | fetched | composite s, median [min, max] | moved MiB | of swap's | "
+              "schedule MiB | equal |\n|---|---|---|---:|---:|---:|---|")
         for name, rows in results.items():
             times = [r[0] for r in rows]
             moved = statistics.median(r[1] for r in rows)
@@ -84,10 +94,12 @@ def main(argv=None) -> int:
         target.clear()
         path.draw()
         one_context = target.read()
-        frame, stats = render_sortlast(client, gl, domains, method="active-swap")
-        print(f"GL domains, active-swap: {stats.composite_s:.3f} s, "
-              f"{stats.bytes_moved / 2**20:.1f} MiB moved, image equal to one context: "
-              f"{np.array_equal(frame.color, one_context)}")
+        render_sortlast(client, gl, domains, method="local")  # every worker opens its context
+        for method in ("local", "active-swap", "local", "active-swap"):
+            color, stats = render_sortlast(client, gl, domains, method=method, color_only=True)
+            print(f"GL domains, {method}: {stats.composite_s:.3f} s, "
+                  f"{stats.bytes_moved / 2**20:.1f} MiB moved, image equal to one context: "
+                  f"{np.array_equal(color, one_context)}")
     return 0
 
 

@@ -83,7 +83,7 @@ def check_span_tables(out_dir) -> None:
 def check_composites(out_dir, domains: set) -> None:
     rows = read_table(out_dir / "composite.csv")
     assert {r["domains"] for r in rows} == domains
-    assert {r["method"] for r in rows} == {"tree", "swap"}
+    assert {r["method"] for r in rows} == {"tree", "swap", "active-swap", "local"}
     assert all(r["equal_to_one_process"] is True and r["differing_px"] == 0 for r in rows)
     assert all(r["bytes_moved_MB"] > 0 for r in rows if r["domains"] > 1)
     for name in ("images.png", "steps.png", "table.md", "steps.md", "composite.md"):

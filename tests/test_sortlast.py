@@ -256,3 +256,59 @@ def test_active_pixel_schedules_on_the_cluster_equal_the_reduction(client, metho
     if domains > 1:
         _, full = render_sortlast(client, render_rects, parts, method="swap")
         assert 0 < stats.schedule_bytes < full.schedule_bytes
+
+
+@pytest.mark.parametrize("domains", [1, 2, 3, 5, 8])
+def test_local_schedule_equals_the_reduction_and_sends_one_piece_per_other_worker(client,
+                                                                                 domains):
+    """Each worker composites its consecutive domains, then sends its drawn pixels once: the
+    reduction of the frames exactly; with two workers one piece moves, and what moved is
+    exactly that piece."""
+    import functools
+
+    from workbench.algo.softraster.active import ActivePixels
+    from workbench.algo.softraster.composite import composite
+    from workbench.experiment.sortlast_schedules import local_placement
+
+    parts = interleaved(domains)
+    frames = [render_rects(p) for p in parts]
+    expected = functools.reduce(composite, frames)
+    out, stats = render_sortlast(client, render_rects, parts, method="local")
+    for name in ("color", "depth", "triangle"):
+        np.testing.assert_array_equal(getattr(out, name), getattr(expected, name), err_msg=name)
+    color, _ = render_sortlast(client, render_rects, parts, method="local", color_only=True)
+    assert color.dtype == np.uint8 and np.array_equal(color, expected.color)
+
+    blocks = local_placement(domains, 2)
+    assert blocks == sorted(blocks) and set(blocks) == ({0} if domains == 1 else {0, 1})
+    if domains == 1:
+        assert stats.workers == 1 and stats.bytes_moved == 0 == stats.schedule_bytes
+        return
+    second = [f for f, w in zip(frames, blocks) if w == 1]
+    piece = ActivePixels.from_frame(functools.reduce(composite, second)).pack()
+    assert stats.workers == 2
+    assert stats.schedule_bytes == piece.nbytes == stats.bytes_moved
+
+
+def test_color_only_fetches_the_colour_for_every_method(client):
+    whole = render_rects(np.arange(COUNT))
+    for method in ("tree", "swap", "active-swap", "radix"):
+        color, stats = render_sortlast(client, render_rects, interleaved(4), method=method,
+                                       color_only=True)
+        assert np.array_equal(color, whole.color), method
+        assert stats.schedule_bytes > 0
+
+
+def test_local_schedule_refuses_frames_of_different_sizes(client):
+    with pytest.raises(ValueError, match="differ in size"):
+        render_sortlast(client, render_wrong_size, [np.arange(2), np.arange(3)], method="local")
+    with pytest.raises(ValueError, match="differ in size"):  # met on one worker
+        render_sortlast(client, render_wrong_size, [np.arange(2), np.arange(3), np.arange(4),
+                                                    np.arange(5)], method="local")
+
+
+def test_the_command_line_offers_every_compositing_method():
+    from workbench.cli.render import COMPOSITE_METHODS
+    from workbench.experiment.sortlast import METHODS
+
+    assert sorted(COMPOSITE_METHODS) == sorted(METHODS)

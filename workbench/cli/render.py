@@ -11,6 +11,9 @@ from pathlib import Path
 
 from .arguments import image_size, key_value, view_angles
 
+# workbench.experiment.sortlast.METHODS, not imported here: it imports Dask
+COMPOSITE_METHODS = ("local", "tree", "swap", "active-tree", "active-swap", "radix")
+
 
 def add_parser(subparsers) -> None:
     """Add ``render`` to the ``workbench`` command's subparsers."""
@@ -89,8 +92,11 @@ def _add_sortlast_arguments(p) -> None:
                         "rasterizer on Dask workers and composite them by depth")
     p.add_argument("--split", choices=("space", "part"), default="space",
                    help="domains by recursive bisection in space (default) or by whole parts")
-    p.add_argument("--composite", choices=("tree", "swap"), default="tree",
-                   help="compositing schedule: binary tree (default) or binary swap")
+    p.add_argument("--composite", choices=COMPOSITE_METHODS, default="local",
+                   help="compositing schedule: local (default: each worker composites its own "
+                        "domains, then sends its drawn pixels once), binary tree or swap of "
+                        "whole frames, or active-tree, active-swap, radix (direct send) of "
+                        "drawn pixels only")
     p.add_argument("--workers", type=int,
                    help="local Dask worker processes (default: one per core)")
     p.add_argument("--scheduler", metavar="ADDRESS",
@@ -309,15 +315,15 @@ def _render_sortlast(args, mesh, path, camera, size) -> int:
                                         path.options)
     # GLDomains opens its own context in each worker process
     with sweep_cluster(args.workers, args.scheduler, gl=False) as cluster:
-        frame, stats = render_sortlast(cluster.client, render_domain, domains,
-                                       method=args.composite)
-    _check_drawn(frame.color, mesh, camera, size, args.step)
+        color, stats = render_sortlast(cluster.client, render_domain, domains,
+                                       method=args.composite, color_only=True)
+    _check_drawn(color, mesh, camera, size, args.step)
     out = Path(args.output)
     if gl:
         path.scale = path.check_mesh(mesh)  # the colour scale of the bar
     else:
         path.prepare(None, mesh, camera)
-    _write_image(out, frame.color, path, args.field, args,
+    _write_image(out, color, path, args.field, args,
                  f"{mesh.name} ({path.name}, {args.domains} domains)")
     print(f"{out}: {mesh.name}, {len(mesh.triangles)} triangles in {args.domains} domains "
           f"by {args.split} on {stats.workers} workers; {args.composite} compositing "

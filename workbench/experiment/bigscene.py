@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..paths.chunked import ChunkedScene, ChunkWriter, render_chunked
-from .sortlast import ChunkDomains, peak_memory_mib, render_sortlast
+from .sortlast import ChunkDomains, domain_workers, peak_memory_mib, render_sortlast
 
 
 def semicylinder_sheet(k: int, n: int, radius: float = 100.0, spacing: float = 10.0):
@@ -122,9 +122,9 @@ def run_chunked_sortlast(client, folder: str | Path, size: tuple[int, int] = (10
     peaks = peak_memory_mib(client)
     sizes = [scene.domain_nbytes(i) / 2**20 for i in range(len(scene))]
     domain_mib = max(sizes)
-    # domain i goes to the i-th worker in address order (render_sortlast's placement)
-    addresses = sorted(peaks)
-    share_mib = {a: sum(sizes[i] for i in range(len(sizes)) if i % len(addresses) == k)
+    addresses = sorted(peaks)  # render_sortlast's placement, by worker rank in address order
+    on = domain_workers(method, len(sizes), len(addresses))
+    share_mib = {a: sum(size for size, w in zip(sizes, on) if w == k)
                  for k, a in enumerate(addresses)}
     equal, reference_s = True, float("nan")
     if reference:

@@ -2,13 +2,15 @@
 their frames composited by depth on the workers, the final image brought to the client.
 
 :func:`render_sortlast` submits one render task per domain, spread over the workers in turn
-(domain i to the i-th worker, in address order, modulo their number). Once every frame exists
-it composites them by the schedule of :mod:`workbench.algo.softraster.composite`, as Dask tasks
-that take futures, so that Dask itself moves the (sub-)images between workers. Each rank of
-the schedule is the worker holding that domain's frame, and each compositing task is placed on
-the worker of the rank that receives. Placements are preferences (``allow_other_workers``):
-Dask follows them while the worker is up and runs a task elsewhere rather than wait for a lost
-one; a task run elsewhere (also by work stealing) shows as extra ``bytes_moved``:
+(domain i to the i-th worker, in address order, modulo their number; for ``"local"``, in
+blocks of consecutive domains). Once every frame exists it composites them by a schedule of
+:mod:`workbench.algo.softraster.composite`, submitted as Dask tasks that take futures
+(:mod:`.sortlast_schedules`), so that Dask itself moves the (sub-)images between workers.
+Each rank of the schedule is the worker holding that domain's frame, and each compositing task
+is placed on the worker of the rank that receives. Placements are preferences
+(``allow_other_workers``): Dask follows them while the worker is up and runs a task elsewhere
+rather than wait for a lost one; a task run elsewhere (also by work stealing) shows as extra
+``bytes_moved``:
 
 * ``"tree"``: one ``composite`` task per pair and round; the result ends on rank 0's worker.
 * ``"swap"``: per pair and round, two crop tasks (each rank cuts out the half it gives up) and
@@ -20,6 +22,10 @@ one; a task run elsewhere (also by work stealing) shows as extra ``bytes_moved``
   the same exchanges (radix-k: :func:`~workbench.algo.softraster.active_schedules.radix_plan`)
   send encoded pieces (bounding box and runs of drawn pixels), merged in domain order; rank 0
   paints every rank's part over its own frame. ``schedule_bytes`` is the pieces' bytes.
+* ``"local"``: each worker composites its own consecutive domains' frames first (compiled,
+  :mod:`workbench.algo.softraster.composite_kernels`); every worker but the first then sends
+  its drawn pixels as one encoded piece to the first, which composites them over its own:
+  two levels of tasks, W − 1 pieces for W workers, whatever the domain count.
 
 The two phases do not overlap: compositing starts once every frame exists, so that render and
 composite times are measured apart. The result equals ``functools.reduce(composite, frames)``
@@ -39,16 +45,17 @@ from dask.sizeof import sizeof
 from distributed import Client, wait
 
 from ..algo.softraster.active import EncodedPiece
-from ..algo.softraster.composite import (
-    Region,
-    assemble,
-    bytes_per_pixel,
-    composite,
-    crop,
-    swap_plan,
-    tree_plan,
-)
+from ..algo.softraster.composite import bytes_per_pixel
 from ..algo.softraster.frame import Frame
+from .sortlast_schedules import (
+    color_of,
+    local_placement,
+    piece_bytes,
+    submit_active,
+    submit_local,
+    submit_swap,
+    submit_tree,
+)
 
 if TYPE_CHECKING:
     from ..algo.softraster import RasterOptions
@@ -56,7 +63,7 @@ if TYPE_CHECKING:
     from ..paths.software import SoftwarePath
     from ..paths.style import Style
 
-METHODS = ("tree", "swap", "active-tree", "active-swap", "radix")
+METHODS = ("tree", "swap", "active-tree", "active-swap", "radix", "local")
 KEY_PREFIX = "sortlast"
 
 
@@ -243,12 +250,12 @@ def _sizeof_piece(piece: EncodedPiece) -> int:
 
 @dataclass
 class SortLastStats:
-    """One sort-last run: ``domains`` frames composited by ``method`` (``"tree"`` or
-    ``"swap"``), rendered on ``workers`` distinct workers.
+    """One sort-last run: ``domains`` frames composited by ``method`` (one of :data:`METHODS`),
+    rendered on ``workers`` distinct workers.
 
     ``render_s``: wall seconds from submitting the render tasks until every domain frame
-    exists. ``composite_s``: wall seconds from then until the final frame is in the client
-    (frame-size check, compositing tasks, fetching the result).
+    exists. ``composite_s``: wall seconds from then until the final frame (or its colour) is in
+    the client (frame-size check where the schedule needs one, compositing tasks, fetching).
     ``bytes_moved``: bytes of compositing-task inputs that travelled from one worker to
     another, summed from every worker's log of received dependencies
     (``distributed.Worker.transfer_incoming_log``; a frame counts its colour + depth + triangle
@@ -271,20 +278,24 @@ class SortLastStats:
 
 def render_sortlast(client: Client, render_domain: Callable[[np.ndarray], Frame],
                     domains: Sequence[np.ndarray], method: str = "tree",
-                    factors: Sequence[int] | None = None) -> tuple[Frame, SortLastStats]:
+                    factors: Sequence[int] | None = None, color_only: bool = False,
+                    ) -> tuple[Frame | np.ndarray, SortLastStats]:
     """Render each domain with ``render_domain`` on the cluster of ``client`` and composite
     the frames by ``method`` on the workers: ``"tree"`` (binary tree) and ``"swap"`` (binary
     swap) send whole (sub-)frames; ``"active-tree"``, ``"active-swap"`` and ``"radix"``
     (radix-k with round sizes ``factors``, default direct send) send only drawn pixels, as
     encoded pieces (:mod:`workbench.algo.softraster.active`), each rank's pixels staying on
-    its worker.
+    its worker; ``"local"`` renders consecutive domains on each worker, composites them
+    there and sends each worker's drawn pixels once, to the first worker
+    (:func:`~workbench.experiment.sortlast_schedules.submit_local`).
 
     ``render_domain`` is a picklable callable taking one domain and returning that domain's
     :class:`Frame` of the whole image; ``domains`` lists them, frame i coming from domain i:
     int64 arrays of triangle indices (e.g. from :func:`workbench.scene.domains.split_domains`,
     for :class:`SoftwareDomains`) or domain numbers (for :class:`ChunkDomains`).
-    Returns the composite — exactly ``functools.reduce(composite, frames)`` — and its
-    :class:`SortLastStats`.
+    Returns the composite — exactly ``functools.reduce(composite, frames)``, or only its
+    colour (H, W, 4) when ``color_only`` (what a display needs: the depth and triangle
+    indices are not fetched) — and its :class:`SortLastStats`.
 
     Refused (ValueError): an unknown ``method``; no domains; a domain that is neither a 1-D
     array of integers nor an integer; domain frames of different sizes. An error raised by
@@ -301,10 +312,11 @@ def render_sortlast(client: Client, render_domain: Callable[[np.ndarray], Frame]
         raise ValueError("the cluster has no workers")
     client.run(_ensure_sizeof)  # every worker sizes frames by their array bytes from now on
     run = f"{KEY_PREFIX}-{uuid.uuid4().hex[:10]}"
+    placement = [addresses[w] for w in domain_workers(method, len(arrays), len(addresses))]
 
     start = time.perf_counter()
     frames = [client.submit(render_domain, tris, key=f"{run}-render-d{i}", pure=False,
-                            workers=[addresses[i % len(addresses)]], allow_other_workers=True)
+                            workers=[placement[i]], allow_other_workers=True)
               for i, tris in enumerate(arrays)]
     wait(frames)
     rendered = time.perf_counter()
@@ -312,26 +324,39 @@ def render_sortlast(client: Client, render_domain: Callable[[np.ndarray], Frame]
         if frame.status != "finished":
             frame.result()  # raises the render error
 
-    holders = client.who_has(frames)
-    where = [min(holders[f.key]) for f in frames]
-    sizes = client.gather([client.submit(_frame_shape, f, key=f"{run}-shape-d{i}", pure=False,
-                                         workers=[where[i]], allow_other_workers=True)
-                           for i, f in enumerate(frames)])
-    if len(set(sizes)) > 1:
-        raise ValueError(f"domain frames differ in size: {sorted(set(sizes))} "
-                         f"(rows, columns, channels)")
-    height, width, _ = sizes[0]
-    if method in ("tree", "swap"):
-        schedule = _tree if method == "tree" else _swap
-        final, schedule_pixels = schedule(client, run, frames, where, height, width)
+    if method == "local":  # sizes are checked where the frames meet
+        final, pieces = submit_local(client, run, frames, placement, color_only)
         result = final.result()
         done = time.perf_counter()
-        schedule_bytes = schedule_pixels * bytes_per_pixel(result)
+        where = placement
     else:
-        final, pieces = _active(client, run, frames, where, height, width, method, factors)
+        holders = client.who_has(frames)
+        where = [min(holders[f.key]) for f in frames]
+        sizes = client.gather([client.submit(_frame_shape, f, key=f"{run}-shape-d{i}",
+                                             pure=False, workers=[where[i]],
+                                             allow_other_workers=True)
+                               for i, f in enumerate(frames)])
+        if len(set(shape for shape, _ in sizes)) > 1:
+            raise ValueError(f"domain frames differ in size: "
+                             f"{sorted(set(shape for shape, _ in sizes))} "
+                             f"(rows, columns, channels)")
+        (height, width, _), pixel_bytes = sizes[0]
+        if method in ("tree", "swap"):
+            schedule = submit_tree if method == "tree" else submit_swap
+            final, schedule_pixels = schedule(client, run, frames, where, height, width)
+            pieces = []
+        else:
+            final, pieces = submit_active(client, run, frames, where, height, width, method,
+                                          factors)
+        if color_only:
+            final = client.submit(color_of, final, key=f"{run}-color", pure=False,
+                                  workers=[where[0]], allow_other_workers=True)
         result = final.result()
         done = time.perf_counter()
-        schedule_bytes = sum(client.gather([client.submit(_piece_bytes, piece, pure=False,
+    if method in ("tree", "swap"):
+        schedule_bytes = schedule_pixels * pixel_bytes
+    else:
+        schedule_bytes = sum(client.gather([client.submit(piece_bytes, piece, pure=False,
                                                           key=f"{run}-bytes-{i}")
                                             for i, piece in enumerate(pieces)]))
 
@@ -339,6 +364,15 @@ def render_sortlast(client: Client, render_domain: Callable[[np.ndarray], Frame]
     stats = SortLastStats(len(arrays), method, len(set(where)), rendered - start, done - rendered,
                           int(sum(moved.values())), int(schedule_bytes))
     return result, stats
+
+
+def domain_workers(method: str, domains: int, workers: int) -> list[int]:
+    """The worker (by rank in address order, 0 … ``workers`` − 1) that :func:`render_sortlast`
+    asks to render each of ``domains`` domains for ``method``: in turn (domain i on worker
+    i mod ``workers``), or for ``"local"`` in blocks of consecutive domains."""
+    if method == "local":
+        return local_placement(domains, workers)
+    return [i % workers for i in range(domains)]
 
 
 def _domain(d, i: int):
@@ -353,188 +387,14 @@ def _domain(d, i: int):
     return a.astype(np.int64)
 
 
-def _tree(client, run, frames, where, height, width):
-    """Binary-tree tasks; returns the final future and the schedule's pixels sent."""
-    plan = tree_plan(len(frames))
-    held = dict(enumerate(frames))
-    for k, pairs in enumerate(plan.rounds):
-        for receiver, sender in pairs:
-            held[receiver] = client.submit(
-                composite, held[receiver], held.pop(sender),
-                key=f"{run}-tree-round{k}-d{receiver}-d{sender}", pure=False,
-                workers=[where[receiver]], allow_other_workers=True)
-    return held[0], plan.bytes_moved(height, width, 1)
-
-
-def _swap(client, run, frames, where, height, width):
-    """Binary-swap tasks; returns the final future and the schedule's pixels sent."""
-    plan = swap_plan(len(frames), height, width)
-
-    def submit(fn, *args, key, rank_domain):
-        return client.submit(fn, *args, key=f"{run}-swap-{key}", pure=False,
-                             workers=[where[rank_domain]], allow_other_workers=True)
-
-    folded = {keeper: submit(composite, frames[keeper], frames[sender],
-                             key=f"fold-d{keeper}-d{sender}", rank_domain=keeper)
-              for keeper, sender in plan.fold}
-    held = [folded.get(d, frames[d]) for d in plan.ranks]
-    for k, exchanges in enumerate(plan.rounds):
-        for e in exchanges:
-            low_d, high_d = plan.ranks[e.lower], plan.ranks[e.upper]
-            low_part, high_part = e.lower_keeps.within(e.held), e.upper_keeps.within(e.held)
-            # each rank cuts out the half it gives up, on its own worker
-            to_low = submit(_cut, held[e.upper], low_part,
-                            key=f"round{k}-cut-d{high_d}-to-d{low_d}", rank_domain=high_d)
-            to_high = submit(_cut, held[e.lower], high_part,
-                             key=f"round{k}-cut-d{low_d}-to-d{high_d}", rank_domain=low_d)
-            # and composites the half it keeps with the half it receives, lower domain first
-            held[e.lower] = submit(_merge, held[e.lower], low_part, to_low, None,
-                                   key=f"round{k}-merge-d{low_d}", rank_domain=low_d)
-            held[e.upper] = submit(_merge, to_high, None, held[e.upper], high_part,
-                                   key=f"round{k}-merge-d{high_d}", rank_domain=high_d)
-    if len(held) == 1:
-        final = held[0]
-    else:
-        final = submit(_gather, height, width, plan.regions, *held, key="gather",
-                       rank_domain=plan.ranks[0])
-    return final, plan.bytes_moved(1)
-
-
-def _active(client, run, frames, where, height, width, method, factors):
-    """Active-pixel schedules (:mod:`workbench.algo.softraster.active`): every rank turns its
-    frame into its drawn pixels on its own worker; what travels are encoded pieces. Returns
-    the final frame's future and the futures of every piece sent."""
-    from ..algo.softraster.active import ActivePixels
-    from ..algo.softraster.active_schedules import radix_plan
-
-    pieces = []
-
-    def submit(fn, *args, key, rank_domain):
-        return client.submit(fn, *args, key=f"{run}-{method}-{key}", pure=False,
-                             workers=[where[rank_domain]], allow_other_workers=True)
-
-    def send(held_of, rank_domain, region, key):
-        piece = submit(_pack, held_of, region, key=f"{key}-pack", rank_domain=rank_domain)
-        pieces.append(piece)
-        return piece
-
-    held = {d: submit(ActivePixels.from_frame, f, key=f"active-d{d}", rank_domain=d)
-            for d, f in enumerate(frames)}
-    ranks = list(range(len(frames)))
-    if method == "active-tree":
-        for k, pairs in enumerate(tree_plan(len(frames)).rounds):
-            for receiver, sender in pairs:
-                piece = send(held.pop(sender), sender, None, f"round{k}-d{sender}")
-                held[receiver] = submit(_merge_in, held[receiver], None, piece,
-                                        key=f"round{k}-merge-d{receiver}",
-                                        rank_domain=receiver)
-        parts, ranks = {0: held[0]}, [0]  # the tree ends on rank 0: nothing to gather
-    elif method == "active-swap":
-        plan = swap_plan(len(frames), height, width)
-        for keeper, sender in plan.fold:
-            piece = send(held.pop(sender), sender, None, f"fold-d{sender}")
-            held[keeper] = submit(_merge_in, held[keeper], None, piece,
-                                  key=f"fold-merge-d{keeper}", rank_domain=keeper)
-        ranks = list(plan.ranks)
-        for k, exchanges in enumerate(plan.rounds):
-            for e in exchanges:
-                low_d, high_d = ranks[e.lower], ranks[e.upper]
-                to_low = send(held[high_d], high_d, e.lower_keeps, f"round{k}-d{high_d}")
-                to_high = send(held[low_d], low_d, e.upper_keeps, f"round{k}-d{low_d}")
-                held[low_d] = submit(_merge_in, held[low_d], e.lower_keeps, to_low,
-                                     key=f"round{k}-merge-d{low_d}", rank_domain=low_d)
-                held[high_d] = submit(_merge_upper, to_high, held[high_d], e.upper_keeps,
-                                      key=f"round{k}-merge-d{high_d}", rank_domain=high_d)
-        parts = {d: held[d] for d in ranks}
-    else:
-        plan = radix_plan(len(frames), height, width, factors)
-        for k, groups in enumerate(plan.rounds):
-            new = {}
-            for g in groups:
-                for j, part in enumerate(g.parts):
-                    receiver = g.members[j]
-                    received = [send(held[m], m, part, f"round{k}-d{m}-to-d{receiver}")
-                                for m in g.members if m != receiver]
-                    new[receiver] = submit(_merge_group, j, part, held[receiver], *received,
-                                           key=f"round{k}-merge-d{receiver}",
-                                           rank_domain=receiver)
-            held.update(new)
-        parts = {d: held[d] for d in ranks}
-    first = ranks[0]
-    gathered = [send(parts[d], d, None, f"gather-d{d}") for d in ranks[1:]]
-    final = submit(_paint, frames[0], parts[first], *gathered, key="paint", rank_domain=0)
-    return final, pieces
-
-
-# ------------------------------------------------------------------------ worker-side tasks
-def _pack(pixels, region):
-    """The encoded piece a rank sends: its drawn pixels (in ``region`` where given)."""
-    return (pixels if region is None else pixels.cut(region)).pack()
-
-
-def _merge_in(own, region, piece):
-    """A rank's drawn pixels (cut to ``region`` where given) merged with a piece received from
-    a later domain: the lower domain first."""
-    from ..algo.softraster.active import merge
-
-    return merge(own if region is None else own.cut(region), piece.unpack())
-
-
-def _merge_upper(piece, own, region):
-    """The upper rank of a swap pair: the piece of the lower domain first, then its own part."""
-    from ..algo.softraster.active import merge
-
-    return merge(piece.unpack(), own.cut(region))
-
-
-def _merge_group(j: int, part, own, *pieces):
-    """Radix-k member ``j`` of its group: the group's parts of ``part`` in member order, its own
-    in place ``j``."""
-    from ..algo.softraster.active import merge_ordered
-
-    items = [p.unpack() for p in pieces]
-    items.insert(j, own.cut(part))
-    return merge_ordered(items)
-
-
-def _paint(frame0: Frame, own, *pieces) -> Frame:
-    """Rank 0's final frame: every rank's drawn pixels painted over frame 0."""
-    from ..algo.softraster.active import paint
-
-    return paint(frame0, [own] + [p.unpack() for p in pieces])
-
-
-def _piece_bytes(piece) -> int:
-    return int(piece.nbytes)
 
 def _ensure_sizeof() -> None:
     """Run on every worker: importing this module registers the frame size with Dask."""
 
 
-def _frame_shape(frame: Frame) -> tuple[int, int, int]:
-    return tuple(int(s) for s in frame.color.shape)
-
-
-def _cut(frame: Frame, region: Region) -> Frame:
-    """A compact copy of the sub-image ``region`` of ``frame`` (what one rank sends)."""
-    part = crop(frame, region)
-    return Frame(np.ascontiguousarray(part.color), np.ascontiguousarray(part.depth),
-                 np.ascontiguousarray(part.triangle))
-
-
-def _merge(lower: Frame, lower_region: Region | None, upper: Frame,
-           upper_region: Region | None) -> Frame:
-    """``composite`` of the lower rank's and the upper rank's sub-images of one region, each
-    cropped first where a region is given."""
-    if lower_region is not None:
-        lower = crop(lower, lower_region)
-    if upper_region is not None:
-        upper = crop(upper, upper_region)
-    return composite(lower, upper)
-
-
-def _gather(height: int, width: int, regions: tuple[Region, ...], *pieces: Frame) -> Frame:
-    return assemble(height, width, regions, pieces)
+def _frame_shape(frame: Frame) -> tuple[tuple[int, int, int], int]:
+    """A frame's (rows, columns, channels) and its bytes per pixel."""
+    return tuple(int(s) for s in frame.color.shape), bytes_per_pixel(frame)
 
 
 def _received_bytes(run: str, dask_worker=None) -> int:

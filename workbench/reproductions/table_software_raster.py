@@ -31,8 +31,10 @@ cache-load time, table-fit share, and the draw against the half-space generator 
 
 **Compositing** (``composite.md``): the benchmark split into D = 1, 2, 4, 8 domains (by space
 and by part), rendered by the software rasterizer on a LocalCluster of 2 worker processes and
-composited by binary tree and binary swap: equality with the one-process image, bytes moved
-between workers, render and compositing seconds (tiny: D = 1, 2 on a small image).
+composited by binary tree and binary swap of whole frames, binary swap of drawn pixels only
+(``active-swap``) and local compositing with one piece per other worker (``local``): equality
+with the one-process image, bytes moved between workers, render and compositing seconds (tiny:
+D = 1, 2 on a small image).
 
 Run: ``workbench run table_software_raster [--quick]``.
 """
@@ -340,11 +342,14 @@ def span_table_rows(rows: list[dict]) -> list[dict]:
     return out
 
 
+COMPOSITE_METHODS = ("tree", "swap", "active-swap", "local")
+
+
 def composite_rows(exp: ExperimentContext) -> list[dict]:
     """The benchmark (8 sheets of 250 × 250 quads at 1000 × 1000; quick 64 × 64 at 500 × 500,
     tiny 16 × 16 at 100 × 100) split into D = 1, 2, 4, 8 domains (tiny 1, 2) by space and by
-    part, drawn on a LocalCluster of 2 worker processes and composited by binary tree and
-    binary swap, against the one-process image."""
+    part, drawn on a LocalCluster of 2 worker processes and composited by every schedule of
+    :data:`COMPOSITE_METHODS`, against the one-process image."""
     from workbench.experiment.cluster import sweep_cluster
     from workbench.experiment.sortlast import SoftwareDomains, render_sortlast
     from workbench.scene.domains import split_domains
@@ -360,7 +365,7 @@ def composite_rows(exp: ExperimentContext) -> list[dict]:
         for by in ("space", "part"):
             for count in exp.pick((1, 2, 4, 8), (1, 2, 4, 8), (1, 2)):
                 domains = split_domains(render_domain.prepared().mesh, count, by=by)
-                for method in ("tree", "swap"):
+                for method in COMPOSITE_METHODS:
                     frame, stats = render_sortlast(cluster.client, render_domain, domains,
                                                    method=method)
                     differing = int(((frame.color != one.color).any(axis=-1)
