@@ -5,10 +5,10 @@ from one compiled loop per screen tile.
 whole batch through memory, so that a second thread gains little. Here, after the per-vertex
 transform and light (the pipeline's own step), the triangles go through three passes:
 
-1. **clip** (:func:`classify`) — every triangle once, in parallel over runs of triangles: the
-   clip test of :func:`.kernels.clip_triangles`, its box of pixel centres and the screen tiles
-   of ``RasterOptions.tile`` pixels it meets, counted per run and tile with their estimated
-   work;
+1. **clip** (:func:`classify`) — every triangle once, in parallel over runs of triangles
+   (:data:`RUNS_PER_THREAD` per thread, a thread taking the next run when done): the clip
+   test of :func:`.kernels.clip_triangles`, its box of pixel centres and the screen tiles of
+   ``RasterOptions.tile`` pixels it meets, counted per run and tile with their estimated work;
 2. **bin** (:func:`place`) — every kept triangle, in the same runs, copied into the list of
    each of its tiles in triangle order: its index, fixed-point vertices and depths (read here
    in triangle order, where the vertices are near one another, so that a tile reads its list
@@ -24,9 +24,12 @@ transform and light (the pipeline's own step), the triangles go through three pa
    :func:`.kernels.light_triangles`, for the triangles seen only) and the write (as
    :func:`.kernels.write_fragments` decides it).
 
-No fragment is stored. The tiles are dealt to the threads by their estimated work (triangles
-and box pixels, the largest first to the least loaded thread); a tile's pixels depend only on
-its triangles in index order, so the image does not depend on the thread count, and of two
+No fragment is stored. The threads take the tiles one at a time, the largest estimated work
+(triangles and box pixels) first, each the next tile when it is done (numba's dynamic
+schedule, chunk size 1): an estimate cannot see how many triangles the hierarchical test will
+skip, and tiles dealt up front by it left one thread idle for a third of the pass. A tile's
+pixels depend only on its triangles in index order, so the image does not depend on the
+thread count or on which thread drew it, and of two
 fragments at one depth the lower triangle index wins, as under GL's ``LESS`` test.
 
 With ``early_depth`` (the default) the depth test comes before the clip planes and the colour;
@@ -54,6 +57,7 @@ DROPPED, SEVERAL = -1, -2  # tile codes of a triangle: drawn nowhere, in more th
 BOX_PIXEL_WORK = 1  # work estimate of a tile: per box pixel tested …
 TRIANGLE_WORK = 4  # … and per triangle set up
 SESSION = 1 << 22  # triangles binned and drawn at a time: the bin holds 44 bytes a triangle
+RUNS_PER_THREAD = 8  # runs of triangles per thread in the clip and bin passes, taken in turn
 HIZ_SHIFT = 3  # blocks of 2^HIZ_SHIFT pixels a side: their largest depths reject hidden triangles
 # bound on the rounding of ``zc + za·i + zb·j`` in float64, relative to |zc| + |za·i| + |zb·j|,
 # twice (the corners', the fragment's) and then some: 2·3u/(1 − 3u) < 7e-16
@@ -130,11 +134,11 @@ def classify(tris, fx, fy, fz, ok, clipd, width, height, bits, shift, tiles_x, c
 
 
 @numba.njit(cache=True)
-def deal(count, work, workers):
-    """The tile lists' layout and the tiles' owners. Returns ``(start, fill, owned_start,
-    owned)``: tile t's triangles will be ``members[start[t]:start[t + 1]]``, run c's first
-    slot in tile t ``fill[c, t]``; worker w draws tiles ``owned[owned_start[w]:owned_start[w +
-    1]]``, dealt the largest estimated work first to the least loaded worker."""
+def layout(count, work):
+    """The tile lists' layout and the order the tiles are drawn in. Returns ``(start, fill,
+    order)``: tile t's triangles will be ``members[start[t]:start[t + 1]]``, run c's first slot
+    in tile t ``fill[c, t]``; ``order`` the tiles that have triangles, the largest estimated
+    work first."""
     chunks, n_tiles = count.shape
     start = np.zeros(n_tiles + 1, np.int64)
     fill = np.empty((chunks, n_tiles), np.int64)
@@ -146,25 +150,14 @@ def deal(count, work, workers):
             at += count[c, t]
             total[t] += work[c, t]
         start[t + 1] = at
-    owner = np.full(n_tiles, -1, np.int64)  # tiles without triangles have none
-    load = np.zeros(workers, np.int64)
-    for t in np.argsort(-total, kind="mergesort"):
+    by_work = np.argsort(-total, kind="mergesort")
+    order = np.empty(n_tiles, np.int64)
+    n = 0
+    for t in by_work:
         if start[t + 1] > start[t]:
-            w = np.argmin(load)
-            owner[t] = w
-            load[w] += total[t]
-    owned_start = np.zeros(workers + 1, np.int64)
-    for t in range(n_tiles):
-        if owner[t] >= 0:
-            owned_start[owner[t] + 1] += 1
-    owned_start = np.cumsum(owned_start)
-    owned = np.empty(owned_start[-1], np.int64)
-    at = owned_start[:-1].copy()
-    for t in range(n_tiles):
-        if owner[t] >= 0:
-            owned[at[owner[t]]] = t
-            at[owner[t]] += 1
-    return start, fill, owned_start, owned
+            order[n] = t
+            n += 1
+    return start, fill, order[:n]
 
 
 @numba.njit(cache=True, inline="always")
@@ -260,10 +253,10 @@ def _block_max(depth, bmax, nmax, b, i0, j0, block):
 
 
 @numba.njit(cache=True, parallel=True)
-def draw_tiles(owned_start, owned, start, members, mxy, mz, tris, ids, fx, fy, attr, clipd,
+def draw_tiles(order, start, members, mxy, mz, tris, ids, fx, fy, attr, clipd,
                pos32, view32, tri_s, kind, base, missing, texels, texf, linear, alpha_test, early,
                shift, tiles_x, bits, depth, color, triangle, covered):
-    """Every tile of ``owned`` (one run of tiles per worker, :func:`deal`) drawn into ``depth``,
+    """Every tile of ``order`` (:func:`layout`), each by one thread, drawn into ``depth``,
     ``color`` (packed RGBA8) and ``triangle``: its triangles (``members``) in index order, each
     set up, its box within the tile tested against the edge functions, each covered fragment
     depth tested, clipped, coloured and written. With ``early``, the depth test comes first,
@@ -279,149 +272,144 @@ def draw_tiles(owned_start, owned, start, members, mxy, mz, tris, ids, fx, fy, a
     bs = min(shift, HIZ_SHIFT)
     block = 1 << bs
     per_row = tile >> bs
-    workers = owned_start.shape[0] - 1
-    # per worker, apart by a cache line or more: the planes of the triangle drawn (depth, the
-    # attributes, the clip distances), and per block of the tile its largest depth and how
-    # many pixels hold it at most
-    planes = np.empty((workers, 1 + n_attr + n_clip + 3, 3))
-    most = np.empty((workers, per_row * per_row + 16), np.float32)
-    held = np.empty((workers, per_row * per_row + 8), np.int64)
-    for w in prange(workers):
-        pl = planes[w:w + 1]
-        bmax, nmax = most[w], held[w]
-        for o in range(owned_start[w], owned_start[w + 1]):
-            t = owned[o]
-            ti0, tj0 = (t % tiles_x) * tile, (t // tiles_x) * tile
-            ti1, tj1 = min(ti0 + tile - 1, width - 1), min(tj0 + tile - 1, height - 1)
-            for bj in range(per_row if early else 0):
-                for bi in range(per_row):
-                    _block_max(depth, bmax, nmax, bj * per_row + bi, ti0 + bi * block,
-                               tj0 + bj * block, block)
-            generated = 0
-            for q in range(start[t], start[t + 1]):
-                x0, y0 = np.int64(mxy[q, 0]), np.int64(mxy[q, 1])
-                x1, y1 = np.int64(mxy[q, 2]), np.int64(mxy[q, 3])
-                x2, y2 = np.int64(mxy[q, 4]), np.int64(mxy[q, 5])
-                i0 = max(-((-min(x0, x1, x2)) >> bits), ti0)
-                i1 = min(max(x0, x1, x2) >> bits, ti1)
-                j0 = max(-((-min(y0, y1, y2)) >> bits), tj0)
-                j1 = min(max(y0, y1, y2) >> bits, tj1)
-                if i0 > i1 or j0 > j1:
+    for o in prange(order.shape[0]):
+        # the tile's own: the planes of the triangle drawn (depth, the attributes, the clip
+        # distances), and per block of the tile its largest depth and how many pixels hold it
+        pl = np.empty((1, 1 + n_attr + n_clip + 3, 3))
+        bmax = np.empty(per_row * per_row + 16, np.float32)
+        nmax = np.empty(per_row * per_row + 8, np.int64)
+        t = order[o]
+        ti0, tj0 = (t % tiles_x) * tile, (t // tiles_x) * tile
+        ti1, tj1 = min(ti0 + tile - 1, width - 1), min(tj0 + tile - 1, height - 1)
+        for bj in range(per_row if early else 0):
+            for bi in range(per_row):
+                _block_max(depth, bmax, nmax, bj * per_row + bi, ti0 + bi * block,
+                           tj0 + bj * block, block)
+        generated = 0
+        for q in range(start[t], start[t + 1]):
+            x0, y0 = np.int64(mxy[q, 0]), np.int64(mxy[q, 1])
+            x1, y1 = np.int64(mxy[q, 2]), np.int64(mxy[q, 3])
+            x2, y2 = np.int64(mxy[q, 4]), np.int64(mxy[q, 5])
+            i0 = max(-((-min(x0, x1, x2)) >> bits), ti0)
+            i1 = min(max(x0, x1, x2) >> bits, ti1)
+            j0 = max(-((-min(y0, y1, y2)) >> bits), tj0)
+            j1 = min(max(y0, y1, y2) >> bits, tj1)
+            if i0 > i1 or j0 > j1:
+                continue
+            # the depth plane over pixel centres, in the vertex order (as depth_gradient)
+            xa, ya, xb, yb = x0 * inv, y0 * inv, x1 * inv, y1 * inv
+            xc, yc = x2 * inv, y2 * inv
+            kernels._plane(xa, ya, xb, yb, xc, yc, np.float64(mz[q, 0]),
+                           np.float64(mz[q, 1]), np.float64(mz[q, 2]), pl, 0, 0)
+            zc, za, zb = pl[0, 0, 0], pl[0, 0, 1], pl[0, 0, 2]
+            if early:
+                # hierarchical rejection: the plane is linear, so no covered pixel
+                # centre's depth lies below its least value at the vertices, nor below
+                # its least over the box (at a corner), less the rounding of either
+                # evaluation (HIZ_SLACK, relative to the sum of the terms' sizes)
+                low = max(min(zc + za * xa + zb * ya, zc + za * xb + zb * yb,
+                              zc + za * xc + zb * yc),
+                          zc + min(za * i0, za * i1) + min(zb * j0, zb * j1)) \
+                    - HIZ_SLACK * (abs(zc) + abs(za) * max(i1, abs(xa), abs(xb), abs(xc))
+                                   + abs(zb) * max(j1, abs(ya), abs(yb), abs(yc)))
+                bi0, bi1 = (i0 - ti0) >> bs, (i1 - ti0) >> bs
+                bj0, bj1 = (j0 - tj0) >> bs, (j1 - tj0) >> bs
+                if bi1 - bi0 <= 1 and bj1 - bj0 <= 1:  # the blocks at the box's corners
+                    far = max(bmax[bj0 * per_row + bi0], bmax[bj0 * per_row + bi1],
+                              bmax[bj1 * per_row + bi0], bmax[bj1 * per_row + bi1])
+                else:
+                    far = np.float32(-np.inf)
+                    for bj in range(bj0, bj1 + 1):
+                        for bi in range(bi0, bi1 + 1):
+                            far = max(far, bmax[bj * per_row + bi])
+                if np.float32(low) > far:
                     continue
-                # the depth plane over pixel centres, in the vertex order (as depth_gradient)
-                xa, ya, xb, yb = x0 * inv, y0 * inv, x1 * inv, y1 * inv
-                xc, yc = x2 * inv, y2 * inv
-                kernels._plane(xa, ya, xb, yb, xc, yc, np.float64(mz[q, 0]),
-                               np.float64(mz[q, 1]), np.float64(mz[q, 2]), pl, 0, 0)
-                zc, za, zb = pl[0, 0, 0], pl[0, 0, 1], pl[0, 0, 2]
-                if early:
-                    # hierarchical rejection: the plane is linear, so no covered pixel
-                    # centre's depth lies below its least value at the vertices, nor below
-                    # its least over the box (at a corner), less the rounding of either
-                    # evaluation (HIZ_SLACK, relative to the sum of the terms' sizes)
-                    low = max(min(zc + za * xa + zb * ya, zc + za * xb + zb * yb,
-                                  zc + za * xc + zb * yc),
-                              zc + min(za * i0, za * i1) + min(zb * j0, zb * j1)) \
-                        - HIZ_SLACK * (abs(zc) + abs(za) * max(i1, abs(xa), abs(xb), abs(xc))
-                                       + abs(zb) * max(j1, abs(ya), abs(yb), abs(yc)))
-                    bi0, bi1 = (i0 - ti0) >> bs, (i1 - ti0) >> bs
-                    bj0, bj1 = (j0 - tj0) >> bs, (j1 - tj0) >> bs
-                    if bi1 - bi0 <= 1 and bj1 - bj0 <= 1:  # the blocks at the box's corners
-                        far = max(bmax[bj0 * per_row + bi0], bmax[bj0 * per_row + bi1],
-                                  bmax[bj1 * per_row + bi0], bmax[bj1 * per_row + bi1])
-                    else:
-                        far = np.float32(-np.inf)
-                        for bj in range(bj0, bj1 + 1):
-                            for bi in range(bi0, bi1 + 1):
-                                far = max(far, bmax[bj * per_row + bi])
-                    if np.float32(low) > far:
+            if (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0) < 0:  # to positive area
+                x1, y1, x2, y2 = x2, y2, x1, y1
+            dx0, dy0 = x1 - x0, y1 - y0
+            dx1, dy1 = x2 - x1, y2 - y1
+            dx2, dy2 = x0 - x2, y0 - y2
+            # covered ⇔ E − bias ≥ 0 with bias 1 on edges that do not own their ties
+            bias0 = 0 if (dy0 < 0 or (dy0 == 0 and dx0 < 0)) else 1
+            bias1 = 0 if (dy1 < 0 or (dy1 == 0 and dx1 < 0)) else 1
+            bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
+            step0, step1, step2 = dy0 << bits, dy1 << bits, dy2 << bits
+            px0 = i0 << bits
+            shaded = False
+            k = members[q]
+            tid = ids[k]
+            tri_rgba = np.uint32(0)
+            tri_visible = True
+            for j in range(j0, j1 + 1):
+                py = j << bits
+                e0 = dx0 * (py - y0) - dy0 * (px0 - x0) - bias0
+                e1 = dx1 * (py - y1) - dy1 * (px0 - x1) - bias1
+                e2 = dx2 * (py - y2) - dy2 * (px0 - x2) - bias2
+                for i in range(i0, i1 + 1):
+                    inside = (e0 | e1 | e2) >= 0  # all three ≥ 0 ⇔ their or ≥ 0
+                    e0 -= step0
+                    e1 -= step1
+                    e2 -= step2
+                    if not inside:
                         continue
-                if (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0) < 0:  # to positive area
-                    x1, y1, x2, y2 = x2, y2, x1, y1
-                dx0, dy0 = x1 - x0, y1 - y0
-                dx1, dy1 = x2 - x1, y2 - y1
-                dx2, dy2 = x0 - x2, y0 - y2
-                # covered ⇔ E − bias ≥ 0 with bias 1 on edges that do not own their ties
-                bias0 = 0 if (dy0 < 0 or (dy0 == 0 and dx0 < 0)) else 1
-                bias1 = 0 if (dy1 < 0 or (dy1 == 0 and dx1 < 0)) else 1
-                bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
-                step0, step1, step2 = dy0 << bits, dy1 << bits, dy2 << bits
-                px0 = i0 << bits
-                shaded = False
-                k = members[q]
-                tid = ids[k]
-                tri_rgba = np.uint32(0)
-                tri_visible = True
-                for j in range(j0, j1 + 1):
-                    py = j << bits
-                    e0 = dx0 * (py - y0) - dy0 * (px0 - x0) - bias0
-                    e1 = dx1 * (py - y1) - dy1 * (px0 - x1) - bias1
-                    e2 = dx2 * (py - y2) - dy2 * (px0 - x2) - bias2
-                    for i in range(i0, i1 + 1):
-                        inside = (e0 | e1 | e2) >= 0  # all three ≥ 0 ⇔ their or ≥ 0
-                        e0 -= step0
-                        e1 -= step1
-                        e2 -= step2
-                        if not inside:
-                            continue
-                        generated += 1
-                        z = zc + za * i + zb * j
-                        if not 0.0 <= z <= 1.0:
-                            continue
-                        z32 = np.float32(z)
-                        if early and not (z32 < depth[j, i] or (
-                                z32 == depth[j, i] and tid < triangle[j, i])):
-                            continue
-                        if not shaded:  # the other planes, once a fragment needs them
-                            shaded = True
-                            a, b, c = tris[k, 0], tris[k, 1], tris[k, 2]
-                            for p in range(n_attr):
-                                kernels._plane(xa, ya, xb, yb, xc, yc, np.float64(attr[a, p]),
-                                               np.float64(attr[b, p]), np.float64(attr[c, p]),
-                                               pl, 0, 1 + p)
-                            for p in range(n_clip):
-                                kernels._plane(xa, ya, xb, yb, xc, yc, np.float64(clipd[a, p]),
-                                               np.float64(clipd[b, p]),
-                                               np.float64(clipd[c, p]), pl, 0, 1 + n_attr + p)
-                            if per_triangle:
-                                light = np.float32(0.0)
-                                if kind != CONSTANT:
-                                    light = _flat_light(pos32, view32, fx, fy, inv, a, b, c)
-                                tri_rgba, tri_visible = _triangle_color(
-                                    kind, light, tri_s[k] if kind == ELEMENT_COLOR
-                                    else np.float32(0.0), base, missing, texels, texf, linear,
-                                    alpha_test)
-                        clipped = False
-                        for p in range(1 + n_attr, 1 + n_attr + n_clip):
-                            if pl[0, p, 0] + pl[0, p, 1] * i + pl[0, p, 2] * j < 0.0:
-                                clipped = True
-                        if clipped:
-                            continue
+                    generated += 1
+                    z = zc + za * i + zb * j
+                    if not 0.0 <= z <= 1.0:
+                        continue
+                    z32 = np.float32(z)
+                    if early and not (z32 < depth[j, i] or (
+                            z32 == depth[j, i] and tid < triangle[j, i])):
+                        continue
+                    if not shaded:  # the other planes, once a fragment needs them
+                        shaded = True
+                        a, b, c = tris[k, 0], tris[k, 1], tris[k, 2]
+                        for p in range(n_attr):
+                            kernels._plane(xa, ya, xb, yb, xc, yc, np.float64(attr[a, p]),
+                                           np.float64(attr[b, p]), np.float64(attr[c, p]),
+                                           pl, 0, 1 + p)
+                        for p in range(n_clip):
+                            kernels._plane(xa, ya, xb, yb, xc, yc, np.float64(clipd[a, p]),
+                                           np.float64(clipd[b, p]),
+                                           np.float64(clipd[c, p]), pl, 0, 1 + n_attr + p)
                         if per_triangle:
-                            rgba, visible = tri_rgba, tri_visible
-                        else:
-                            rgba, visible = _pixel_color(kind, pl, i, j, base, missing, texels,
-                                                         texf, linear, alpha_test)
-                        if not visible:
-                            continue
-                        d = depth[j, i]
-                        if not early:
-                            if z32 < d or (z32 == d and tid < triangle[j, i]):
-                                depth[j, i] = z32
-                                color[j, i] = rgba
-                                triangle[j, i] = tid
-                            continue
-                        depth[j, i] = z32  # the depth test passed above
-                        color[j, i] = rgba
-                        triangle[j, i] = tid
-                        bj, bi = (j - tj0) >> bs, (i - ti0) >> bs
-                        blk = bj * per_row + bi
-                        if d == bmax[blk]:  # one pixel fewer holds the block's largest depth
-                            nmax[blk] -= 1
-                            if nmax[blk] <= 0:
-                                _block_max(depth, bmax, nmax, blk, ti0 + bi * block,
-                                           tj0 + bj * block, block)
-            covered[t] = generated
+                            light = np.float32(0.0)
+                            if kind != CONSTANT:
+                                light = _flat_light(pos32, view32, fx, fy, inv, a, b, c)
+                            tri_rgba, tri_visible = _triangle_color(
+                                kind, light, tri_s[k] if kind == ELEMENT_COLOR
+                                else np.float32(0.0), base, missing, texels, texf, linear,
+                                alpha_test)
+                    clipped = False
+                    for p in range(1 + n_attr, 1 + n_attr + n_clip):
+                        if pl[0, p, 0] + pl[0, p, 1] * i + pl[0, p, 2] * j < 0.0:
+                            clipped = True
+                    if clipped:
+                        continue
+                    if per_triangle:
+                        rgba, visible = tri_rgba, tri_visible
+                    else:
+                        rgba, visible = _pixel_color(kind, pl, i, j, base, missing, texels,
+                                                     texf, linear, alpha_test)
+                    if not visible:
+                        continue
+                    d = depth[j, i]
+                    if not early:
+                        if z32 < d or (z32 == d and tid < triangle[j, i]):
+                            depth[j, i] = z32
+                            color[j, i] = rgba
+                            triangle[j, i] = tid
+                        continue
+                    depth[j, i] = z32  # the depth test passed above
+                    color[j, i] = rgba
+                    triangle[j, i] = tid
+                    bj, bi = (j - tj0) >> bs, (i - ti0) >> bs
+                    blk = bj * per_row + bi
+                    if d == bmax[blk]:  # one pixel fewer holds the block's largest depth
+                        nmax[blk] -= 1
+                        if nmax[blk] <= 0:
+                            _block_max(depth, bmax, nmax, blk, ti0 + bi * block,
+                                       tj0 + bj * block, block)
+        covered[t] = generated
 
 
 # ----------------------------------------------------------------------------- the draw
@@ -477,28 +465,32 @@ def _draw(tris, ids, lit, frame, color32, options, look, shading, threads, stats
         tri_s = lit.tri_s[k0:k1] if len(lit.tri_s) == len(tris) else lit.tri_s
         stats.sessions += 1
         code = _lend(workspace, "fused_code", k1 - k0, np.int32)
-        count = np.zeros((threads, n_tiles), np.int64)
-        work = np.zeros((threads, n_tiles), np.int64)
-        kept = int(kernel(classify)(tris[k0:k1], lit.fx, lit.fy, lit.fz, lit.ok, lit.clipd,
-                                    width, height, bits, shift, tiles_x, threads, code, count,
-                                    work))
+        runs = RUNS_PER_THREAD * threads
+        count = np.zeros((runs, n_tiles), np.int64)
+        work = np.zeros((runs, n_tiles), np.int64)
+        with numba.parallel_chunksize(1):
+            kept = int(kernel(classify)(tris[k0:k1], lit.fx, lit.fy, lit.fz, lit.ok, lit.clipd,
+                                        width, height, bits, shift, tiles_x, runs, code, count,
+                                        work))
         stats.kept += kept
         clock.lap("clip triangle")
         if kept == 0:
             continue
-        start, fill, owned_start, owned = kernel(deal)(count, work, threads)
+        start, fill, order = kernel(layout)(count, work)
         slots = int(start[-1])
         members = _lend(workspace, "fused_members", slots, np.int32)
         mxy = _lend(workspace, "fused_xy", slots, np.int32, 6)
         mz = _lend(workspace, "fused_z", slots, np.float32, 3)
-        kernel(place)(tris[k0:k1], lit.fx, lit.fy, lit.fz, bits, width, height, shift, tiles_x,
-                      code, fill, members, mxy, mz)
+        with numba.parallel_chunksize(1):
+            kernel(place)(tris[k0:k1], lit.fx, lit.fy, lit.fz, bits, width, height, shift,
+                          tiles_x, code, fill, members, mxy, mz)
         clock.lap("bin")
         covered = np.zeros(n_tiles, np.int64)
-        kernel(draw_tiles)(owned_start, owned, start, members, mxy, mz, tris[k0:k1],
-                           ids[k0:k1], lit.fx, lit.fy, lit.attr, lit.clipd, lit.pos32,
-                           lit.view32, tri_s, look.code, look.base, look.missing, look.texels,
-                           look.texf, shading.linear, shading.alpha_test, options.early_depth,
-                           shift, tiles_x, bits, frame.depth, color32, frame.triangle, covered)
+        with numba.parallel_chunksize(1):  # a thread takes the next tile when it is done
+            kernel(draw_tiles)(order, start, members, mxy, mz, tris[k0:k1], ids[k0:k1], lit.fx,
+                               lit.fy, lit.attr, lit.clipd, lit.pos32, lit.view32, tri_s,
+                               look.code, look.base, look.missing, look.texels, look.texf,
+                               shading.linear, shading.alpha_test, options.early_depth, shift,
+                               tiles_x, bits, frame.depth, color32, frame.triangle, covered)
         stats.fragments += int(covered.sum())
         clock.lap("generate fragment")
