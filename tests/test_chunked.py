@@ -160,3 +160,65 @@ def test_refusals(tmp_path, mesh):
             writer.add(path, domains[0])
             writer.add(other, domains[1])
     assert not any(p.name.startswith((".mixed", "mixed")) for p in tmp_path.iterdir())
+
+
+# ---------------------------------------------------------------------------- command line
+def test_render_writes_a_chunked_scene_and_draws_it_again_from_its_folder(tmp_path, capsys):
+    """``render --domains D --write-chunked F`` draws the plain render's image from the new
+    chunked scene; ``render F`` draws it again from the folder alone, and with a colour bar
+    of the field the scene was written with."""
+    from PIL import Image
+
+    from workbench.cli import main
+
+    view = ["--size", "200x160", "--view", "20,10", "--up", "y", "--raw"]
+    common = ["render", "semicylinders:12", "--field", "distance", "--bands", "6",
+              "--rasterizer", "software", *view]
+    one, written, again = (tmp_path / f"{n}.png" for n in ("one", "written", "again"))
+    folder = tmp_path / "scene"
+    assert main([*common, "-o", str(one)]) == 0
+    assert main([*common, "-o", str(written), "--domains", "4", "--workers", "2",
+                 "--write-chunked", str(folder)]) == 0
+    assert len(ChunkedScene(folder)) == 4 and ChunkedScene(folder).triangles == 2304
+    assert main(["render", str(folder), "-o", str(again), "--workers", "2", *view]) == 0
+    out = capsys.readouterr().out
+    assert "2304 triangles in 4 domains of" in out and "on 2 workers" in out
+    images = [np.asarray(Image.open(p)) for p in (one, written, again)]
+    assert (images[0][..., :3] < 250).any(axis=-1).sum() > 5000
+    assert np.array_equal(images[0], images[1]) and np.array_equal(images[0], images[2])
+
+    bar = tmp_path / "bar.png"
+    assert main(["render", str(folder), "-o", str(bar), "--workers", "2", "--size", "200x160"]) == 0
+    assert np.asarray(Image.open(bar)).shape[1] > 200  # the colour bar beside the image
+
+
+@pytest.mark.parametrize("flags,message", [
+    (["--field", "x"], "--field does not apply to a chunked scene"),
+    (["--bands", "3"], "--bands does not apply to a chunked scene"),
+    (["--domains", "3"], "--domains does not apply to a chunked scene"),
+    (["--projection", "perspective"], "orthographic views only"),
+])
+def test_render_of_a_chunked_scene_refuses_what_it_fixed(tmp_path, capsys, flags, message):
+    from workbench.cli import main
+
+    folder = write_semicylinders_chunked(tmp_path / "scene", 2, 4, bands=4)
+    code = main(["render", str(folder), "-o", str(tmp_path / "x.png"), *flags])
+    err = capsys.readouterr().err
+    assert code == 2 and message in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_write_chunked_refuses_gl_and_an_existing_folder(tmp_path, capsys):
+    from workbench.cli import main
+
+    existing = tmp_path / "old"
+    existing.mkdir()
+    (existing / "keep.txt").write_text("mine")
+    base = ["render", "semicylinders:4", "-o", str(tmp_path / "x.png"), "--domains", "2"]
+    for flags, message in ((["--write-chunked", str(tmp_path / "new")], "--rasterizer software"),
+                           (["--rasterizer", "software", "--write-chunked", str(existing)],
+                            "it exists")):
+        code = main([*base, *flags])
+        err = capsys.readouterr().err
+        assert code == 2 and message in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "new").exists() and (existing / "keep.txt").read_text() == "mine"

@@ -1,7 +1,9 @@
 """``workbench render``: one scene drawn offscreen through the one measurement function
 (untimed) and written as a PNG, with a colour bar when a field is shown; on the headless GL
 context or the es2008 software rasterizer. ``--domains D`` (sort-last) splits the mesh into D
-domains, draws them with the software rasterizer on Dask workers and composites them by depth.
+domains, draws them on Dask workers and composites them by depth; a chunked scene (a folder
+written by ``--write-chunked``) is drawn on the workers from its files
+(:mod:`.render_sortlast`).
 """
 
 from __future__ import annotations
@@ -10,6 +12,7 @@ import argparse
 from pathlib import Path
 
 from .arguments import image_size, key_value, view_angles
+from .render_image import check_drawn, check_extent, write_image
 
 # workbench.experiment.sortlast.METHODS, not imported here: it imports Dask
 COMPOSITE_METHODS = ("local", "tree", "swap", "active-tree", "active-swap", "radix")
@@ -27,14 +30,15 @@ def add_parser(subparsers) -> None:
         description="Render a mesh file (LS-DYNA .k, d3plot, meshio or trimesh formats), a "
                     "built-in scene (car, d3plot, semicylinders[:N], panels[:Q]) or a spacetime "
                     "scene (spacetime:radial[:N], spacetime:bar) offscreen, through the one "
-                    "measurement function (untimed).",
+                    "measurement function (untimed); or a chunked scene's folder (written by "
+                    "--write-chunked) on Dask workers.",
         epilog="render paths:\n  FE meshes:        " + ", ".join(mesh_paths) +
                "\n  spacetime scenes: " + ", ".join(spacetime_paths) +
                "\nany option of a path's style: --option KEY=VALUE (e.g. "
                "--option edge_overdraw=skirts"
                "\n  --option height_scale=800 for a spacetime path, "
                "--option clip_planes=((1,0,0,0),))")
-    p.add_argument("mesh", help="mesh file or built-in scene name")
+    p.add_argument("mesh", help="mesh file, built-in scene name or chunked scene folder")
     p.add_argument("-o", "--output", required=True, help="PNG file to write")
     p.add_argument("--field", help="node or element field to colour by")
     p.add_argument("--path", metavar="PATH",
@@ -97,6 +101,11 @@ def _add_sortlast_arguments(p) -> None:
                         "domains, then sends its drawn pixels once), binary tree or swap of "
                         "whole frames, or active-tree, active-swap, radix (direct send) of "
                         "drawn pixels only")
+    p.add_argument("--write-chunked", metavar="FOLDER",
+                   help="with --domains and --rasterizer software: write the domains once as a "
+                        "chunked scene (Parquet per domain) to the new FOLDER and draw them "
+                        "from there, each worker loading only its own; render FOLDER draws "
+                        "it again")
     p.add_argument("--workers", type=int,
                    help="local Dask worker processes (default: one per core)")
     p.add_argument("--scheduler", metavar="ADDRESS",
@@ -141,15 +150,15 @@ def _render_options(args, kind: str) -> dict:
     return options
 
 
-def _check_output_and_cluster(args) -> None:
+def _check_output_and_cluster(args, chunked: bool) -> None:
     """Refuse (ValueError) an output that exists and is not a regular file, one that is not a
-    PNG file name, and Dask options without ``--domains``."""
+    PNG file name, and Dask options without ``--domains`` (or a ``chunked`` scene)."""
     from ..experiment.targets import output_target
 
     if output_target(args.output).suffix.lower() != ".png":
         raise ValueError(f"-o {args.output}: render writes a PNG image; give a file name "
                          f"ending in .png")
-    if args.domains is None:
+    if args.domains is None and not chunked:
         given = [f"--{name}" for name in ("scheduler", "workers")
                  if getattr(args, name, None) is not None]
         if given:
@@ -178,95 +187,24 @@ def _backend(args, path):
     return backend, backend.path(path)
 
 
-def _write_image(out: Path, image, path, field: str | None, args, title: str) -> None:
-    """``image`` as a PNG at ``out``: with a colour bar of ``field`` when there is one and a
-    colour scale, unless ``--raw``."""
-    from ..experiment.figures import save_field_figure, save_png
-
-    out.parent.mkdir(parents=True, exist_ok=True)
-    scale = getattr(path, "scale", None)
-    if field is not None and not args.raw and scale is not None:
-        save_field_figure(out, image, value_range=scale.value_range,
-                          colormap=path.style.colormap, label=field, units=args.units,
-                          title=title, bands=args.bands)
-    else:
-        save_png(out, image)
-
-
-# the widest model drawn (model units): beyond it the float32 coordinates relative to its
-# centre and the matrices that scale them near float32's limit, 3.4e38 (1e38 draws nothing)
-FLOAT32_EXTENT = 0.1 * 3.4028235e38
-
-
-def _extent_of(mesh, step: int) -> tuple[float, str]:
-    """(extent, words): the largest side of the box of ``mesh``'s referenced nodes at ``step``
-    (model units), and words naming it with the node farthest from the nodes' median (the
-    stray node that makes the box that wide)."""
-    import numpy as np
-
-    nodes = mesh.coordinates(step)
-    used = mesh.used_nodes()
-    points = nodes[used]
-    extent = float(np.max(points.max(axis=0) - points.min(axis=0)))
-    distance = np.linalg.norm(points - np.median(points, axis=0), axis=1)
-    far = int(used[np.argmax(distance)])
-    label = (f"node {int(mesh.node_ids[far])}" if mesh.node_ids is not None
-             else f"node index {far}")
-    x, y, z = nodes[far]
-    return extent, (f"its extent of {extent:.3g} {mesh.units} ({label} at ({x:.3g}, {y:.3g}, "
-                    f"{z:.3g}) lies {distance.max():.3g} {mesh.units} from the median node)")
-
-
-def _check_extent(scene, step: int) -> None:
-    """Refuse (ValueError) an FE mesh wider than :data:`FLOAT32_EXTENT`: its coordinates
-    relative to its centre, and the matrices that scale them, overflow float32 and draw
-    nothing."""
-    if scene.kind != "mesh":
-        return
-    extent, words = _extent_of(scene, step)
-    if extent > FLOAT32_EXTENT:
-        raise ValueError(f"{scene.name}: {words} is beyond what float32 coordinates relative "
-                         f"to its centre can draw (at most {FLOAT32_EXTENT:.3g})")
-
-
-def _check_drawn(image, scene, camera, size: tuple[int, int], step: int) -> None:
-    """Refuse (ValueError, one line) an image in which no pixel differs from the white
-    background: nothing of the scene was drawn, so no image is written. For an FE mesh whose
-    elements all project thinner than a pixel the line says so, with the model's extent and
-    its farthest node: the camera is fitted to the box of every referenced node, so one node
-    far out (1e20 mm among millimetre-sized elements) makes the view that wide."""
-    import numpy as np
-
-    from ..experiment.compare import coverage
-    from ..experiment.measure import WHITE
-
-    if coverage(image, WHITE).any():
-        return
-    why = ""
-    if scene.kind == "mesh":
-        win = camera.project(scene.coordinates(step), size)[:, :2]
-        tri = scene.triangles
-        a, b, c = win[tri[:, 0]], win[tri[:, 1]], win[tri[:, 2]]
-        ab, ac, bc = b - a, c - a, c - b
-        area2 = np.abs(ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0])
-        longest = np.max([np.hypot(*e.T) for e in (ab, ac, bc)], axis=0)
-        # each triangle's width across its longest edge, in pixels
-        widths = np.divide(area2, longest, out=np.zeros_like(area2), where=longest > 0)
-        if widths.max() < 1.0:
-            why = (f"; every element is thinner than a pixel (the widest {widths.max():.2g} "
-                   f"px) in the view fitted to {_extent_of(scene, step)[1]}")
-    raise ValueError(f"the {size[0]}x{size[1]} image shows nothing of {scene.name}: no pixel "
-                     f"differs from the background{why}")
-
-
 def cmd_render(args) -> int:
     """Draw the scene, write ``--output``, print what was drawn; 0."""
     from ..experiment.measure import measure
     from ..paths import make_path, path_class
     from ..paths.registry import scene_path
     from ..scene.builtin import load_scene
+    from .render_sortlast import (
+        check_write_chunked,
+        is_chunked_scene,
+        render_chunked_scene,
+        render_domains,
+    )
 
-    _check_output_and_cluster(args)
+    chunked = is_chunked_scene(args.mesh)
+    _check_output_and_cluster(args, chunked)
+    if chunked:
+        return render_chunked_scene(args)
+    check_write_chunked(args)
     scene = load_scene(args.mesh, all_faces=args.all_faces)
     is_mesh = scene.kind == "mesh"
     if is_mesh:
@@ -278,54 +216,18 @@ def cmd_render(args) -> int:
     size = args.size
     camera = path.default_camera(scene, size, view=args.view, projection=args.projection,
                                  up=args.up, style=path.style)
-    _check_extent(scene, args.step)
+    check_extent(scene, args.step)
     if args.domains is not None:
-        return _render_sortlast(args, scene, path, camera, size)
+        return render_domains(args, scene, path, camera, size)
     result = measure(backend, scene, path, camera=camera, size=size, samples=args.samples,
                      timed=False)
-    _check_drawn(result.image, scene, camera, size, args.step)
+    check_drawn(result.image, scene, camera, size, args.step)
     out = Path(args.output)
     field = args.field if args.field is not None else getattr(path.style, "field", None)
-    _write_image(out, result.image, path, field if is_mesh else None, args,
+    write_image(out, result.image, path, field if is_mesh else None, args,
                  f"{scene.name} ({path_name})")
     strips = f", {path.strips} strip{'s' * (path.strips != 1)}" if path.strips else ""
     print(f"{out}: {result.row['scene']}, {path.triangles} triangles, {path.vertices_sent} "
           f"vertices sent{strips}, path {path_name}"
           + (f", {result.row['renderer']}" if args.rasterizer == "software" else ""))
-    return 0
-
-
-def _render_sortlast(args, mesh, path, camera, size) -> int:
-    """``render --domains D``: the mesh split into D domains, drawn on Dask workers by the
-    software rasterizer or (``--rasterizer gl``) each worker's own EGL context, composited by
-    depth (sort-last) and written like a plain render."""
-    from ..experiment.cluster import sweep_cluster
-    from ..experiment.sortlast import GLDomains, SoftwareDomains, render_sortlast
-    from ..scene.domains import split_domains
-
-    if args.all_faces:
-        raise ValueError("--domains loads the scene again on each worker; --all-faces is not "
-                         "passed on")
-    domains = split_domains(mesh, args.domains, by=args.split)
-    gl = args.rasterizer == "gl"
-    if gl:
-        render_domain = GLDomains(args.mesh, path.name, path.style, camera, size)
-    else:
-        render_domain = SoftwareDomains(args.mesh, path.name, path.style, camera, size,
-                                        path.options)
-    # GLDomains opens its own context in each worker process
-    with sweep_cluster(args.workers, args.scheduler, gl=False) as cluster:
-        color, stats = render_sortlast(cluster.client, render_domain, domains,
-                                       method=args.composite, color_only=True)
-    _check_drawn(color, mesh, camera, size, args.step)
-    out = Path(args.output)
-    if gl:
-        path.scale = path.check_mesh(mesh)  # the colour scale of the bar
-    else:
-        path.prepare(None, mesh, camera)
-    _write_image(out, color, path, args.field, args,
-                 f"{mesh.name} ({path.name}, {args.domains} domains)")
-    print(f"{out}: {mesh.name}, {len(mesh.triangles)} triangles in {args.domains} domains "
-          f"by {args.split} on {stats.workers} workers; {args.composite} compositing "
-          f"{stats.composite_s:.3f} s, {stats.bytes_moved / 1e6:.1f} MB moved between workers")
     return 0
