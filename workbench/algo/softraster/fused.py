@@ -326,14 +326,8 @@ def draw_tiles(order, start, members, mxy, mz, tris, ids, fx, fy, attr, clipd,
                     continue
             if (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0) < 0:  # to positive area
                 x1, y1, x2, y2 = x2, y2, x1, y1
-            dx0, dy0 = x1 - x0, y1 - y0
-            dx1, dy1 = x2 - x1, y2 - y1
-            dx2, dy2 = x0 - x2, y0 - y2
-            # covered ⇔ E − bias ≥ 0 with bias 1 on edges that do not own their ties
-            bias0 = 0 if (dy0 < 0 or (dy0 == 0 and dx0 < 0)) else 1
-            bias1 = 0 if (dy1 < 0 or (dy1 == 0 and dx1 < 0)) else 1
-            bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
-            step0, step1, step2 = dy0 << bits, dy1 << bits, dy2 << bits
+            (dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, step0, step1,
+             step2) = kernels._edges(x0, y0, x1, y1, x2, y2, bits)
             px0 = i0 << bits
             shaded = False
             k = members[q]

@@ -332,6 +332,21 @@ def bin_triangles(box, shift, tiles_x, n_tiles, chunks):
 
 
 # ----------------------------------------------------------------------------- generate fragment
+@numba.njit(cache=True, inline="always")
+def _edges(x0, y0, x1, y1, x2, y2, bits):
+    """The edge functions of a triangle of positive area in fixed point (``bits`` fraction
+    bits): per edge its deltas, its bias (covered ⇔ E − bias ≥ 0, bias 1 on the edges that do
+    not own their ties: :mod:`.rule`) and its step from one pixel centre to the next in x.
+    Returns (dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, step0, step1, step2)."""
+    dx0, dy0 = x1 - x0, y1 - y0
+    dx1, dy1 = x2 - x1, y2 - y1
+    dx2, dy2 = x0 - x2, y0 - y2
+    bias0 = 0 if (dy0 < 0 or (dy0 == 0 and dx0 < 0)) else 1
+    bias1 = 0 if (dy1 < 0 or (dy1 == 0 and dx1 < 0)) else 1
+    bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
+    return dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, dy0 << bits, dy1 << bits, dy2 << bits
+
+
 @numba.njit(cache=True, parallel=True)
 def generate_fragments(start, members, frag_start, verts, box, fit, lo_table, hi_table, size,
                        tile, tiles_x, bits, early, zplane, depth, frag_tri, frag_i, frag_j,
@@ -372,14 +387,8 @@ def generate_fragments(start, members, frag_start, verts, box, fit, lo_table, hi
                         pos += 1
                 continue
             x1, y1, x2, y2 = verts[m, 2], verts[m, 3], verts[m, 4], verts[m, 5]
-            dx0, dy0 = x1 - x0, y1 - y0
-            dx1, dy1 = x2 - x1, y2 - y1
-            dx2, dy2 = x0 - x2, y0 - y2
-            # covered ⇔ E − bias ≥ 0 with bias 1 on edges that do not own their ties (rule.py)
-            bias0 = 0 if (dy0 < 0 or (dy0 == 0 and dx0 < 0)) else 1
-            bias1 = 0 if (dy1 < 0 or (dy1 == 0 and dx1 < 0)) else 1
-            bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
-            step0, step1, step2 = dy0 << bits, dy1 << bits, dy2 << bits
+            (dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, step0, step1,
+             step2) = _edges(x0, y0, x1, y1, x2, y2, bits)
             px0 = i0 << bits
             zc, za, zb = zplane[m, 0, 0], zplane[m, 0, 1], zplane[m, 0, 2]
             for j in range(j0, j1 + 1):

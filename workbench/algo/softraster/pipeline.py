@@ -65,7 +65,8 @@ _KERNELS = ("transform", "light_vertices", "light_triangles", "clip_triangles",
             "depth_gradient", "scalar_gradient", "range_and_tc", "collect_table_fit",
             "bin_triangles", "generate_fragments", "interpolate_z", "interpolate_color",
             "write_fragments")
-_HELPERS = ("texel_rgba", "unorm8", "pack", "headlight", "_plane", "_eye", "_flat_light")
+_HELPERS = ("texel_rgba", "unorm8", "pack", "headlight", "_plane", "_eye", "_flat_light",
+            "_edges")
 
 
 @dataclass(frozen=True)
