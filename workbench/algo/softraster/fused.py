@@ -336,9 +336,9 @@ def draw_tiles(order, start, members, mxy, mz, tris, ids, fx, fy, attr, clipd,
             tri_visible = True
             for j in range(j0, j1 + 1):
                 py = j << bits
-                e0 = dx0 * (py - y0) - dy0 * (px0 - x0) - bias0
-                e1 = dx1 * (py - y1) - dy1 * (px0 - x1) - bias1
-                e2 = dx2 * (py - y2) - dy2 * (px0 - x2) - bias2
+                e0 = kernels._edge_at(dx0, dy0, x0, y0, px0, py, bias0)
+                e1 = kernels._edge_at(dx1, dy1, x1, y1, px0, py, bias1)
+                e2 = kernels._edge_at(dx2, dy2, x2, y2, px0, py, bias2)
                 for i in range(i0, i1 + 1):
                     inside = (e0 | e1 | e2) >= 0  # all three ≥ 0 ⇔ their or ≥ 0
                     e0 -= step0

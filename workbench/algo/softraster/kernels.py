@@ -347,6 +347,13 @@ def _edges(x0, y0, x1, y1, x2, y2, bits):
     return dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, dy0 << bits, dy1 << bits, dy2 << bits
 
 
+@numba.njit(cache=True, inline="always")
+def _edge_at(dx, dy, x, y, px, py, bias):
+    """An edge function from (x, y) along (dx, dy), less its bias, at the fixed-point pixel
+    centre (px, py): ≥ 0 on the covered side."""
+    return dx * (py - y) - dy * (px - x) - bias
+
+
 @numba.njit(cache=True, parallel=True)
 def generate_fragments(start, members, frag_start, verts, box, fit, lo_table, hi_table, size,
                        tile, tiles_x, bits, early, zplane, depth, frag_tri, frag_i, frag_j,
@@ -393,9 +400,9 @@ def generate_fragments(start, members, frag_start, verts, box, fit, lo_table, hi
             zc, za, zb = zplane[m, 0, 0], zplane[m, 0, 1], zplane[m, 0, 2]
             for j in range(j0, j1 + 1):
                 py = j << bits
-                e0 = dx0 * (py - y0) - dy0 * (px0 - x0) - bias0
-                e1 = dx1 * (py - y1) - dy1 * (px0 - x1) - bias1
-                e2 = dx2 * (py - y2) - dy2 * (px0 - x2) - bias2
+                e0 = _edge_at(dx0, dy0, x0, y0, px0, py, bias0)
+                e1 = _edge_at(dx1, dy1, x1, y1, px0, py, bias1)
+                e2 = _edge_at(dx2, dy2, x2, y2, px0, py, bias2)
                 for i in range(i0, i1 + 1):
                     # all three ≥ 0 ⇔ their bitwise or ≥ 0
                     if (e0 | e1 | e2) >= 0 and not (

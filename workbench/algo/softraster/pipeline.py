@@ -66,7 +66,7 @@ _KERNELS = ("transform", "light_vertices", "light_triangles", "clip_triangles",
             "bin_triangles", "generate_fragments", "interpolate_z", "interpolate_color",
             "write_fragments")
 _HELPERS = ("texel_rgba", "unorm8", "pack", "headlight", "_plane", "_eye", "_flat_light",
-            "_edges")
+            "_edges", "_edge_at")
 
 
 @dataclass(frozen=True)
