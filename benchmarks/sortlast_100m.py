@@ -5,9 +5,9 @@ Steps: write ``--sheets`` sheets of ``--n``×``--n`` quads (default 8 × 2500²:
 as a chunked scene, one domain per sheet (:func:`workbench.experiment.bigscene.
 write_semicylinders_chunked`; the writer holds one sheet at a time); start a LocalCluster of
 ``--workers`` worker processes (one thread each); render at ``--size`` with ``--method``
-compositing (:func:`~workbench.experiment.bigscene.run_chunked_sortlast`; a small scene of as
-many domains first, so that the workers' kernels are compiled), then render the
-reference in this process domain by domain and compare. Printed: triangles, write time, render
+compositing (default ``local``; :func:`~workbench.experiment.bigscene.run_chunked_sortlast`; a
+small scene of as many domains first, so that the workers' kernels are compiled), then render
+the reference in this process domain by domain and compare. Printed: triangles, write time, render
 and composite time, triangles/s, bytes moved, each worker's peak resident memory next to the
 largest domain's in-memory size and the memory of an idle worker (the fixed overhead), the
 reference time and whether the images are equal. Peak memory is each worker's high-water mark,
@@ -33,7 +33,8 @@ def main(argv=None) -> int:
     parser.add_argument("--n", type=int, default=2500, help="quads per sheet edge (2500)")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--size", default="1000x1000")
-    parser.add_argument("--method", choices=("tree", "swap"), default="swap")
+    parser.add_argument("--method", default="local",
+                        choices=("local", "tree", "swap", "active-tree", "active-swap", "radix"))
     parser.add_argument("--path", default="pixel_color")
     parser.add_argument("--folder", help="where to write the scene (default: a temporary one)")
     parser.add_argument("--keep", action="store_true", help="keep the scene folder")

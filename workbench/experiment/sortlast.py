@@ -328,7 +328,8 @@ def render_sortlast(client: Client, render_domain: Callable[[np.ndarray], Frame]
         final, pieces = submit_local(client, run, frames, placement, color_only)
         result = final.result()
         done = time.perf_counter()
-        where = placement
+        holders = client.who_has(frames)  # where the frames were drawn (after the timing)
+        where = [min(holders[f.key]) for f in frames]
     else:
         holders = client.who_has(frames)
         where = [min(holders[f.key]) for f in frames]
