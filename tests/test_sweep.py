@@ -282,6 +282,13 @@ def test_on_a_scheduler_and_workers_started_apart(tmp_path):
     assert (result.computed, result.failed, result.workers) == (4, 0, 2)
     rows = read_table(out / "table.csv")
     assert all(r["workers"] == 2 and r["host"] and r["wall_ms"] > 0 for r in rows)
+    # each worker pinned to one EGL device of its host, round-robin, and every row says which
+    from workbench.gl.devices import egl_devices
+
+    identities = [d.identity for d in egl_devices()]
+    pinned = [result.devices[a] for a in sorted(result.devices)]
+    assert pinned == [identities[i % len(identities)] for i in range(2)]
+    assert {r["egl_device"] for r in rows} <= set(pinned)
     assert [r["mean_diff_255"] > 0 for r in rows] == [True, True, False, False]
 
 

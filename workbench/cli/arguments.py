@@ -83,3 +83,57 @@ def refused(exc: BaseException) -> int:
     message = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
     print(f"workbench: error: {message}", file=sys.stderr)
     return EXIT_BAD_INPUT
+
+
+def add_device_argument(parser: argparse.ArgumentParser) -> None:
+    """``--device N``: the EGL device a drawing command draws on (default
+    ``WORKBENCH_EGL_DEVICE``, else 0); checked when the context is made."""
+    parser.add_argument("--device", metavar="N",
+                        help="EGL device index to draw on (default: $WORKBENCH_EGL_DEVICE, "
+                             "else 0; workbench info lists the devices)")
+
+
+def device_list(text: str) -> tuple[int, ...]:
+    """``--worker-devices 0,1,…``: EGL device indices (0 or more), comma-separated."""
+    try:
+        devices = tuple(int(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected EGL device indices separated by commas, got {text!r}") from None
+    if any(d < 0 for d in devices):
+        raise argparse.ArgumentTypeError(f"EGL device indices are 0 or more, got {text!r}")
+    return devices
+
+
+def add_cluster_output_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--worker-devices`` (the EGL devices Dask workers are pinned to) and ``--verbose``
+    (Dask's INFO log lines)."""
+    parser.add_argument("--worker-devices", type=device_list, metavar="I,J,...",
+                        help="EGL devices the Dask workers draw on, dealt out in turn "
+                             "(default: each host's devices round-robin)")
+    parser.add_argument("--verbose", action="store_true",
+                        help="show Dask's INFO log lines (default: warnings and errors only)")
+
+
+def say_worker_devices(devices: dict[str, str | None]) -> None:
+    """One line on stderr per Dask worker: its address and the EGL device it draws on."""
+    for address, device in sorted(devices.items()):
+        print(f"worker {address}: EGL device {device or '(none)'}", file=sys.stderr)
+
+
+def select_device(args) -> None:
+    """Make ``args.device`` (if given) the EGL device of this process and the processes it
+    starts, by setting ``WORKBENCH_EGL_DEVICE``; ValueError (one line) for an index this
+    machine does not have. ``args.verbose`` (if set) shows Dask's INFO log lines of the
+    clusters the command starts (``WORKBENCH_VERBOSE``)."""
+    import os
+
+    from ..gl.devices import DEVICE_ENV, device_index
+
+    if getattr(args, "device", None) is not None:
+        os.environ[DEVICE_ENV] = str(device_index(args.device))
+    if getattr(args, "verbose", False):
+        os.environ[VERBOSE_ENV] = "1"
+
+
+VERBOSE_ENV = "WORKBENCH_VERBOSE"

@@ -7,6 +7,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from .arguments import add_device_argument, select_device
 from .results import add_results_option, store_of
 
 
@@ -19,6 +20,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("experiment")
     p.add_argument("--quick", action="store_true", help="small sizes and few repetitions")
     p.add_argument("--figures", default="figures", help="output folder (default figures/)")
+    _add_drawing_arguments(p)
     add_results_option(p)
     p.set_defaults(func=cmd_run)
 
@@ -26,8 +28,17 @@ def add_parser(subparsers) -> None:
                               help="run every registered experiment, with a progress bar")
     p.add_argument("--quick", action="store_true", help="small sizes and few repetitions")
     p.add_argument("--figures", default="figures", help="output folder (default figures/)")
+    _add_drawing_arguments(p)
     add_results_option(p)
     p.set_defaults(func=cmd_reproduce)
+
+
+def _add_drawing_arguments(p) -> None:
+    """``--device`` and ``--verbose`` of ``run`` and ``reproduce``."""
+    add_device_argument(p)
+    p.add_argument("--verbose", action="store_true",
+                   help="show Dask's INFO log lines of the experiments' clusters (default: "
+                        "warnings and errors only)")
 
 
 def cmd_list(args) -> int:
@@ -52,6 +63,7 @@ def cmd_run(args) -> int:
 
     discover()
     get_experiment(args.experiment)  # an unknown name is refused before anything is recorded
+    select_device(args)
     recorder = start_recording(args, f"run {args.experiment}" + " --quick" * args.quick)
     rows, out_dir = run_experiment(args.experiment, figures_root=Path(args.figures),
                                    quick=args.quick,
@@ -69,6 +81,7 @@ def cmd_reproduce(args) -> int:
     from ..experiment.registry import discover, run_experiment
 
     names = sorted(discover())
+    select_device(args)
     recorder = start_recording(args, "reproduce" + " --quick" * args.quick)
     bar = tqdm(names, desc="reproduce", unit="experiment")
     for name in bar:

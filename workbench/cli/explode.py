@@ -20,7 +20,7 @@ import sys
 
 import numpy as np
 
-from .arguments import image_size, view_angles
+from .arguments import add_device_argument, image_size, view_angles
 
 FORMATS = (".gif", ".png")
 
@@ -34,6 +34,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "driven by occlusion queries, capped at the assembly diameter, front half "
                     "ghosted beyond 0.7 of it). Writes an animated GIF or a strip PNG.")
     p.add_argument("mesh", help="mesh file or built-in scene name")
+    add_device_argument(p)
     p.add_argument("--focus", type=int, required=True, metavar="PART",
                    help="part id of the object of interest")
     p.add_argument("--view", type=view_angles, default=(30.0, 25.0), metavar="AZ,EL",
@@ -93,7 +94,7 @@ def cmd_explode(args) -> int:
     scene = _focus_mesh(args.mesh, args.focus)
     path = make_path("exploded", focus=args.focus, plane=args.plane, speed=1.0,
                      ratio_exponent=args.ratio_exponent)
-    ctx = create_context()
+    ctx = create_context(device=args.device)
     camera = exploded_camera(default_camera(scene, args.size, view=args.view, up=args.up), scene)
     steps, write = _progress(args.frames)
 

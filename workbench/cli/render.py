@@ -11,7 +11,13 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .arguments import image_size, key_value, view_angles
+from .arguments import (
+    add_cluster_output_arguments,
+    add_device_argument,
+    image_size,
+    key_value,
+    view_angles,
+)
 from .render_image import check_drawn, check_extent, write_image
 
 # workbench.experiment.sortlast.METHODS, not imported here: it imports Dask
@@ -69,6 +75,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("--samples", type=int, default=0, help="MSAA samples (0: none)")
     p.add_argument("--units", default="", help="units of the field, for the colour bar label")
     p.add_argument("--raw", action="store_true", help="write the bare image without a colour bar")
+    add_device_argument(p)
     _add_software_arguments(p)
     _add_sortlast_arguments(p)
     p.set_defaults(func=cmd_render)
@@ -110,6 +117,7 @@ def _add_sortlast_arguments(p) -> None:
                    help="local Dask worker processes (default: one per core)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="an existing Dask scheduler (tcp://host:port) instead of a local cluster")
+    add_cluster_output_arguments(p)
 
 
 def _check_field_and_step(scene, args) -> None:
@@ -159,7 +167,8 @@ def _check_output_and_cluster(args, chunked: bool) -> None:
         raise ValueError(f"-o {args.output}: render writes a PNG image; give a file name "
                          f"ending in .png")
     if args.domains is None and not chunked:
-        given = [f"--{name}" for name in ("scheduler", "workers")
+        given = [f"--{name.replace('_', '-')}" for name in ("scheduler", "workers",
+                                                            "worker_devices")
                  if getattr(args, name, None) is not None]
         if given:
             verb = "apply" if len(given) > 1 else "applies"
@@ -174,7 +183,7 @@ def _backend(args, path):
     if args.rasterizer != "software":
         from ..gl import create_context
 
-        return create_context(), path
+        return create_context(device=args.device), path
     from ..algo.softraster import RasterOptions
     from ..paths import SoftwareRasterizer
 

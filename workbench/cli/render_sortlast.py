@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .arguments import say_worker_devices
 from .render_image import check_drawn, write_image
 
 # style flags of ``render`` that a chunked scene fixes when it is written, and their defaults
@@ -66,7 +67,9 @@ def render_domains(args, mesh, path, camera, size) -> int:
         render_domain = SoftwareDomains(args.mesh, path.name, path.style, camera, size,
                                         path.options)
     # GLDomains opens its own context in each worker process
-    with sweep_cluster(args.workers, args.scheduler, gl=False) as cluster:
+    with sweep_cluster(args.workers, args.scheduler, gl=False, devices=args.worker_devices,
+                       verbose=args.verbose) as cluster:
+        say_worker_devices(cluster.devices)
         color, stats = render_sortlast(cluster.client, render_domain, domains,
                                        method=args.composite, color_only=True)
     check_drawn(color, mesh, camera, size, args.step)
@@ -109,7 +112,9 @@ def render_chunked_scene(args) -> int:
     size = args.size
     camera = SoftwarePath.fit_camera(*scene.bounds(), size, view=args.view, up=args.up)
     render_domain = ChunkDomains(str(Path(args.mesh).resolve()), camera, size)
-    with sweep_cluster(args.workers, args.scheduler, gl=False) as cluster:
+    with sweep_cluster(args.workers, args.scheduler, gl=False, devices=args.worker_devices,
+                       verbose=args.verbose) as cluster:
+        say_worker_devices(cluster.devices)
         color, stats = render_sortlast(cluster.client, render_domain, list(range(len(scene))),
                                        method=args.composite, color_only=True)
     if not coverage(color, WHITE).any():

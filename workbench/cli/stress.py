@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import sys
 
-from .arguments import at_least
+from .arguments import add_device_argument, at_least, select_device
 
 
 def _print_report(title: str, report, unit: str) -> bool:
@@ -25,6 +25,7 @@ def cmd_stress(args) -> int:
     any check failed."""
     from ..reliability import run_d3plot_stress, run_reader_stress, run_render_stress
 
+    select_device(args)  # the render suite's processes draw on it too
     ok = True
     if args.suite in ("readers", "all"):
         report = run_reader_stress(args.n, args.seed)
@@ -62,4 +63,5 @@ def add_parser(subparsers) -> None:
     p.add_argument("--seed", type=int, default=0, help="random seed of the mutations (default 0)")
     p.add_argument("--cycles", type=at_least(1), default=300,
                    help="prepare/draw/release cycles of the render soak (default 300)")
+    add_device_argument(p)
     p.set_defaults(func=cmd_stress)

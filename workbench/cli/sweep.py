@@ -10,7 +10,7 @@ import os
 import sys
 from pathlib import Path
 
-from .arguments import refused
+from .arguments import add_cluster_output_arguments, refused, say_worker_devices
 from .results import add_results_option, store_of
 
 
@@ -26,11 +26,13 @@ def cmd_sweep(args) -> int:
     try:
         result = run_sweep(config, out, workers=args.workers, scheduler=args.scheduler,
                            quick=args.quick, timed=False if args.untimed else None,
-                           recorder=recorder)
+                           recorder=recorder, devices=args.worker_devices,
+                           verbose=args.verbose)
     except KeyboardInterrupt:
         print(f"sweep {config.name}: interrupted; finished points are kept in {out / 'points'}",
               file=sys.stderr)
         return 130
+    say_worker_devices(result.devices)
     print(f"{out / 'table.md'}, {out / 'pareto.png'}")
     print(result.summary)
     print(f"results: run {recorder.run_id}, {recorder.appended} rows -> "
@@ -56,6 +58,7 @@ def add_parser(subparsers):
                    help="smaller built-in scenes and at most 5 timed repeats")
     p.add_argument("--untimed", action="store_true",
                    help="draw every point once without timing (error-only, fully parallel)")
+    add_cluster_output_arguments(p)
     add_results_option(p)
     p.set_defaults(func=cmd_sweep)
     return p

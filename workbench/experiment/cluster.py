@@ -6,6 +6,11 @@ machine (one thread each) or connects to an existing scheduler, registers
 run on, and reuses it for every task) and closes what it started on the way out, also on
 KeyboardInterrupt. A task reaches its worker's context with :func:`worker_context`.
 
+Each worker is pinned to one EGL device before its first context exists (:func:`pin_devices`:
+round-robin over each host's devices, or an explicit list), so the workers of a multi-GPU node
+spread over its GPUs; :attr:`SweepCluster.devices` says which device each worker draws on.
+Dask's own log lines are kept at WARNING unless ``verbose``.
+
 Timed draws disturb each other, so a task holds :func:`draw_lock` (one
 :class:`distributed.Lock` per host name, held through the scheduler) around its timed
 measurement; error-only work takes no lock and runs in parallel.
@@ -19,7 +24,7 @@ import logging
 import os
 import socket
 import threading
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -51,6 +56,7 @@ class GLContextPlugin(WorkerPlugin):
 
     def __init__(self, imports: tuple[str, ...] = ()) -> None:
         self.renderer: str | None = None
+        self.device: str | None = None  # the EGL device identity of the first context
         self.imports = tuple(imports)
         self._contexts: dict[int, moderngl.Context] = {}
 
@@ -78,11 +84,14 @@ class GLContextPlugin(WorkerPlugin):
         ctx = self._contexts.get(thread)
         if ctx is None:
             from ..gl import create_context, renderer
+            from ..gl.devices import current_device
 
             ctx = create_context()
             self._contexts[thread] = ctx
             if self.renderer is None:
                 self.renderer = renderer(ctx)
+                device = current_device()
+                self.device = device.identity if device is not None else None
         return ctx
 
     def teardown(self, worker: Worker) -> None:
@@ -111,9 +120,84 @@ def worker_context() -> moderngl.Context:
     return plugin.context()
 
 
+def worker_device() -> str | None:
+    """The EGL device identity of the worker running the calling task (None elsewhere or
+    before its context exists)."""
+    try:
+        return get_worker().plugins[PLUGIN_NAME].device
+    except (ValueError, KeyError):
+        return None
+
+
 def _worker_renderer(dask_worker) -> str | None:
     plugin = dask_worker.plugins.get(PLUGIN_NAME)
     return None if plugin is None else plugin.renderer
+
+
+def _device_count() -> int:
+    from ..gl.devices import egl_devices
+
+    return len(egl_devices())
+
+
+def _pin(index: int) -> int:
+    """Pin the calling worker process to EGL device ``index`` (its contexts made from now on)."""
+    from ..gl.devices import DEVICE_ENV
+
+    os.environ[DEVICE_ENV] = str(index)
+    return index
+
+
+def _pinned_device(dask_worker) -> str | None:
+    """The identity of the EGL device the worker draws on: its GL context's, else the one it
+    is pinned to; None where it has no EGL device."""
+    from ..gl.devices import DEVICE_ENV, egl_devices
+
+    plugin = dask_worker.plugins.get(PLUGIN_NAME)
+    if plugin is not None and plugin.device is not None:
+        return plugin.device
+    devices = egl_devices()
+    index = int(os.environ.get(DEVICE_ENV) or 0)
+    return devices[index].identity if index < len(devices) else None
+
+
+def device_assignment(counts: dict[str, int], hosts: dict[str, str],
+                      devices: Sequence[int] | None = None) -> dict[str, int]:
+    """{worker address: EGL device index}: the workers of each host (``hosts``: address → host
+    name), in address order, take that host's ``counts[address]`` devices round-robin, or the
+    indices ``devices`` in turn. Workers whose host has no EGL device are left out.
+
+    Refused (ValueError): an index in ``devices`` that a host with workers does not have,
+    whether or not a worker of that host would be dealt it."""
+    by_host: dict[str, list[str]] = {}
+    for address in sorted(counts):
+        by_host.setdefault(hosts.get(address, address), []).append(address)
+    assigned = {}
+    for host, addresses in by_host.items():
+        count = max(counts[address] for address in addresses)
+        if count == 0:
+            continue
+        wrong = [index for index in devices or () if not 0 <= index < count]
+        if wrong:
+            raise ValueError(f"--worker-devices {wrong[0]}: host {host} has {count} EGL "
+                             f"device{'s' if count != 1 else ''}")
+        for i, address in enumerate(addresses):
+            assigned[address] = devices[i % len(devices)] if devices else i % count
+    return assigned
+
+
+def pin_devices(client: Client, devices: Sequence[int] | None = None) -> dict[str, int]:
+    """Pin every worker of ``client`` to one EGL device of its host
+    (:func:`device_assignment`: round-robin, or ``devices`` in turn); returns {worker address:
+    device index}. A worker restarted by its nanny starts unpinned (device 0, or its
+    environment's choice)."""
+    counts = client.run(_device_count)
+    info = client.scheduler_info(n_workers=-1)["workers"]
+    hosts = {address: info.get(address, {}).get("host", address) for address in counts}
+    assigned = device_assignment(counts, hosts, devices)
+    for address, index in assigned.items():
+        client.run(_pin, index, workers=[address])
+    return assigned
 
 
 def draw_lock_name(host: str | None = None) -> str:
@@ -134,12 +218,15 @@ def draw_lock() -> Iterator[None]:
 
 @dataclass
 class SweepCluster:
-    """A connected client, the number of workers it found, and the renderer they draw with."""
+    """A connected client, the number of workers it found, the renderer they draw with, the
+    scheduler's address and the EGL device identity each worker draws on ({address: identity},
+    None for a worker without EGL)."""
 
     client: Client
     workers: int
     renderer: str
     address: str
+    devices: dict[str, str | None]
 
 
 def _renderer_of(client: Client) -> str:
@@ -156,7 +243,8 @@ def _renderer_of(client: Client) -> str:
 @contextmanager
 def sweep_cluster(workers: int | None = None, scheduler: str | None = None, *,
                   raster_threads: int | None = None, gl: bool = True,
-                  imports: tuple[str, ...] = ()) -> Iterator[SweepCluster]:
+                  imports: tuple[str, ...] = (), devices: Sequence[int] | None = None,
+                  verbose: bool | None = None) -> Iterator[SweepCluster]:
     """A :class:`SweepCluster`: a new LocalCluster of ``workers`` processes (default
     ``os.cpu_count()``, one thread each), or the cluster at ``scheduler``
     (``tcp://host:port``), with :class:`GLContextPlugin` registered on every worker.
@@ -167,6 +255,11 @@ def sweep_cluster(workers: int | None = None, scheduler: str | None = None, *,
 
     ``gl=False`` registers no GL context on the workers (work that draws with the software
     rasterizer only: the workers need no EGL; ``renderer`` is then "software").
+
+    Every worker is pinned to an EGL device first (:func:`pin_devices`; ``devices`` lists the
+    indices to deal out, default each host's devices round-robin). Dask's log lines (scheduler,
+    nanny, worker, client) print at WARNING and above, at INFO with ``verbose`` (default: the
+    environment's ``WORKBENCH_VERBOSE=1``, which the commands' ``--verbose`` sets).
 
     ``raster_threads`` sets llvmpipe's rasterizer threads (``LP_NUM_THREADS``) in the local
     workers, unless the environment sets it already: 1 suits error-only sweeps, whose workers
@@ -182,6 +275,10 @@ def sweep_cluster(workers: int | None = None, scheduler: str | None = None, *,
     if workers is not None and (int(workers) != workers or workers < 1):
         raise ValueError(f"workers must be a positive integer, got {workers}")
     cluster = client = None
+    if verbose is None:
+        verbose = os.environ.get("WORKBENCH_VERBOSE") == "1"
+    level = logging.INFO if verbose else logging.WARNING
+    logging.getLogger("distributed").setLevel(level)
     try:
         if scheduler is None:
             # the statistical profiler samples every task thread's stack every 10 ms, holding
@@ -192,7 +289,7 @@ def sweep_cluster(workers: int | None = None, scheduler: str | None = None, *,
             with dask.config.set({"distributed.worker.profile.enabled": False}):
                 cluster = LocalCluster(n_workers=int(workers or os.cpu_count() or 1),
                                        processes=True, threads_per_worker=1,
-                                       dashboard_address=None, silence_logs=logging.CRITICAL,
+                                       dashboard_address=None, silence_logs=level,
                                        env=env)
             client = Client(cluster)
         else:
@@ -201,11 +298,12 @@ def sweep_cluster(workers: int | None = None, scheduler: str | None = None, *,
                 client.wait_for_workers(1, timeout=WORKER_WAIT_S)
             except TimeoutError as exc:
                 raise OSError(f"scheduler {scheduler}: {exc or 'no workers'}") from None
+        pin_devices(client, devices)
         if gl:
             client.register_plugin(GLContextPlugin(imports), name=PLUGIN_NAME)
         count = len(client.scheduler_info(n_workers=-1)["workers"])
         yield SweepCluster(client, count, _renderer_of(client) if gl else "software",
-                           client.scheduler.address)
+                           client.scheduler.address, client.run(_pinned_device))
     finally:
         if client is not None:
             client.close()

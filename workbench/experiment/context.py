@@ -73,6 +73,7 @@ class ExperimentContext:
     skipped: list[str] = field(default_factory=list)
     tables: list[tuple[str, list[dict[str, Any]]]] = field(default_factory=list)
     gl_renderer: str | None = None  # the renderer of the run's GL context, once made
+    gl_device: str | None = None  # its EGL device's identity (EGLDevice.identity), once made
     _gl_scope: ExitStack | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -139,10 +140,20 @@ class ExperimentContext:
         """Write ``rows`` as ``<name>.csv`` and ``<name>.md`` (titled, with a note where its
         GPU times are empty on a software renderer) into the run's folder, and keep them in
         :attr:`tables` for the results store."""
-        rows = list(rows)
+        rows = self.with_device(rows)
         write_table(rows, self.out_dir, name, columns=columns, title=title,
                     notes=empty_gpu_note(rows, self.gl_renderer))
         self.tables.append((name, rows))
+
+    def with_device(self, rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+        """``rows`` with an ``egl_device`` column (the run's EGL device identity, e.g.
+        "egl0:software" or "egl1:<uuid>") on each row drawn on the run's GL renderer, so that
+        two identical GPUs are told apart; rows of other renderers are left as they are."""
+        if self.gl_device is None:
+            return list(rows)
+        return [{**row, "egl_device": self.gl_device}
+                if row.get("renderer") == self.gl_renderer and "egl_device" not in row else row
+                for row in rows]
 
     # ------------------------------------------------------------------ data and drawing
     def shared(self, relative: Path | str, what: str) -> Path | None:
@@ -170,8 +181,10 @@ class ExperimentContext:
 
     @cached_property
     def gl(self) -> moderngl.Context:
-        """The run's headless GL context, created on first use (and current from then on)."""
+        """The run's headless GL context, created on first use (and current from then on), on
+        the EGL device ``WORKBENCH_EGL_DEVICE`` names (default 0; ``--device`` sets it)."""
         from ..gl.context import create_context, egl, keeping_current, renderer
+        from ..gl.devices import current_device
 
         scope = ExitStack()
         restore = scope.enter_context(keeping_current())
@@ -183,6 +196,8 @@ class ExperimentContext:
         restore.display = egl().eglGetCurrentDisplay()
         self._gl_scope = scope
         self.gl_renderer = renderer(ctx)
+        device = current_device()
+        self.gl_device = device.identity if device is not None else None
         return ctx
 
     def close(self) -> None:

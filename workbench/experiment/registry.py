@@ -149,6 +149,7 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
         bad = [type(r).__name__ for r in rows if not isinstance(r, dict)]
         if bad:
             raise TypeError(f"experiment {name!r} returned rows that are not dicts: {bad[:3]}")
+        rows = context.with_device(rows)
         write_table(rows, staging, "table", title=f"{exp.name}: {exp.description}",
                     notes=empty_gpu_note(rows, context.gl_renderer))
         _swap_in(staging, out_dir)

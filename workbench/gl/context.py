@@ -18,18 +18,30 @@ class GLUnavailable(RuntimeError):
     """No headless OpenGL 3.3+ context could be created through EGL."""
 
 
-def create_context(require: int = 330) -> moderngl.Context:
-    """A standalone moderngl context on EGL (no display needed), OpenGL ``require`` or newer.
+def create_context(require: int = 330, device: int | str | None = None) -> moderngl.Context:
+    """A standalone moderngl context on EGL (no display needed), OpenGL ``require`` or newer,
+    on EGL device ``device`` (default ``WORKBENCH_EGL_DEVICE``, else 0; see
+    :func:`~workbench.gl.devices.device_index`).
 
-    Refuses with :class:`GLUnavailable` naming the Debian packages to install when EGL or a
-    Mesa/GPU driver is missing.
+    Refuses with ValueError a device index that is not one of this machine's (or that
+    contradicts glcontext's own ``GLCONTEXT_DEVICE_INDEX``), and with :class:`GLUnavailable`
+    naming the Debian packages to install when EGL or a Mesa/GPU driver is missing.
     """
+    from .devices import device_index
+
+    index = device_index(device)
+    forced = os.environ.get("GLCONTEXT_DEVICE_INDEX")
+    if forced is not None and forced.strip() != str(index):
+        raise ValueError(f"GLCONTEXT_DEVICE_INDEX={forced} overrides the EGL device {index} "
+                         f"asked for; unset it and use --device or WORKBENCH_EGL_DEVICE")
     try:
-        ctx = moderngl.create_standalone_context(require=require, backend="egl")
+        ctx = moderngl.create_standalone_context(require=require, backend="egl",
+                                                 device_index=index)
     except Exception as exc:  # moderngl raises plain Exception for a missing libEGL or driver
         raise GLUnavailable(
             f"no headless OpenGL {require // 100}.{require % 100 // 10} context through EGL "
-            f"({exc}); on Debian/Ubuntu install: apt-get install {EGL_PACKAGES}"
+            f"on device {index} ({exc}); on Debian/Ubuntu install: apt-get install "
+            f"{EGL_PACKAGES}"
         ) from exc
     return ctx
 

@@ -247,12 +247,14 @@ def measured_columns(point: Point, ctx) -> dict:
 def run_point(point: Point, workers: int, run_id: str) -> dict:
     """The row of ``point``, measured on this worker: :meth:`Point.columns`, then
     :func:`measured_columns`, ``point_ms`` (wall ms of the whole point), ``workers`` (the
-    cluster's worker count), ``host``, ``run_id`` (the run that computed it) — or, when the
-    point raises, its columns with ``error`` (one line ``Type: message``)."""
-    from ..experiment.cluster import worker_context
+    cluster's worker count), ``host``, ``egl_device`` (the identity of the worker's EGL
+    device), ``run_id`` (the run that computed it) — or, when the point raises, its columns
+    with ``error`` (one line ``Type: message``)."""
+    from ..experiment.cluster import worker_context, worker_device
 
     start = time.perf_counter()
-    extra = dict(workers=workers, host=socket.gethostname(), run_id=run_id)
+    extra = dict(workers=workers, host=socket.gethostname(), egl_device=worker_device(),
+                 run_id=run_id)
     try:
         columns = measured_columns(point, worker_context())
     except Exception as exc:  # a failing point is a result of the sweep, not its end

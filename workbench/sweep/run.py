@@ -21,6 +21,8 @@ from .points import Point, failure_row, run_point
 from .sources import point_key
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
     from ..experiment.recording import Recorder
 
 # what every worker imports once its context exists, so that the first point's time is not
@@ -33,7 +35,8 @@ class SweepResult:
     """What :func:`run_sweep` did: ``rows`` (grid order, as in the table), ``computed``,
     ``cached`` and ``failed`` point counts, the run's ``run_id``, ``renderer``, ``workers``,
     ``out_dir``, ``skip_ms`` (per cached point: ms to compute its key and read its row) and
-    ``compute_s`` (wall seconds from submitting the missing points to storing the last)."""
+    ``compute_s`` (wall seconds from submitting the missing points to storing the last) and
+    ``devices`` (the EGL device identity each worker drew on, by worker address)."""
 
     name: str
     rows: list[dict]
@@ -46,6 +49,7 @@ class SweepResult:
     out_dir: Path
     skip_ms: list[float] = field(default_factory=list)
     compute_s: float = 0.0
+    devices: dict[str, str | None] = field(default_factory=dict)
 
     @property
     def summary(self) -> str:
@@ -63,7 +67,8 @@ def _progress(total: int, initial: int, name: str, enabled: bool):
 
 def run_sweep(config: SweepConfig | str | Path, out_dir, *, workers: int | None = None,
               scheduler: str | None = None, quick: bool = False, progress: bool = True,
-              timed: bool | None = None, recorder: Recorder | None = None) -> SweepResult:
+              timed: bool | None = None, recorder: Recorder | None = None,
+              devices: Sequence[int] | None = None, verbose: bool = False) -> SweepResult:
     """Run ``config`` (a :class:`SweepConfig` or a config file) on a Dask cluster (a new
     LocalCluster of ``workers`` processes, default one per CPU, or the one at ``scheduler``),
     computing only points not cached in ``out_dir/points``; write ``table.csv``, ``table.md``
@@ -77,7 +82,9 @@ def run_sweep(config: SweepConfig | str | Path, out_dir, *, workers: int | None 
     also when the sweep is interrupted, and the rows carry the recorder's run id. An
     ``out_dir`` or ``out_dir/points`` that is a symbolic link (wherever it points) or not a
     folder is refused (ValueError) before any point is computed, as is a ``table.csv``,
-    ``table.md`` or ``pareto.png`` there that exists and is not a regular file.
+    ``table.md`` or ``pareto.png`` there that exists and is not a regular file. ``devices``
+    lists the EGL devices the workers are pinned to (default each host's round-robin);
+    ``verbose`` shows Dask's INFO log lines.
     """
     from ..experiment.cluster import sweep_cluster
 
@@ -93,7 +100,7 @@ def run_sweep(config: SweepConfig | str | Path, out_dir, *, workers: int | None 
     skip_ms, computed = [], 0
     untimed = not any(p.timed for p in points)
     with sweep_cluster(workers, scheduler, raster_threads=1 if untimed else None,
-                       imports=WORKER_IMPORTS) as cluster:
+                       imports=WORKER_IMPORTS, devices=devices, verbose=verbose) as cluster:
         keys = {}
         for point in points:
             start = time.perf_counter()
@@ -114,12 +121,12 @@ def run_sweep(config: SweepConfig | str | Path, out_dir, *, workers: int | None 
                                 experiment=f"sweep:{config.name}", table="points",
                                 experiment_size="quick" if quick else "full")
         compute_s = time.perf_counter() - start
-        renderer, count = cluster.renderer, cluster.workers
+        renderer, count, devices = cluster.renderer, cluster.workers, cluster.devices
     ordered = [rows[p.index] for p in points]
     write_results(config, ordered, out, renderer, timed=points[0].timed if points else True)
     failed = sum(1 for r in ordered if r.get("error"))
     return SweepResult(config.name, ordered, computed, len(points) - computed, failed, run_id,
-                       renderer, count, out, skip_ms, compute_s)
+                       renderer, count, out, skip_ms, compute_s, devices)
 
 
 def _compute(cluster, points: list[Point], keys: dict, points_dir: Path, run_id: str,
