@@ -27,6 +27,26 @@ def test_the_devices_are_listed_with_distinct_identities_and_a_context_on_each()
     assert all(d.identity.startswith(f"egl{d.index}:") for d in devices)
 
 
+def test_what_a_gpu_driver_says_of_its_devices_is_read():
+    """CUDA ids and UUIDs where the driver offers them (NVIDIA's EGL): none on Mesa alone, so
+    on a machine without such a GPU this checks only that nothing is invented."""
+    devices = egl_devices()
+    for d in devices:
+        if "EGL_NV_device_cuda" in d.extensions:
+            assert isinstance(d.cuda_device, int) and d.cuda_device >= 0
+        else:
+            assert d.cuda_device is None
+        if "EGL_EXT_device_persistent_id" in d.extensions:
+            assert d.uuid is not None and len(d.uuid) == 32 and int(d.uuid, 16) >= 0
+            assert d.identity == f"egl{d.index}:{d.uuid}"
+        else:
+            assert d.uuid is None
+    cuda = [d.cuda_device for d in devices if d.cuda_device is not None]
+    assert len(set(cuda)) == len(cuda)
+    uuids = [d.uuid for d in devices if d.uuid is not None]
+    assert len(set(uuids)) == len(uuids)
+
+
 def test_a_context_is_made_on_the_device_asked_for():
     from workbench.gl import create_context, renderer
     from workbench.gl.context import egl, keeping_current
