@@ -457,3 +457,20 @@ def test_box_in_box_hides_its_inner_part_in_a_closed_box():
     assert np.abs(inner).max() == pytest.approx(0.2) and np.abs(outer).max(axis=1).min() == 1.0
     with pytest.raises(ValueError, match="below box_half"):
         box_in_box(1.0, 1.0)
+
+
+def test_the_builtin_crash_is_the_car_crushed_over_eight_states(car):
+    from workbench.scene.builtin import load_scene
+
+    crash = load_scene("crash")
+    assert crash.n_steps == 8 and len(load_scene("crash:3").times) == 3
+    np.testing.assert_array_equal(crash.coordinates(0), car.coordinates())
+    np.testing.assert_array_equal(crash.elements, car.elements)
+    moved = np.linalg.norm(crash.coordinates(7) - car.coordinates(), axis=1)
+    rigid = {p for p, title in car.part_names.items() if "rigid" in title.lower()}
+    assert rigid and moved.max() > 0
+    still = np.isin(crash.parts, list(rigid))
+    only_rigid = np.setdiff1d(np.unique(crash.elements[still]),
+                              np.unique(crash.elements[~still]))
+    assert np.all(moved[only_rigid] == 0)  # the rigid barrier holds still
+    assert set(crash.node_fields) == {"displacement"} and "plastic_strain" in crash.element_fields

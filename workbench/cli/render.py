@@ -34,7 +34,8 @@ def add_parser(subparsers) -> None:
         "render", help="render one scene to a PNG",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         description="Render a mesh file (LS-DYNA .k, d3plot, meshio or trimesh formats), a "
-                    "built-in scene (car, d3plot, semicylinders[:N], panels[:Q]) or a spacetime "
+                    "built-in scene (car, crash[:S], d3plot, semicylinders[:N], panels[:Q]) or a "
+                    "spacetime "
                     "scene (spacetime:radial[:N], spacetime:bar) offscreen, through the one "
                     "measurement function (untimed); or a chunked scene's folder (written by "
                     "--write-chunked) on Dask workers.",

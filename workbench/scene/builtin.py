@@ -4,6 +4,8 @@ Built-in scenes are a registry, like render paths and experiments: a function de
 :func:`builtin` makes the scene of one name. This module registers the FE meshes:
 
 * ``car`` — the LS-DYNA car deck of the shared data; ``d3plot`` — the shared d3plot result;
+* ``crash[:S]`` — the car through a synthetic frontal crush of S states (default 8), its rigid
+  parts held still, with node field ``displacement`` and element field ``plastic_strain``;
 * ``semicylinders[:N]`` — the es2008 benchmark, N×N quads per sheet (default 250: 1 M
   triangles; 64 quick);
 * ``panels[:Q]`` — generated stamped panels, about Q quads.
@@ -134,7 +136,7 @@ def load_mesh(spec: str, quick: bool = False, all_faces: bool = False) -> FEMesh
     scene = load_scene(spec, quick, all_faces)
     if scene.kind != "mesh":
         raise ValueError(f"{spec!r} is a {scene.kind} scene; this takes an FE mesh (a mesh file, "
-                         f"car, d3plot, semicylinders[:N] or panels[:Q])")
+                         f"car, crash[:S], d3plot, semicylinders[:N] or panels[:Q])")
     return scene
 
 
@@ -176,6 +178,15 @@ def car(size: int | None, quick: bool) -> FEMesh:
 @builtin("d3plot", "the shared d3plot result")
 def d3plot(size: int | None, quick: bool) -> FEMesh:
     return _shared_mesh("d3plot", D3PLOT)
+
+
+@builtin("crash", "the car crushed from the front over S states (default 8)", sized=True)
+def crash(size: int | None, quick: bool) -> FEMesh:
+    from .generators import crash_sequence
+
+    car = _shared_mesh("crash", CAR_DECK)
+    rigid = [part for part, title in car.part_names.items() if "rigid" in title.lower()]
+    return crash_sequence(car, steps=size or 8, still_parts=rigid)
 
 
 @builtin("semicylinders", "the es2008 benchmark, N×N quads per sheet (default 250: 1 M "
