@@ -13,13 +13,14 @@ from hypothesis import strategies as st
 
 from workbench.cli import main
 from workbench.experiment.cluster import device_assignment
+from workbench.gl.context import probed_devices
 from workbench.gl.devices import DEVICE_ENV, current_device, device_index, egl_devices
 
 pytestmark = pytest.mark.gl
 
 
 def test_the_devices_are_listed_with_distinct_identities_and_a_context_on_each():
-    devices = egl_devices(probe=True)
+    devices = probed_devices()
     assert devices, "EGL lists no device"
     assert [d.index for d in devices] == list(range(len(devices)))
     assert len({d.identity for d in devices}) == len(devices)
@@ -57,7 +58,7 @@ def test_a_context_is_made_on_the_device_asked_for():
         restore.display = egl().eglGetCurrentDisplay()
         try:
             assert current_device().index == last
-            assert renderer(other) == egl_devices(probe=True)[last].renderer
+            assert renderer(other) == probed_devices()[last].renderer
         finally:
             other.release()
 
@@ -115,7 +116,7 @@ def test_info_lists_every_device_with_its_identity(capsys):
     assert main(["info"]) == 0
     out = capsys.readouterr().out
     assert "EGL devices (" in out
-    for device in egl_devices(probe=True):
+    for device in probed_devices():
         line = next(ln for ln in out.splitlines() if ln.strip().startswith(f"{device.index} "))
         assert device.identity in line and device.renderer in line
 

@@ -58,17 +58,26 @@ def check_devices(device: str | None) -> Check:
 
 
 def check_gl(device: str | None) -> Check:
-    from ..gl.context import GLUnavailable, create_context, gl_version, renderer
+    from ..gl.context import (
+        GLUnavailable,
+        create_context,
+        egl,
+        gl_version,
+        keeping_current,
+        renderer,
+    )
 
-    try:
-        ctx = create_context(device=device)
-    except (GLUnavailable, ValueError) as exc:
-        return Check("OpenGL", False, str(exc),
-                     f"{MESA}, or a GPU driver with OpenGL 3.3 core through EGL")
-    try:
-        return Check("OpenGL", True, f"{gl_version(ctx)} on {renderer(ctx)}")
-    finally:
-        ctx.release()
+    with keeping_current() as restore:  # the caller's context (if any) current again after
+        try:
+            ctx = create_context(device=device)
+        except (GLUnavailable, ValueError) as exc:
+            return Check("OpenGL", False, str(exc),
+                         f"{MESA}, or a GPU driver with OpenGL 3.3 core through EGL")
+        restore.display = egl().eglGetCurrentDisplay()
+        try:
+            return Check("OpenGL", True, f"{gl_version(ctx)} on {renderer(ctx)}")
+        finally:
+            ctx.release()
 
 
 def check_shared_data() -> Check:

@@ -38,10 +38,10 @@ def cmd_info(args) -> int:
     """Print the renderer, the EGL devices, versions and the shared data folder; 0."""
     from ..data import shared_data_dir
     from ..gl import create_context, renderer
-    from ..gl.context import gl_version
-    from ..gl.devices import DEVICE_ENV, current_device, egl_devices
+    from ..gl.context import gl_version, probed_devices
+    from ..gl.devices import DEVICE_ENV, current_device
 
-    devices = egl_devices(probe=True)
+    devices = probed_devices()
     ctx = create_context(device=args.device)
     print(f"workbench {metadata.version('workbench')}")
     print(f"renderer  {renderer(ctx)}")

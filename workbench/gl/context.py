@@ -7,9 +7,12 @@ import os
 import re
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from types import ModuleType
 
 import moderngl
+
+from .devices import EGLDevice, device_index, egl_devices
 
 EGL_PACKAGES = "libegl1 libegl-mesa0 libgl1-mesa-dri"
 
@@ -27,8 +30,6 @@ def create_context(require: int = 330, device: int | str | None = None) -> moder
     contradicts glcontext's own ``GLCONTEXT_DEVICE_INDEX``), and with :class:`GLUnavailable`
     naming the Debian packages to install when EGL or a Mesa/GPU driver is missing.
     """
-    from .devices import device_index
-
     index = device_index(device)
     forced = os.environ.get("GLCONTEXT_DEVICE_INDEX")
     if forced is not None and forced.strip() != str(index):
@@ -44,6 +45,27 @@ def create_context(require: int = 330, device: int | str | None = None) -> moder
             f"{EGL_PACKAGES}"
         ) from exc
     return ctx
+
+
+def probed_devices() -> list[EGLDevice]:
+    """:func:`~workbench.gl.devices.egl_devices` with each device's GL ``renderer`` and
+    ``vendor`` read from a context made on it and released (the caller's current context is
+    current again afterwards); a device on which no context can be made keeps None."""
+    return [_probed(device) for device in egl_devices()]
+
+
+def _probed(device: EGLDevice) -> EGLDevice:
+    try:
+        with keeping_current() as restore:
+            ctx = moderngl.create_standalone_context(backend="egl", device_index=device.index)
+            restore.display = egl().eglGetCurrentDisplay()
+            try:
+                return replace(device, renderer=str(ctx.info["GL_RENDERER"]),
+                               vendor=str(ctx.info["GL_VENDOR"]))
+            finally:
+                ctx.release()
+    except Exception:  # moderngl raises plain Exception where a device gives no context
+        return device
 
 
 def renderer(ctx: moderngl.Context) -> str:

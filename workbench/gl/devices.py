@@ -32,8 +32,9 @@ class EGLDevice:
     """One EGL device: its ``index`` in EGL's order and what the driver says of it (None where
     it does not say): device ``extensions``, ``drm_file`` and ``render_node`` (DRM device
     files), ``cuda_device`` (CUDA's ordinal, EGL_NV_device_cuda), ``uuid`` (hex) and
-    ``driver``. ``renderer`` and ``vendor`` are GL's strings, filled by :func:`egl_devices`
-    with ``probe=True`` (a context made on the device and released)."""
+    ``driver``. ``renderer`` and ``vendor`` are GL's strings, filled by
+    :func:`~workbench.gl.context.probed_devices` (a context made on the device and
+    released)."""
 
     index: int
     extensions: tuple[str, ...] = ()
@@ -142,38 +143,13 @@ def _egl() -> _EGL | None:
         return None
 
 
-def egl_devices(probe: bool = False) -> list[EGLDevice]:
-    """Every EGL device in EGL's order ([] where libEGL or device enumeration is missing). With
-    ``probe``, each device's GL ``renderer`` and ``vendor`` are read from a context made on it
-    and released (the caller's current context is current again afterwards); a device on
-    which no context can be made keeps None."""
+def egl_devices() -> list[EGLDevice]:
+    """Every EGL device in EGL's order ([] where libEGL or device enumeration is missing);
+    :func:`~workbench.gl.context.probed_devices` adds each one's GL renderer and vendor."""
     egl = _egl()
     if egl is None:
         return []
-    devices = [egl.device(i, handle) for i, handle in enumerate(egl.handles())]
-    if probe:
-        devices = [_probed(device) for device in devices]
-    return devices
-
-
-def _probed(device: EGLDevice) -> EGLDevice:
-    from dataclasses import replace
-
-    import moderngl
-
-    from .context import egl, keeping_current
-
-    try:
-        with keeping_current() as restore:
-            ctx = moderngl.create_standalone_context(backend="egl", device_index=device.index)
-            restore.display = egl().eglGetCurrentDisplay()
-            try:
-                return replace(device, renderer=str(ctx.info["GL_RENDERER"]),
-                               vendor=str(ctx.info["GL_VENDOR"]))
-            finally:
-                ctx.release()
-    except Exception:  # moderngl raises plain Exception where a device gives no context
-        return device
+    return [egl.device(i, handle) for i, handle in enumerate(egl.handles())]
 
 
 def current_device() -> EGLDevice | None:
