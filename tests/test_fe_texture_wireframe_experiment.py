@@ -5,6 +5,7 @@ meshes too; marked slow)."""
 import csv
 
 import pytest
+from device_column import own_columns
 
 from workbench.algo.fepatch.pipeline import PARAMETER_SETS
 from workbench.experiment.tables import read_table
@@ -67,7 +68,7 @@ def test_tiny_writes_every_table_with_its_columns(tiny):
     _, out_dir = tiny
     for name, columns in TABLES.items():
         assert (out_dir / f"{name}.md").is_file()
-        assert _columns(out_dir / f"{name}.csv") == columns, name
+        assert own_columns(_columns(out_dir / f"{name}.csv")) == columns, name
     rows = read_table(out_dir / "table.csv")
     assert {r["case"] for r in rows} >= {"original, shaded", "original + line overdraw",
                                          "original + wire texture"}
