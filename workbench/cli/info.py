@@ -9,7 +9,8 @@ from importlib import metadata
 from .arguments import add_device_argument
 
 VERSIONED = ("numpy", "scipy", "moderngl", "trimesh", "meshio", "lasso-python", "libigl",
-             "pymeshlab", "open3d", "pyrender", "meshoptimizer", "scikit-image", "matplotlib")
+             "pymeshlab", "open3d", "pyrender", "pyvista", "vtk", "meshoptimizer",
+             "scikit-image", "matplotlib", "distributed", "jupyter-rfb")
 
 
 def add_parser(subparsers) -> None:

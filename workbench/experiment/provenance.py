@@ -29,8 +29,9 @@ if TYPE_CHECKING:
 
 # the libraries the workbench draws, reads or compares with; their versions go into every run
 LIBRARIES = ("numpy", "scipy", "numba", "moderngl", "PyOpenGL", "trimesh", "meshio",
-             "lasso-python", "libigl", "pymeshlab", "open3d", "pyrender", "meshoptimizer",
-             "coal", "scikit-image", "matplotlib", "distributed", "pyarrow", "duckdb")
+             "lasso-python", "libigl", "pymeshlab", "open3d", "pyrender", "pyvista", "vtk",
+             "meshoptimizer", "coal", "scikit-image", "matplotlib", "distributed", "pyarrow",
+             "duckdb", "fcpw", "imageio-ffmpeg")
 MACHINE_FIELDS = ("cpu", "logical_cores", "memory_gib", "os", "python", "renderer",
                   "gl_vendor", "gl_version", "driver", "egl_device")
 _RUN_ID = re.compile(r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*$")

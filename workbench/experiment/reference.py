@@ -59,7 +59,7 @@ def _load():
     return pyrender, EGL, GL
 
 
-def _colours(colors, count: int) -> np.ndarray:
+def rgba_colours(colors, count: int) -> np.ndarray:
     """(count, 4) float RGBA in [0, 1] from None, one colour or per-vertex colours."""
     c = np.asarray((0.8, 0.8, 0.8) if colors is None else colors)
     if c.ndim == 1:
@@ -133,7 +133,7 @@ class PyrenderReference:
         towards_viewer /= np.linalg.norm(towards_viewer)
         normals = normals / length[:, None]
         normals[normals @ towards_viewer < 0.0] *= -1.0
-        rgba = _colours(base_color if colors is None else colors, len(vertices))
+        rgba = rgba_colours(base_color if colors is None else colors, len(vertices))
         linear = np.c_[rgba[:, :3] ** GAMMA, rgba[:, 3]]
 
         positions = camera.relative(vertices)

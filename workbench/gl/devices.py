@@ -152,6 +152,16 @@ def egl_devices() -> list[EGLDevice]:
     return [egl.device(i, handle) for i, handle in enumerate(egl.handles())]
 
 
+def device_handle(index: int) -> int:
+    """The EGLDeviceEXT handle of device ``index`` (for eglGetPlatformDisplayEXT); ValueError
+    where EGL lists no such device."""
+    egl = _egl()
+    handles = egl.handles() if egl is not None else []
+    if not 0 <= index < len(handles):
+        raise ValueError(f"EGL lists no device {index} ({len(handles)} devices)")
+    return handles[index]
+
+
 def current_device() -> EGLDevice | None:
     """The EGL device of the current context, None where EGL cannot say."""
     egl = _egl()

@@ -11,10 +11,11 @@ mesh). A scene's paths are measured together by
 :func:`workbench.experiment.measure.measure_together` (their draws interleaved, each time with
 its 95 % interval); GPU time is recorded only where the renderer's timer queries time the draw
 (not on llvmpipe, where wall time — draw + ``finish`` — is the time).
-In the same run the same triangles are drawn by pyrender through EGL at the same size, with
-the same culling and comparable lighting (SSIM against our Gouraud image shows the comparison
-is like for like), and a bare position-only draw gives the floor. ``targets.md`` holds the
-ratios the foundation is judged by, each measured interleaved with its 95 % interval.
+In the same run the same triangles are drawn by pyrender and by pyvista/VTK through EGL at the
+same size, with the same culling and comparable lighting (SSIM against our Gouraud image shows
+the comparison is like for like), and a bare position-only draw gives the floor.
+``targets.md`` holds the ratios the foundation is judged by, each measured interleaved with its
+95 % interval.
 
 Run: ``workbench run render_paths [--quick]``.
 """
@@ -31,6 +32,8 @@ from workbench.experiment.figures import save_field_figure, save_image_grid
 from workbench.experiment.interleave import Clock, draw_clock, interleaved_ratios
 from workbench.experiment.measure import Together, measure_together, prepared
 from workbench.experiment.reference import PyrenderReference
+from workbench.experiment.reference_vtk import LIGHTING as VTK_LIGHTING
+from workbench.experiment.reference_vtk import PyvistaReference
 from workbench.experiment.registry import experiment
 from workbench.experiment.timing import time_call
 from workbench.gl import Camera
@@ -86,7 +89,8 @@ def path_configs(step: int, field: str, element_field: str | None, value_range, 
     if step > 0:
         yield ("pixel bands, deformation x3", "pixel_color", replace(banded, magnification=3.0),
                0, None)
-    # pyrender always draws with 4x multisampling: these rows are its like-for-like peers
+    # pyrender always draws with 4x multisampling (pyvista/VTK is given 4x too): these rows
+    # are their like-for-like peers
     yield "gouraud, 4x MSAA", "gouraud", plain, 4, None
     yield "pixel bands, 4x MSAA", "pixel_color", banded, 4, None
 
@@ -151,40 +155,88 @@ def pyrender_row(exp: ExperimentContext, label: str, mesh, step: int, camera: Ca
     return row, ref_image, split, ref
 
 
+def pyvista_row(exp: ExperimentContext, label: str, mesh, step: int, camera: Camera, size,
+                split, ours: np.ndarray, ours_row: dict):
+    """pyvista/VTK (its EGL render window, 4× MSAA) drawing the crease-split Gouraud triangles
+    ``split`` of step ``step`` at ``size``, timed with read-back and compared with our 4× MSAA
+    Gouraud image ``ours`` (RGB, over the pixels either draws). ``wall_over_ours`` is its wall
+    time (render + read-back) over ours (``ours_row``: draw + read-back), from the two rows'
+    separate measurements (the targets hold the ratio measured interleaved);
+    ``peer_version`` names VTK's and pyvista's versions and ``lighting`` what VTK's lighting
+    is and where it differs from ours. Returns its row, its image and the reference itself,
+    still prepared (the caller releases it)."""
+    coords = mesh.coordinates(step)
+    ref = PyvistaReference(coords[split.vertex_node], split.triangles, split.normals(coords),
+                           camera=camera, size=size, base_color=Style().base_color, samples=4)
+    try:
+        ref_image = ref.render()
+        ref_timing = ref.time(warmup=2, repeat=exp.repeats)
+    except BaseException:
+        ref.release()
+        raise
+    diff = compare_drawn(ref_image, ours[..., :3], background=(1.0, 1.0, 1.0))
+    ours_ms = ours_row["wall_ms"] + ours_row["readback_ms"]
+    row = dict(renderer=exp.renderer, scene=label, case="pyvista/VTK (EGL)", path="pyvista",
+               size=f"{size[0]}x{size[1]}", samples=ref.samples, triangles=len(split.triangles),
+               vertices=split.n_vertices, **ref_timing.as_row(),
+               mtri_per_s=len(split.triangles) / ref_timing.wall_ms / 1e3,
+               reference="gouraud, 4x MSAA", max_diff_255=diff.max_abs,
+               share_differing=diff.share_differing, psnr_db=diff.psnr, ssim=diff.ssim,
+               wall_over_ours=ref_timing.wall_ms / ours_ms, peer_version=ref.version,
+               lighting=VTK_LIGHTING)
+    exp.say(f"  pyvista/VTK: wall {ref_timing.wall_ms:.2f} ms ({row['wall_over_ours']:.2f}x "
+            f"ours), SSIM vs gouraud 4x MSAA {diff.ssim:.3f}")
+    return row, ref_image, ref
+
+
 def interleaved_targets(exp: ExperimentContext, mesh, configs: dict, camera: Camera, size,
-                        ref: PyrenderReference) -> dict:
-    """The two ratios the targets state, each measured interleaved (A B A B …, see
+                        ref: PyrenderReference, vtk: PyvistaReference) -> dict:
+    """The ratios the targets state, each measured interleaved (A B A B …, see
     :mod:`workbench.experiment.interleave`) with its 95 % interval: per-pixel bands over the
-    position-only draw, and per-pixel bands with 4× MSAA and read-back over pyrender (which
-    reads back in its render)."""
+    position-only draw; per-pixel bands with 4× MSAA and read-back over pyrender and over
+    pyvista/VTK (both read back in their render); and Gouraud with 4× MSAA and read-back (the
+    same triangles) over pyvista/VTK. The peers' ratios come from one run, every side drawn
+    once per round."""
     def setting(case):
         _, name, style, samples, _ = configs[case]
         return dict(path=name, style=style, camera=camera, size=size, samples=samples)
 
+    def with_readback(ready) -> Clock:
+        clock = draw_clock(ready)
+        return Clock(lambda: (clock.run(), ready.target.read()), clock.setup)
+
     with prepared(exp.gl, mesh, **setting("pixel bands")) as bands, \
             prepared(exp.gl, mesh, **setting("position")) as floor, \
-            prepared(exp.gl, mesh, **setting("pixel bands, 4x MSAA")) as msaa:
-        draw_msaa = draw_clock(msaa)
+            prepared(exp.gl, mesh, **setting("pixel bands, 4x MSAA")) as msaa, \
+            prepared(exp.gl, mesh, **setting("gouraud, 4x MSAA")) as gouraud:
         floor_ratio = interleaved_ratios(
             {"bands": draw_clock(bands), "position": draw_clock(floor)},
             [("bands", "position")], exp.ratio_stop())[("bands", "position")]
-        peer_ratio = interleaved_ratios(
-            {"msaa": Clock(lambda: (draw_msaa.run(), msaa.target.read()), draw_msaa.setup),
-             "pyrender": Clock(ref.render)},
-            [("msaa", "pyrender")], exp.ratio_stop(max_samples=15))[("msaa", "pyrender")]
+        peers = interleaved_ratios(
+            {"msaa": with_readback(msaa), "pyrender": Clock(ref.render),
+             "gouraud": with_readback(gouraud), "pyvista": Clock(vtk.render)},
+            [("msaa", "pyrender"), ("msaa", "pyvista"), ("gouraud", "pyvista")],
+            exp.ratio_stop(max_samples=15))
+    peer_ratio, vtk_ratio = peers[("msaa", "pyrender")], peers[("msaa", "pyvista")]
+    gouraud_ratio = peers[("gouraud", "pyvista")]
     exp.say(f"  interleaved: pixel bands / position-only {floor_ratio.interval.estimate:.3f} "
             f"[{floor_ratio.interval.lo:.3f}, {floor_ratio.interval.hi:.3f}], 4x MSAA + "
-            f"read-back / pyrender {peer_ratio.interval.estimate:.3f}")
+            f"read-back / pyrender {peer_ratio.interval.estimate:.3f}, / pyvista "
+            f"{vtk_ratio.interval.estimate:.3f}; gouraud 4x MSAA + read-back / pyvista "
+            f"{gouraud_ratio.interval.estimate:.3f}")
     return {**floor_ratio.as_row("contour_over_position_only"),
-            **peer_ratio.as_row("contour_msaa_over_pyrender")}
+            **peer_ratio.as_row("contour_msaa_over_pyrender"),
+            **vtk_ratio.as_row("contour_msaa_over_pyvista"),
+            **gouraud_ratio.as_row("gouraud_msaa_over_pyvista")}
 
 
 def target_row(exp: ExperimentContext, label: str, mesh, size, rows: list[dict],
-               reference: dict, split, ratios: dict) -> dict:
-    """The targets of one scene: the contour path against the position-only draw and against
-    pyrender (its ``reference`` row) — the times from their own rows, the ratios measured
-    interleaved (``ratios``, from :func:`interleaved_targets`) — and what a time step uploads
-    against preparation."""
+               reference: dict, vtk: dict, split, ratios: dict) -> dict:
+    """The targets of one scene: the contour path against the position-only draw, against
+    pyrender (its ``reference`` row) and against pyvista/VTK (its ``vtk`` row), and Gouraud
+    against pyvista/VTK — the times from their own rows, the ratios measured interleaved
+    (``ratios``, from :func:`interleaved_targets`) — and what a time step uploads against
+    preparation."""
     by_case = {r["case"]: r for r in rows}
     contour, contour_msaa = by_case["pixel bands"], by_case["pixel bands, 4x MSAA"]
     return {
@@ -193,8 +245,10 @@ def target_row(exp: ExperimentContext, label: str, mesh, size, rows: list[dict],
         "position_only_wall_ms": by_case["position"]["wall_ms"],
         "contour_msaa_incl_readback_ms": contour_msaa["wall_ms"] + contour_msaa["readback_ms"],
         "pyrender_incl_readback_ms": reference["wall_ms"],
+        "pyvista_incl_readback_ms": vtk["wall_ms"],
         **ratios,
         "pyrender_ssim": reference["ssim"],
+        "pyvista_ssim": vtk["ssim"],
         "nodes": len(mesh.used_nodes()), "crease_vertices_added": split.added,
         "bytes_per_step": contour["bytes_per_step"],
         "bytes_at_prepare": contour["bytes_uploaded"],
@@ -202,9 +256,11 @@ def target_row(exp: ExperimentContext, label: str, mesh, size, rows: list[dict],
 
 
 def save_figures(exp: ExperimentContext, label: str, images: dict, ref_image: np.ndarray,
-                 ssim: float, value_range, field: str, units: str) -> None:
+                 ssim: float, vtk_image: np.ndarray, vtk_ssim: float, value_range, field: str,
+                 units: str) -> None:
     """The scene's per-pixel bands with the wire frame, per-vertex against per-pixel colour,
-    and ours beside pyrender (``ref_image``, ``ssim`` against ours)."""
+    ours beside pyrender (``ref_image``, ``ssim`` against ours) and ours beside pyvista/VTK
+    (``vtk_image``, ``vtk_ssim``)."""
     stem = label.split()[0]
     save_field_figure(exp.file(f"{stem}_bands_wire.png"), images["pixel bands + wire"],
                       value_range=value_range, colormap=Style().colormap, label=field, units=units,
@@ -215,10 +271,13 @@ def save_figures(exp: ExperimentContext, label: str, images: dict, ref_image: np
                     ["colour per vertex", "colour per pixel (reference)", "|difference| x8"])
     save_image_grid(exp.file(f"{stem}_pyrender.png"), [images["gouraud, 4x MSAA"], ref_image],
                     ["workbench gouraud, 4x MSAA", f"pyrender (SSIM {ssim:.3f})"])
+    save_image_grid(exp.file(f"{stem}_pyvista.png"), [images["gouraud, 4x MSAA"][..., :3],
+                                                      vtk_image],
+                    ["workbench gouraud, 4x MSAA", f"pyvista/VTK (SSIM {vtk_ssim:.3f})"])
 
 
 @experiment("render_paths", "first render paths on the car and the es2008 semicylinders: time "
-                            "against error, pyrender and a bare draw beside them")
+                            "against error, pyrender, pyvista/VTK and a bare draw beside them")
 def run(exp: ExperimentContext) -> list[dict]:
     rows: list[dict] = []
     targets: list[dict] = []
@@ -234,13 +293,21 @@ def run(exp: ExperimentContext) -> list[dict]:
         reference, ref_image, split, ref = pyrender_row(exp, label, mesh, step, camera, size,
                                                         images["gouraud, 4x MSAA"])
         try:
-            ratios = interleaved_targets(exp, mesh, {c[0]: c for c in configs}, camera, size,
-                                         ref)
+            ours = next(r for r in scene_rows if r["case"] == "gouraud, 4x MSAA")
+            vtk_row, vtk_image, vtk = pyvista_row(exp, label, mesh, step, camera, size, split,
+                                                  images["gouraud, 4x MSAA"], ours)
+            try:
+                ratios = interleaved_targets(exp, mesh, {c[0]: c for c in configs}, camera,
+                                             size, ref, vtk)
+            finally:
+                vtk.release()
         finally:
             ref.release()
-        rows += scene_rows + [reference]
-        targets.append(target_row(exp, label, mesh, size, scene_rows, reference, split, ratios))
-        save_figures(exp, label, images, ref_image, reference["ssim"], value_range, field, units)
+        rows += scene_rows + [reference, vtk_row]
+        targets.append(target_row(exp, label, mesh, size, scene_rows, reference, vtk_row, split,
+                                  ratios))
+        save_figures(exp, label, images, ref_image, reference["ssim"], vtk_image,
+                     vtk_row["ssim"], value_range, field, units)
     exp.table(targets, "targets", "Targets: contour path against pyrender and a bare draw")
     return rows
 
