@@ -166,7 +166,18 @@ def save_field_figure(path: str | os.PathLike[str], image: ArrayLike, *,
                       value_range: tuple[float, float], colormap: str | Colormap | ArrayLike,
                       label: str, units: str, title: str | None = None, bands: int = 0,
                       log: bool = False) -> Path:
-    """A rendered field image with a colour bar ``label [units]``; returns the path.
+    """A rendered field image with a colour bar ``label [units]`` (:func:`field_figure`)
+    written as a PNG; returns the path."""
+    return _write_figure(field_figure(image, value_range=value_range, colormap=colormap,
+                                      label=label, units=units, title=title, bands=bands,
+                                      log=log), path)
+
+
+def field_figure(image: ArrayLike, *, value_range: tuple[float, float],
+                 colormap: str | Colormap | ArrayLike, label: str, units: str,
+                 title: str | None = None, bands: int = 0, log: bool = False):
+    """The matplotlib ``Figure`` (on an Agg canvas, 100 dpi) of a rendered field image with a
+    colour bar ``label [units]``, as :func:`save_field_figure` writes it.
 
     ``value_range`` = (low, high) is the field range the render mapped onto ``colormap`` (a
     matplotlib name, a ``Colormap`` or the (N, 3|4) colour table the render path used);
@@ -193,7 +204,7 @@ def save_field_figure(path: str | os.PathLike[str], image: ArrayLike, *,
     if title:
         fig.text(0.5, 1.0 - (TITLE_HEIGHT / 2) / (MARGIN + h + top), title, ha="center",
                  va="center")
-    return _write_figure(fig, path)
+    return fig
 
 
 def save_image_grid(path: str | os.PathLike[str], images: Sequence[ArrayLike],

@@ -186,7 +186,9 @@ def crash(size: int | None, quick: bool) -> FEMesh:
 
     car = _shared_mesh("crash", CAR_DECK)
     rigid = [part for part, title in car.part_names.items() if "rigid" in title.lower()]
-    return crash_sequence(car, steps=size or 8, still_parts=rigid)
+    crash = crash_sequence(car, steps=size or 8, still_parts=rigid)
+    crash.name = "crash"
+    return crash
 
 
 @builtin("semicylinders", "the es2008 benchmark, N×N quads per sheet (default 250: 1 M "
