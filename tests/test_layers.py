@@ -2,10 +2,14 @@
 circle, and no private name is imported across packages.
 
 Layers, bottom to top: ``gl`` (with the shaders, ``glsl``), ``scene`` (with ``data``) →
-``algo`` → ``paths`` → ``experiment`` → ``sweep`` → ``reliability`` → ``cli``, and the
-experiment scripts (``reproductions``) on top. A module may import its own layer and the layers
-below. Imports inside functions count: a lazy import that points up, or closes a circle, is the
-same coupling. The checks are tested on a small package with the faults they exist to catch.
+``algo`` → ``paths`` → ``experiment`` → ``sweep`` → ``reliability`` → ``cli`` (beside it the
+live Jupyter view, ``viewer``), and the experiment scripts (``reproductions``) on top. A module
+may import its own layer and the layers below. Imports inside functions count: a lazy import
+that points up, or closes a circle, is the same coupling. The one exception is named in
+``ROOT_FACADE``: the package root (layer 0, since ``sweep`` reads its ``__version__``) hands
+out ``workbench.view`` from the viewer through a module ``__getattr__``; that edge still counts
+for the circle check. The checks are tested on a small package with the faults they exist to
+catch.
 """
 
 import ast
@@ -16,7 +20,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 LAYERS = {"gl": 0, "scene": 0, "data": 0, "algo": 1, "paths": 2, "experiment": 3, "sweep": 4,
-          "reliability": 5, "cli": 6, "reproductions": 7, "glsl": 0, "__init__": 0}
+          "reliability": 5, "cli": 6, "viewer": 6, "reproductions": 7, "glsl": 0, "__init__": 0}
+# upward imports allowed by name: the package root's lazy ``workbench.view``
+ROOT_FACADE = {("workbench", "workbench.viewer")}
 PACKAGE_DIRS = {"workbench": ROOT / "workbench"}
 
 
@@ -121,7 +127,9 @@ def graph():
 
 
 def test_every_layer_imports_only_downward(graph):
-    assert upward_imports(graph, LAYERS) == []
+    checked = {module: {t for t in targets if (module, t) not in ROOT_FACADE}
+               for module, targets in graph.items()}
+    assert upward_imports(checked, LAYERS) == []
 
 
 def test_no_import_cycles(graph):
