@@ -59,6 +59,42 @@ def _load():
     return pyrender, EGL, GL
 
 
+def checked_triangles(vertices: ArrayLike, triangles: ArrayLike,
+                      normals: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(vertices float64, triangles, normals float64) a reference renderer draws, refused
+    (ValueError) where malformed: vertices not a non-empty finite (V, 3) array, triangles not a
+    (K, 3) integer array of indices into them, normals not finite and shaped like the vertices,
+    or of zero length."""
+    vertices = np.asarray(vertices, np.float64)
+    triangles = np.asarray(triangles)
+    normals = np.asarray(normals, np.float64)
+    if vertices.ndim != 2 or vertices.shape[1] != 3 or not len(vertices):
+        raise ValueError(f"vertices must be a non-empty (V, 3) array, got {vertices.shape}")
+    if not np.isfinite(vertices).all():
+        raise ValueError("vertices must be finite")
+    if (triangles.ndim != 2 or triangles.shape[1] != 3
+            or not np.issubdtype(triangles.dtype, np.integer)):
+        raise ValueError(f"triangles must be a (K, 3) integer array, got {triangles.dtype} "
+                         f"{triangles.shape}")
+    if len(triangles) and (triangles.min() < 0 or triangles.max() >= len(vertices)):
+        raise ValueError(f"triangle indices must lie in [0, {len(vertices)})")
+    if normals.shape != vertices.shape or not np.isfinite(normals).all():
+        raise ValueError(f"normals must be finite and shaped like vertices {vertices.shape}, "
+                         f"got {normals.shape}")
+    zero = int(np.sum(np.linalg.norm(normals, axis=1) == 0.0))
+    if zero:
+        raise ValueError(f"{zero} vertex normals have zero length")
+    return vertices, triangles, normals
+
+
+def checked_size(size: tuple[int, int]) -> tuple[int, int]:
+    """(width, height) as integers; ValueError where either is not positive."""
+    width, height = (int(s) for s in size)
+    if width <= 0 or height <= 0:
+        raise ValueError(f"size must be positive, got {size}")
+    return width, height
+
+
 def rgba_colours(colors, count: int) -> np.ndarray:
     """(count, 4) float RGBA in [0, 1] from None, one colour or per-vertex colours."""
     c = np.asarray((0.8, 0.8, 0.8) if colors is None else colors)
@@ -98,28 +134,8 @@ class PyrenderReference:
                  background: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0)) -> None:
         if colors is not None and base_color is not None:
             raise ValueError("give per-vertex colors or one base_color, not both")
-        vertices = np.asarray(vertices, np.float64)
-        triangles = np.asarray(triangles)
-        normals = np.asarray(normals, np.float64)
-        if vertices.ndim != 2 or vertices.shape[1] != 3 or not len(vertices):
-            raise ValueError(f"vertices must be a non-empty (V, 3) array, got {vertices.shape}")
-        if not np.isfinite(vertices).all():
-            raise ValueError("vertices must be finite")
-        if (triangles.ndim != 2 or triangles.shape[1] != 3
-                or not np.issubdtype(triangles.dtype, np.integer)):
-            raise ValueError(f"triangles must be a (K, 3) integer array, got {triangles.dtype} "
-                             f"{triangles.shape}")
-        if len(triangles) and (triangles.min() < 0 or triangles.max() >= len(vertices)):
-            raise ValueError(f"triangle indices must lie in [0, {len(vertices)})")
-        if normals.shape != vertices.shape or not np.isfinite(normals).all():
-            raise ValueError(f"normals must be finite and shaped like vertices {vertices.shape}, "
-                             f"got {normals.shape}")
-        length = np.linalg.norm(normals, axis=1)
-        if np.any(length == 0.0):
-            raise ValueError(f"{int(np.sum(length == 0.0))} vertex normals have zero length")
-        width, height = (int(s) for s in size)
-        if width <= 0 or height <= 0:
-            raise ValueError(f"size must be positive, got {size}")
+        vertices, triangles, normals = checked_triangles(vertices, triangles, normals)
+        width, height = checked_size(size)
         bg = np.asarray(background, np.float64)
         if bg.shape != (4,) or not np.all((bg >= 0) & (bg <= 1)):
             raise ValueError(f"background must be 4 floats in [0, 1], got {background!r}")
@@ -131,7 +147,7 @@ class PyrenderReference:
         # two-sided headlight: turn every normal towards the light (the viewer)
         towards_viewer = np.asarray(camera.eye, np.float64) - np.asarray(camera.target, np.float64)
         towards_viewer /= np.linalg.norm(towards_viewer)
-        normals = normals / length[:, None]
+        normals = normals / np.linalg.norm(normals, axis=1)[:, None]
         normals[normals @ towards_viewer < 0.0] *= -1.0
         rgba = rgba_colours(base_color if colors is None else colors, len(vertices))
         linear = np.c_[rgba[:, :3] ** GAMMA, rgba[:, 3]]

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..gl.context import egl, is_software_renderer, keeping_current, raw_gl
-from .reference import AMBIENT, DIFFUSE, rgba_colours
+from .reference import AMBIENT, DIFFUSE, checked_size, checked_triangles, rgba_colours
 from .timing import Timing, check_counts
 
 if TYPE_CHECKING:
@@ -201,28 +201,8 @@ class PyvistaReference:
                  camera: Camera, size: tuple[int, int], *, base_color: ArrayLike | None = None,
                  background: tuple[float, float, float] = (1.0, 1.0, 1.0), samples: int = 4,
                  device: int | None = None) -> None:
-        vertices = np.asarray(vertices, np.float64)
-        triangles = np.asarray(triangles)
-        normals = np.asarray(normals, np.float64)
-        if vertices.ndim != 2 or vertices.shape[1] != 3 or not len(vertices):
-            raise ValueError(f"vertices must be a non-empty (V, 3) array, got {vertices.shape}")
-        if not np.isfinite(vertices).all():
-            raise ValueError("vertices must be finite")
-        if (triangles.ndim != 2 or triangles.shape[1] != 3
-                or not np.issubdtype(triangles.dtype, np.integer)):
-            raise ValueError(f"triangles must be a (K, 3) integer array, got {triangles.dtype} "
-                             f"{triangles.shape}")
-        if len(triangles) and (triangles.min() < 0 or triangles.max() >= len(vertices)):
-            raise ValueError(f"triangle indices must lie in [0, {len(vertices)})")
-        if normals.shape != vertices.shape or not np.isfinite(normals).all():
-            raise ValueError(f"normals must be finite and shaped like vertices {vertices.shape}, "
-                             f"got {normals.shape}")
-        zero = int(np.sum(np.linalg.norm(normals, axis=1) == 0.0))
-        if zero:
-            raise ValueError(f"{zero} vertex normals have zero length")
-        width, height = (int(s) for s in size)
-        if width <= 0 or height <= 0:
-            raise ValueError(f"size must be positive, got {size}")
+        vertices, triangles, normals = checked_triangles(vertices, triangles, normals)
+        width, height = checked_size(size)
         bg = np.asarray(background, np.float64)
         if bg.shape != (3,) or not np.all((bg >= 0) & (bg <= 1)):
             raise ValueError(f"background must be 3 floats in [0, 1], got {background!r}")
