@@ -33,6 +33,8 @@ from ..gl.context import is_software_renderer, keeping_current, raw_gl
 from .timing import Timing, check_counts
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     import pyrender
     from numpy.typing import ArrayLike
 
@@ -93,6 +95,45 @@ def checked_size(size: tuple[int, int]) -> tuple[int, int]:
     if width <= 0 or height <= 0:
         raise ValueError(f"size must be positive, got {size}")
     return width, height
+
+
+def time_frames(GL, renderer_name: str, frame: Callable[[], object],
+                read: Callable[[], object], warmup: int, repeat: int) -> Timing:
+    """The :class:`Timing` of a reference renderer's ``frame`` (its render with read-back, in
+    the GL context current now, ``GL`` PyOpenGL's module): wall ms of ``repeat`` frames after
+    ``warmup``, GPU ms from a GL_TIME_ELAPSED query around each (none on a software renderer
+    ``renderer_name`` or where timer queries fail), and wall ms of ``read`` (the read-back
+    alone) ``repeat`` times."""
+    query = None
+    if not is_software_renderer(renderer_name):
+        try:
+            query = int(GL.glGenQueries(1)[0])
+        except Exception:  # no timer queries on this driver
+            query = None
+    wall, gpu, readback = [], [], []
+    try:
+        for i in range(warmup + repeat):
+            if query is not None:
+                GL.glBeginQuery(GL.GL_TIME_ELAPSED, query)
+            start = time.perf_counter()
+            frame()
+            elapsed = (time.perf_counter() - start) * 1e3
+            if query is not None:
+                GL.glEndQuery(GL.GL_TIME_ELAPSED)
+                ns = ctypes.c_uint64()
+                GL.glGetQueryObjectui64v(query, GL.GL_QUERY_RESULT, ctypes.byref(ns))
+            if i >= warmup:
+                wall.append(elapsed)
+                if query is not None:
+                    gpu.append(ns.value / 1e6)
+        for _ in range(repeat):
+            start = time.perf_counter()
+            read()
+            readback.append((time.perf_counter() - start) * 1e3)
+    finally:
+        if query is not None:
+            GL.glDeleteQueries(1, [query])
+    return Timing.from_samples(wall, gpu if query is not None else None, readback)
 
 
 def rgba_colours(colors, count: int) -> np.ndarray:
@@ -208,38 +249,14 @@ class PyrenderReference:
         Refuses ``repeat`` < 5 and a negative ``warmup``."""
         check_counts(warmup, repeat)
         self._check_alive()
-        GL = self._GL
-        wall, gpu, readback = [], [], []
+        renderer = self._offscreen._renderer
         with keeping_current(self._restore_display):
             self._platform.make_current()
-            query = None
-            if not is_software_renderer(self.renderer_name):
-                try:
-                    query = int(GL.glGenQueries(1)[0])
-                except Exception:
-                    query = None
-            for i in range(warmup + repeat):
-                if query is not None:
-                    GL.glBeginQuery(GL.GL_TIME_ELAPSED, query)
-                start = time.perf_counter()
-                self._offscreen.render(self._scene, flags=self._flags)
-                elapsed = (time.perf_counter() - start) * 1e3
-                if query is not None:
-                    GL.glEndQuery(GL.GL_TIME_ELAPSED)
-                    ns = ctypes.c_uint64()
-                    GL.glGetQueryObjectui64v(query, GL.GL_QUERY_RESULT, ctypes.byref(ns))
-                if i >= warmup:
-                    wall.append(elapsed)
-                    if query is not None:
-                        gpu.append(ns.value / 1e6)
-            renderer = self._offscreen._renderer
-            for _ in range(repeat):
-                start = time.perf_counter()
-                renderer._read_main_framebuffer(self._scene, self._offscreen_flags)
-                readback.append((time.perf_counter() - start) * 1e3)
-            if query is not None:
-                GL.glDeleteQueries(1, [query])
-        return Timing.from_samples(wall, gpu if query is not None else None, readback)
+            return time_frames(
+                self._GL, self.renderer_name,
+                lambda: self._offscreen.render(self._scene, flags=self._flags),
+                lambda: renderer._read_main_framebuffer(self._scene, self._offscreen_flags),
+                warmup, repeat)
 
     def release(self) -> None:
         """Free pyrender's GL resources and its EGL context (not the shared display)."""

@@ -28,13 +28,19 @@ with our 4× MSAA Gouraud image); 0 turns it off.
 from __future__ import annotations
 
 import ctypes
-import time
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..gl.context import egl, is_software_renderer, keeping_current, raw_gl
-from .reference import AMBIENT, DIFFUSE, checked_size, checked_triangles, rgba_colours
+from ..gl.context import egl, keeping_current, raw_gl
+from .reference import (
+    AMBIENT,
+    DIFFUSE,
+    checked_size,
+    checked_triangles,
+    rgba_colours,
+    time_frames,
+)
 from .timing import Timing, check_counts
 
 if TYPE_CHECKING:
@@ -277,38 +283,14 @@ class PyvistaReference:
         read-back alone. Refuses ``repeat`` < 5 and a negative ``warmup``."""
         check_counts(warmup, repeat)
         self._check_alive()
-        GL = self._GL
-        wall, gpu, readback = [], [], []
+
+        def frame() -> None:
+            self._window.Render()
+            self._read()
+
         with keeping_current(self._context.display):
             self._context.make_current()
-            query = None
-            if not is_software_renderer(self.renderer_name):
-                try:
-                    query = int(GL.glGenQueries(1)[0])
-                except Exception:
-                    query = None
-            for i in range(warmup + repeat):
-                if query is not None:
-                    GL.glBeginQuery(GL.GL_TIME_ELAPSED, query)
-                start = time.perf_counter()
-                self._window.Render()
-                self._read()
-                elapsed = (time.perf_counter() - start) * 1e3
-                if query is not None:
-                    GL.glEndQuery(GL.GL_TIME_ELAPSED)
-                    ns = ctypes.c_uint64()
-                    GL.glGetQueryObjectui64v(query, GL.GL_QUERY_RESULT, ctypes.byref(ns))
-                if i >= warmup:
-                    wall.append(elapsed)
-                    if query is not None:
-                        gpu.append(ns.value / 1e6)
-            for _ in range(repeat):
-                start = time.perf_counter()
-                self._read()
-                readback.append((time.perf_counter() - start) * 1e3)
-            if query is not None:
-                GL.glDeleteQueries(1, [query])
-        return Timing.from_samples(wall, gpu if query is not None else None, readback)
+            return time_frames(self._GL, self.renderer_name, frame, self._read, warmup, repeat)
 
     def _free(self) -> None:
         """With VTK's context current: free VTK's GL objects, drop every VTK object (destroyed
