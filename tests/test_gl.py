@@ -247,6 +247,9 @@ def test_context_description_names_renderer_driver_and_device(ctx):
     assert info["gl_vendor"] == ctx.info["GL_VENDOR"]
     if "Mesa" in info["gl_version"]:
         assert info["driver"].startswith("Mesa ") and info["driver"] in info["gl_version"]
-    # Mesa's EGL exposes EGL_EXT_device_query: the device is named (a DRM file or its kind)
-    assert info["egl_device"] is None or len(info["egl_device"]) > 0
+    # Mesa's EGL exposes EGL_EXT_device_query: the device is named by its identity
+    from workbench.gl.devices import egl_devices
+
+    if "Mesa" in info["gl_version"]:
+        assert info["egl_device"] in {d.identity for d in egl_devices()}
     assert timer_queries_meaningful(ctx) is not is_software_renderer(info["renderer"])

@@ -121,11 +121,11 @@ def say_worker_devices(devices: dict[str, str | None]) -> None:
         print(f"worker {address}: EGL device {device or '(none)'}", file=sys.stderr)
 
 
-def select_device(args) -> None:
-    """Make ``args.device`` (if given) the EGL device of this process and the processes it
-    starts, by setting ``WORKBENCH_EGL_DEVICE``; ValueError (one line) for an index this
-    machine does not have. ``args.verbose`` (if set) shows Dask's INFO log lines of the
-    clusters the command starts (``WORKBENCH_VERBOSE``)."""
+def apply_process_options(args) -> None:
+    """For commands whose experiments make their own contexts and clusters: make
+    ``args.device`` (if given) the EGL device of this process and the processes it starts
+    (``WORKBENCH_EGL_DEVICE``), ValueError (one line) for an index this machine does not have;
+    and with ``args.verbose`` show Dask's INFO log lines of the clusters it starts."""
     import os
 
     from ..gl.devices import DEVICE_ENV, device_index
@@ -133,7 +133,6 @@ def select_device(args) -> None:
     if getattr(args, "device", None) is not None:
         os.environ[DEVICE_ENV] = str(device_index(args.device))
     if getattr(args, "verbose", False):
+        from ..experiment.cluster import VERBOSE_ENV
+
         os.environ[VERBOSE_ENV] = "1"
-
-
-VERBOSE_ENV = "WORKBENCH_VERBOSE"

@@ -7,7 +7,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from .arguments import add_device_argument, select_device
+from .arguments import add_device_argument, apply_process_options
 from .results import add_results_option, store_of
 
 
@@ -63,7 +63,7 @@ def cmd_run(args) -> int:
 
     discover()
     get_experiment(args.experiment)  # an unknown name is refused before anything is recorded
-    select_device(args)
+    apply_process_options(args)
     recorder = start_recording(args, f"run {args.experiment}" + " --quick" * args.quick)
     rows, out_dir = run_experiment(args.experiment, figures_root=Path(args.figures),
                                    quick=args.quick,
@@ -81,7 +81,7 @@ def cmd_reproduce(args) -> int:
     from ..experiment.registry import discover, run_experiment
 
     names = sorted(discover())
-    select_device(args)
+    apply_process_options(args)
     recorder = start_recording(args, "reproduce" + " --quick" * args.quick)
     bar = tqdm(names, desc="reproduce", unit="experiment")
     for name in bar:

@@ -35,9 +35,8 @@ def add_parser(subparsers) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
         description="Render a mesh file (LS-DYNA .k, d3plot, meshio or trimesh formats), a "
                     "built-in scene (car, crash[:S], d3plot, semicylinders[:N], panels[:Q]) or a "
-                    "spacetime "
-                    "scene (spacetime:radial[:N], spacetime:bar) offscreen, through the one "
-                    "measurement function (untimed); or a chunked scene's folder (written by "
+                    "spacetime scene (spacetime:radial[:N], spacetime:bar) offscreen, through the "
+                    "one measurement function (untimed); or a chunked scene's folder (written by "
                     "--write-chunked) on Dask workers.",
         epilog="render paths:\n  FE meshes:        " + ", ".join(mesh_paths) +
                "\n  spacetime scenes: " + ", ".join(spacetime_paths) +

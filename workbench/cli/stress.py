@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import sys
 
-from .arguments import add_device_argument, at_least, select_device
+from .arguments import add_device_argument, apply_process_options, at_least
 
 
 def _print_report(title: str, report, unit: str) -> bool:
@@ -25,7 +25,7 @@ def cmd_stress(args) -> int:
     any check failed."""
     from ..reliability import run_d3plot_stress, run_reader_stress, run_render_stress
 
-    select_device(args)  # the render suite's processes draw on it too
+    apply_process_options(args)  # the render suite's processes draw on it too
     ok = True
     if args.suite in ("readers", "all"):
         report = run_reader_stress(args.n, args.seed)

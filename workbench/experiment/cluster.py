@@ -37,6 +37,7 @@ if TYPE_CHECKING:
     from distributed import Worker
 
 PLUGIN_NAME = "workbench-gl"
+VERBOSE_ENV = "WORKBENCH_VERBOSE"  # "1": Dask's INFO log lines (the commands' --verbose)
 # a scheduler that answers at all answers within a second; one that does not is refused soon
 CONNECT_TIMEOUT_S = 5
 WORKER_WAIT_S = 60
@@ -276,7 +277,7 @@ def sweep_cluster(workers: int | None = None, scheduler: str | None = None, *,
         raise ValueError(f"workers must be a positive integer, got {workers}")
     cluster = client = None
     if verbose is None:
-        verbose = os.environ.get("WORKBENCH_VERBOSE") == "1"
+        verbose = os.environ.get(VERBOSE_ENV) == "1"
     level = logging.INFO if verbose else logging.WARNING
     logging.getLogger("distributed").setLevel(level)
     try:

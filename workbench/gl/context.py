@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import ctypes
 import os
 import re
 from collections.abc import Iterator
@@ -12,7 +11,7 @@ from types import ModuleType
 
 import moderngl
 
-from .devices import EGLDevice, device_index, egl_devices
+from .devices import EGLDevice, current_device, device_index, egl_devices
 
 EGL_PACKAGES = "libegl1 libegl-mesa0 libgl1-mesa-dri"
 
@@ -100,45 +99,19 @@ def timer_queries_meaningful(ctx: moderngl.Context) -> bool:
 def describe(ctx: moderngl.Context) -> dict[str, str | None]:
     """What identifies the renderer of ``ctx``: ``renderer``, ``gl_vendor``, ``gl_version``,
     ``driver`` (Mesa's version, e.g. "Mesa 22.3.6", else the text after the GL version
-    number) and ``egl_device`` (the EGL device's DRM device file, or its device extensions
-    where it has no file; None where EGL cannot say)."""
+    number) and ``egl_device`` (the identity of the current context's EGL device,
+    :attr:`~workbench.gl.devices.EGLDevice.identity`: index and UUID, render node or DRM file,
+    or "software"; None where EGL cannot say)."""
     version = gl_version(ctx)
     mesa = re.search(r"Mesa \S+", version)
     driver = mesa.group(0) if mesa else (version.split(" ", 1)[1] if " " in version else None)
     return {"renderer": renderer(ctx), "gl_vendor": str(ctx.info["GL_VENDOR"]),
-            "gl_version": version, "driver": driver, "egl_device": _egl_device()}
+            "gl_version": version, "driver": driver, "egl_device": _current_identity()}
 
 
-EGL_DEVICE_EXT, EGL_EXTENSIONS, EGL_DRM_DEVICE_FILE_EXT = 0x322C, 0x3055, 0x3233
-
-
-def _egl_device() -> str | None:
-    """The EGL device of the current display (EGL_EXT_device_query): its DRM device file where
-    it has one, else its device extensions (Mesa's software device reads
-    "EGL_MESA_device_software ..."); None where the query is not available. PyOpenGL does not
-    bind these entry points, so they are fetched with eglGetProcAddress."""
-    try:
-        lib = ctypes.CDLL("libEGL.so.1")
-        lib.eglGetProcAddress.restype = ctypes.c_void_p
-        lib.eglGetProcAddress.argtypes = [ctypes.c_char_p]
-        lib.eglGetCurrentDisplay.restype = ctypes.c_void_p
-        display_attrib = lib.eglGetProcAddress(b"eglQueryDisplayAttribEXT")
-        device_string = lib.eglGetProcAddress(b"eglQueryDeviceStringEXT")
-        display = lib.eglGetCurrentDisplay()
-        if not (display and display_attrib and device_string):
-            return None
-        query_attrib = ctypes.CFUNCTYPE(ctypes.c_uint, ctypes.c_void_p, ctypes.c_int,
-                                        ctypes.POINTER(ctypes.c_void_p))(display_attrib)
-        query_string = ctypes.CFUNCTYPE(ctypes.c_char_p, ctypes.c_void_p,
-                                        ctypes.c_int)(device_string)
-        device = ctypes.c_void_p()
-        if not query_attrib(display, EGL_DEVICE_EXT, ctypes.byref(device)) or not device:
-            return None
-        found = query_string(device, EGL_DRM_DEVICE_FILE_EXT) or query_string(device,
-                                                                              EGL_EXTENSIONS)
-        return found.decode() if found else None
-    except (OSError, AttributeError):  # no libEGL.so.1 or no such entry point
-        return None
+def _current_identity() -> str | None:
+    device = current_device()
+    return device.identity if device is not None else None
 
 
 def raw_gl() -> ModuleType:

@@ -68,7 +68,8 @@ def _progress(total: int, initial: int, name: str, enabled: bool):
 def run_sweep(config: SweepConfig | str | Path, out_dir, *, workers: int | None = None,
               scheduler: str | None = None, quick: bool = False, progress: bool = True,
               timed: bool | None = None, recorder: Recorder | None = None,
-              devices: Sequence[int] | None = None, verbose: bool = False) -> SweepResult:
+              devices: Sequence[int] | None = None,
+              verbose: bool | None = None) -> SweepResult:
     """Run ``config`` (a :class:`SweepConfig` or a config file) on a Dask cluster (a new
     LocalCluster of ``workers`` processes, default one per CPU, or the one at ``scheduler``),
     computing only points not cached in ``out_dir/points``; write ``table.csv``, ``table.md``
@@ -84,7 +85,8 @@ def run_sweep(config: SweepConfig | str | Path, out_dir, *, workers: int | None 
     folder is refused (ValueError) before any point is computed, as is a ``table.csv``,
     ``table.md`` or ``pareto.png`` there that exists and is not a regular file. ``devices``
     lists the EGL devices the workers are pinned to (default each host's round-robin);
-    ``verbose`` shows Dask's INFO log lines.
+    ``verbose`` shows Dask's INFO log lines (default: as :func:`sweep_cluster`
+    decides).
     """
     from ..experiment.cluster import sweep_cluster
 
