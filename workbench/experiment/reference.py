@@ -61,6 +61,27 @@ def _load():
     return pyrender, EGL, GL
 
 
+class ReleasedReference:
+    """A reference renderer holding GL resources of its own: ``with ref:`` releases them on the
+    way out, and so does garbage collection (errors then ignored); subclasses define
+    ``release``, harmless when done already."""
+
+    def release(self) -> None:
+        raise NotImplementedError
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.release()
+
+    def __del__(self) -> None:
+        try:
+            self.release()
+        except Exception:  # an interpreter shutting down may have torn down EGL already
+            pass
+
+
 def checked_triangles(vertices: ArrayLike, triangles: ArrayLike,
                       normals: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(vertices float64, triangles, normals float64) a reference renderer draws, refused
@@ -154,7 +175,7 @@ def rgba_colours(colors, count: int) -> np.ndarray:
     return c
 
 
-class PyrenderReference:
+class PyrenderReference(ReleasedReference):
     """The triangles ``(vertices, triangles, normals)`` drawn by pyrender through our ``camera``.
 
     ``vertices``: (V, 3) float64 model coordinates, uploaded relative to ``camera.origin``;
@@ -275,15 +296,3 @@ class PyrenderReference:
         renderer.delete = lambda: None
         platform._egl_context = platform._egl_display = None
         offscreen._renderer = offscreen._platform = None
-
-    def __enter__(self) -> PyrenderReference:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.release()
-
-    def __del__(self) -> None:
-        try:
-            self.release()
-        except Exception:
-            pass

@@ -36,6 +36,7 @@ from ..gl.context import egl, keeping_current, raw_gl
 from .reference import (
     AMBIENT,
     DIFFUSE,
+    ReleasedReference,
     checked_size,
     checked_triangles,
     rgba_colours,
@@ -182,7 +183,7 @@ def _pixel_array():
     return vtkUnsignedCharArray()
 
 
-class PyvistaReference:
+class PyvistaReference(ReleasedReference):
     """The triangles ``(vertices, triangles, normals)`` drawn by VTK (a pyvista mesh) through
     our ``camera``.
 
@@ -312,15 +313,3 @@ class PyvistaReference:
         with keeping_current(self._context.display):
             self._context.make_current()
             self._free()
-
-    def __enter__(self) -> PyvistaReference:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.release()
-
-    def __del__(self) -> None:
-        try:
-            self.release()
-        except Exception:
-            pass
