@@ -25,8 +25,11 @@ only ever gives a lower bound, and sampled tools do not say how far below H they
 
 Any face set gives a valid upper bound; a lower bound needs the nearest face of each point it
 measures, which the candidate sets hold by construction (see :func:`~.polygon._gather`).
-Distances are in model units; the bracket is exact up to float64 rounding of the distances
-themselves (relative 1e-16 of the coordinates after the translation).
+Distances are in model units. The bracket is certified: its ends are rounded outward by the
+bound of their own rounding (:func:`~.metric.bracket_rounding`, the error model of
+:mod:`workbench.algo.distance`: the backward-stable distance kernel's error, and how far the
+measured points, built by interpolation, may lie from A), so it holds the exact value, also 0
+for a surface against any refinement of itself, slivers included.
 
 The package: :mod:`.metric` the public :func:`hausdorff`, :class:`HausdorffResult` and the
 one-sided driver; :mod:`.refine` the sampled upper bounds and their refinement;

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..bvh import TriangleBVH, check_triangles
+from ..distance import construction_rounding, distance_rounding, outward
 from .refine import _locate_in, _refine, _refine_planes, _sample_upper, _tighten
 
 __all__ = ["HausdorffResult", "hausdorff"]
@@ -24,7 +25,7 @@ DEFAULT_REL_TOL = 1e-4  # of A's bounding-box diagonal
 DEFAULT_MAX_DEPTH = 16
 MAX_DEPTH_LIMIT = 30
 SPLITS = ("planes", "midpoint")
-# distances closer than this share of the coordinates are equal to rounding
+# a piece's bound within this share of the coordinates of its largest vertex distance is final
 _ROUNDING = 1e-13
 # degree-3 quadrature on a triangle: weights of each corner, each edge midpoint, the centroid
 _W_CORNER, _W_EDGE, _W_CENTROID = 1.0 / 20.0, 2.0 / 15.0, 9.0 / 20.0
@@ -34,15 +35,16 @@ _W_CORNER, _W_EDGE, _W_CENTROID = 1.0 / 20.0, 2.0 / 15.0, 9.0 / 20.0
 class HausdorffResult:
     """The Hausdorff distance from surface A to surface B as a certified bracket (model units).
 
-    ``lower <= H <= upper``; ``max`` is the best estimate, the lower bound (a distance actually
-    attained at ``location[0]``). ``mean`` and ``rms`` are area-weighted **sample estimates** of
-    the distance over A (a degree-3 rule on each triangle: corners, edge midpoints, centroid),
-    not bounds. ``location`` (2, 3): the point of A where ``lower`` is attained and the point of
-    B nearest to it, in the input coordinates. ``samples``: points whose exact distance was
-    queried through the tree (vertices, edge midpoints, centroids; the corners visited by the
-    subdivision are not counted). ``refined``: triangles of A bounded against every face near
-    them (the last refinement step). ``area``: A's area. ``tol_reached``:
-    ``upper - lower <= tol``.
+    ``lower <= H <= upper``, each rounded outward by the bound of its own rounding error;
+    ``max`` is the best estimate, the largest distance computed at a point of A
+    (``location[0]``), of which ``lower`` is the rounded-down value. ``mean`` and ``rms`` are
+    area-weighted **sample estimates** of the distance over A (a degree-3 rule on each
+    triangle: corners, edge midpoints, centroid), not bounds. ``location`` (2, 3): the point
+    of A where ``max`` is attained and the point of B nearest to it, in the input coordinates.
+    ``samples``: points whose exact distance was queried through the tree (vertices, edge
+    midpoints, centroids; the corners visited by the subdivision are not counted).
+    ``refined``: triangles of A bounded against every face near them (the last refinement
+    step). ``area``: A's area. ``tol_reached``: ``upper - lower <= tol``.
 
     For the symmetric distance (``one_sided=False``) the bracket is the larger of both
     directions', ``mean``/``rms`` are taken over both surfaces by area, ``location[0]`` lies on
@@ -123,7 +125,8 @@ def hausdorff(va, fa, vb, fb, *, one_sided: bool = True, tol: float | None = Non
     lower = max(forward.lower, backward.lower)
     upper = max(forward.upper, backward.upper)
     return HausdorffResult(
-        max=lower, lower=lower, upper=upper, mean=float(mean), rms=float(rms),
+        max=max(forward.max, backward.max), lower=lower, upper=upper, mean=float(mean),
+        rms=float(rms),
         location=top.location, samples=forward.samples + backward.samples,
         seconds=time.perf_counter() - start, tol=tol,
         tol_reached=forward.tol_reached and backward.tol_reached,
@@ -213,13 +216,13 @@ def _one_sided(a: _Surface, b: _Surface, tol: float, max_depth: int, split: str,
                 point_a, point_b = point, near[0]
             lower = max(found, new_lower)
 
-    # the computed distances carry float64 rounding of the size of the two surfaces: widen the
-    # bracket by it so that it holds the exact value (0 for a surface against itself); the
-    # diagonal of both together does not depend on the origin or on which surface is A
-    both = np.concatenate([v, b.bvh.corners.reshape(-1, 3)])
-    margin = _ROUNDING * float(np.linalg.norm(both.max(axis=0) - both.min(axis=0)))
-    lower = max(0.0, lower - margin)
-    global_upper = max(float(upper.max()), lower) + margin
+    # round the bracket outward by the bound of its own rounding (the error model of
+    # workbench.algo.distance): distances to B's faces, and the points they were measured at,
+    # built by up to `levels` interpolations (samples, cuts or midpoints, the translation)
+    estimate = lower
+    lower, global_upper = outward(lower, max(float(upper.max()), lower),
+                                  bracket_rounding(v, b.bvh.corners, max(lower, upper.max()),
+                                                   split, max_depth))
     area2 = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]),
                            axis=1)
     area = 0.5 * float(area2.sum())
@@ -227,10 +230,26 @@ def _one_sided(a: _Surface, b: _Surface, tol: float, max_depth: int, split: str,
     mean = float(_quadrature(dv[f], dm[tri_edge], dc, weights, 1))
     rms = float(np.sqrt(_quadrature(dv[f], dm[tri_edge], dc, weights, 2)))
     return HausdorffResult(
-        max=lower, lower=lower, upper=global_upper, mean=mean, rms=rms,
+        max=estimate, lower=lower, upper=global_upper, mean=mean, rms=rms,
         location=np.stack([point_a + origin, point_b + origin]),
         samples=len(v) + len(edges) + len(f), seconds=time.perf_counter() - start, tol=tol,
         tol_reached=global_upper - lower <= tol, refined=int(refined), area=area)
+
+
+def bracket_rounding(vertices, faces, distance, split, max_depth) -> float:
+    """The margin (model units) by which a computed bracket of distances up to ``distance``
+    from points built on A (``vertices`` (N, 3), translated) to the faces ``faces`` (F, 3, 3)
+    of B is widened: the rounding of a distance to a face of B's longest edge, plus how far the
+    measured points may lie from A (``3 · max_depth`` plane cuts or ``max_depth`` midpoint
+    levels after a sample's own construction, and the translation of A and of B). Coordinates
+    are bounded by the diagonal of the box around both (the origin lies in it), so the margin
+    does not depend on the origin or on which surface came first."""
+    edges = faces[:, [1, 2, 0]] - faces
+    longest = float(np.sqrt((edges ** 2).sum(axis=2).max())) if len(faces) else 0.0
+    both = np.concatenate([vertices, faces.reshape(-1, 3)])
+    magnitude = float(np.linalg.norm(both.max(axis=0) - both.min(axis=0)))
+    levels = (3 * max_depth if split == "planes" else max_depth) + 3
+    return distance_rounding(distance, longest) + construction_rounding(magnitude, levels)
 
 
 def _quadrature(d_corner, d_edge, d_centroid, weights, power):

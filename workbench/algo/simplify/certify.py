@@ -23,7 +23,12 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..distance import closest_point_on_triangle, triangle_bounds
+from ..distance import (
+    closest_point_on_triangle,
+    construction_rounding,
+    distance_rounding,
+    triangle_bounds,
+)
 
 # bounds of the automatic certification depth (see certification_depths)
 MIN_DEPTH = 5
@@ -50,6 +55,22 @@ def certification_depths(corners: np.ndarray, tol: np.ndarray, max_depth=None) -
     longest = np.sqrt((edges ** 2).sum(axis=2).max(axis=1))
     ratio = np.maximum(longest / tol, 1.0)
     return np.clip(np.ceil(np.log2(ratio)) + 1, MIN_DEPTH, MAX_AUTO_DEPTH).astype(np.int64)
+
+
+def certificate_rounding(vertices, triangles, tol, depths) -> np.ndarray:
+    """(len(tol),) the bound (model units) of the rounding error of a certificate
+    ``max_{p ∈ T} d(p, S(T)) <= tol`` for each tolerance ``tol`` (one per part), following the
+    error model of :mod:`workbench.algo.distance`: a corner distance up to tol to a face no
+    longer than the bounding-box diagonal of the used ``vertices`` (N, 3, near the origin), plus
+    how far a piece's corners may lie from T after ``depths.max()`` levels of midpoints and the
+    translation of the model (which moves T and the faces alike: twice). The certification
+    compares against ``tol`` less this, and the reported bounds are rounded up by it."""
+    used = vertices[np.unique(triangles)]
+    diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+    magnitude = float(np.sqrt((used ** 2).sum(axis=1)).max())
+    levels = int(np.max(depths, initial=0)) + 2
+    return np.array([distance_rounding(t, diagonal) + construction_rounding(magnitude, levels)
+                     for t in np.asarray(tol, np.float64)])
 
 
 @numba.njit(cache=True)

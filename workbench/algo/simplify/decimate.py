@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .certify import _final_bounds, certification_depths
+from .certify import _final_bounds, certificate_rounding, certification_depths
 from .collapse import _decimate
 from .constraints import _constraints
 from .inputs import (
@@ -153,8 +153,11 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     quadrics = _quadrics(V, F, n_origin, face_area)
 
     alive = np.ones(len(F), np.bool_)
-    orig_tol = tol_of_label[part_index]
-    orig_depth = certification_depths(orig, orig_tol, max_depth)
+    orig_depth = certification_depths(orig, tol_of_label[part_index], max_depth)
+    # certify against each tolerance less the bound of the certificate's own rounding, and
+    # report the bounds rounded up by it: a reported bound <= tol holds for the exact distance
+    margin = certificate_rounding(V, t_orig, tol_of_label, orig_depth)
+    orig_tol = (tol_of_label - margin)[part_index]
     cos_max = float(np.cos(np.radians(float(max_normal_deg))))
     sup, sup_n, collapses, rejected, n_passes = _decimate(
         Surface(V, F, fpart, alive, n_origin), Originals(orig, orig_tol, orig_face, orig_depth),
@@ -162,7 +165,7 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     kept_bounds = _final_bounds(V, F, orig, orig_tol, sup, sup_n, orig_depth)
 
     bounds = np.full(k_in, np.nan)
-    bounds[keep] = kept_bounds
+    bounds[keep] = np.nextafter(kept_bounds + margin[part_index], np.inf)
     out_faces = np.flatnonzero(alive)
     out = np.ascontiguousarray(F[out_faces], np.int32)
     n_used = len(np.unique(out))
