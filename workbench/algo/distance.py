@@ -82,39 +82,27 @@ def _segment_sq(p0, p1, p2, a0, a1, a2, e0, e1, e2):
 
 
 @numba.njit(cache=True)
-def closest_point_on_triangle(p, a, b, c, out):
-    """The point of triangle abc closest to p, written into ``out`` (3,); returns the squared
-    distance. p, a, b, c are float64 (3,) arrays.
-
-    Backward stable: the result is the exact answer for inputs moved by a few units in the last
-    place of ``|p − corner|`` and of the triangle's size, for every triangle (slivers, needles,
-    collinear and repeated corners), so the distance is within a few 1e-16 of
-    ``max_i |p − corner_i|`` of the exact one (the distance moves by at most as much as a corner
-    does). How: the frame is set on the longest edge e (from corner o), the third corner's
-    offset from it is orthogonalised against e twice (Gram–Schmidt, so the frame is orthogonal
-    to rounding however thin the triangle), and p's coordinates in that frame decide whether
-    its projection falls inside; an error in that decision only happens within rounding of an
-    edge, where the face and the edge give the same distance to rounding. Outside, the nearest
-    of the three edges (projections on segments are backward stable) gives the point. A triangle
-    whose height is at most 2⁻⁵³ of its longest edge is its three edges.
-    """
-    ab0, ab1, ab2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
-    bc0, bc1, bc2 = c[0] - b[0], c[1] - b[1], c[2] - b[2]
-    ca0, ca1, ca2 = a[0] - c[0], a[1] - c[1], a[2] - c[2]
+def _closest_sq(p0, p1, p2, a0, a1, a2, b0, b1, b2, c0, c1, c2):
+    """(squared distance, closest point x, y, z) from p to triangle abc, from scalars: the
+    kernel of :func:`closest_point_on_triangle` (scalar arguments: no array passing per
+    call)."""
+    ab0, ab1, ab2 = b0 - a0, b1 - a1, b2 - a2
+    bc0, bc1, bc2 = c0 - b0, c1 - b1, c2 - b2
+    ca0, ca1, ca2 = a0 - c0, a1 - c1, a2 - c2
     lab = _dot(ab0, ab1, ab2, ab0, ab1, ab2)
     lbc = _dot(bc0, bc1, bc2, bc0, bc1, bc2)
     lca = _dot(ca0, ca1, ca2, ca0, ca1, ca2)
     # o the start of the longest edge e, w from o to the third corner
     if lab >= lbc and lab >= lca:
-        o0, o1, o2, e0, e1, e2, w0, w1, w2, ee = a[0], a[1], a[2], ab0, ab1, ab2, -ca0, -ca1, \
+        o0, o1, o2, e0, e1, e2, w0, w1, w2, ee = a0, a1, a2, ab0, ab1, ab2, -ca0, -ca1, \
             -ca2, lab
     elif lbc >= lca:
-        o0, o1, o2, e0, e1, e2, w0, w1, w2, ee = b[0], b[1], b[2], bc0, bc1, bc2, -ab0, -ab1, \
+        o0, o1, o2, e0, e1, e2, w0, w1, w2, ee = b0, b1, b2, bc0, bc1, bc2, -ab0, -ab1, \
             -ab2, lbc
     else:
-        o0, o1, o2, e0, e1, e2, w0, w1, w2, ee = c[0], c[1], c[2], ca0, ca1, ca2, -bc0, -bc1, \
+        o0, o1, o2, e0, e1, e2, w0, w1, w2, ee = c0, c1, c2, ca0, ca1, ca2, -bc0, -bc1, \
             -bc2, lca
-    q0, q1, q2 = p[0] - o0, p[1] - o1, p[2] - o2
+    q0, q1, q2 = p0 - o0, p1 - o1, p2 - o2
     if ee > 0.0:
         # h: the third corner's offset orthogonal to e, twice orthogonalised
         s = _dot(w0, w1, w2, e0, e1, e2) / ee
@@ -134,22 +122,41 @@ def closest_point_on_triangle(p, a, b, c, out):
                 nn = _dot(n0, n1, n2, n0, n1, n2)
                 qn = _dot(q0, q1, q2, n0, n1, n2)
                 t = qn / nn
-                out[0], out[1], out[2] = p[0] - t * n0, p[1] - t * n1, p[2] - t * n2
-                return qn * t
+                return qn * t, p0 - t * n0, p1 - t * n1, p2 - t * n2
     else:  # three equal corners
-        out[0], out[1], out[2] = a[0], a[1], a[2]
-        return _dot(q0, q1, q2, q0, q1, q2)
+        return _dot(q0, q1, q2, q0, q1, q2), a0, a1, a2
     # outside the face (or a flat triangle): the nearest of the three edges
-    best, t = _segment_sq(p[0], p[1], p[2], a[0], a[1], a[2], ab0, ab1, ab2)
-    s0, s1, s2_, f0, f1, f2 = a[0], a[1], a[2], ab0, ab1, ab2
-    d, u = _segment_sq(p[0], p[1], p[2], b[0], b[1], b[2], bc0, bc1, bc2)
+    best, t = _segment_sq(p0, p1, p2, a0, a1, a2, ab0, ab1, ab2)
+    s0, s1, s2_, f0, f1, f2 = a0, a1, a2, ab0, ab1, ab2
+    d, u = _segment_sq(p0, p1, p2, b0, b1, b2, bc0, bc1, bc2)
     if d < best:
-        best, t, s0, s1, s2_, f0, f1, f2 = d, u, b[0], b[1], b[2], bc0, bc1, bc2
-    d, u = _segment_sq(p[0], p[1], p[2], c[0], c[1], c[2], ca0, ca1, ca2)
+        best, t, s0, s1, s2_, f0, f1, f2 = d, u, b0, b1, b2, bc0, bc1, bc2
+    d, u = _segment_sq(p0, p1, p2, c0, c1, c2, ca0, ca1, ca2)
     if d < best:
-        best, t, s0, s1, s2_, f0, f1, f2 = d, u, c[0], c[1], c[2], ca0, ca1, ca2
-    out[0], out[1], out[2] = s0 + t * f0, s1 + t * f1, s2_ + t * f2
-    return best
+        best, t, s0, s1, s2_, f0, f1, f2 = d, u, c0, c1, c2, ca0, ca1, ca2
+    return best, s0 + t * f0, s1 + t * f1, s2_ + t * f2
+
+
+@numba.njit(cache=True, inline="always")
+def closest_point_on_triangle(p, a, b, c, out):
+    """The point of triangle abc closest to p, written into ``out`` (3,); returns the squared
+    distance. p, a, b, c are float64 (3,) arrays.
+
+    Backward stable: the result is the exact answer for inputs moved by a few units in the last
+    place of ``|p − corner|`` and of the triangle's size, for every triangle (slivers, needles,
+    collinear and repeated corners), so the distance is within a few 1e-16 of
+    ``max_i |p − corner_i|`` of the exact one (the distance moves by at most as much as a corner
+    does). How: the frame is set on the longest edge e (from corner o), the third corner's
+    offset from it is orthogonalised against e twice (Gram–Schmidt, so the frame is orthogonal
+    to rounding however thin the triangle), and p's coordinates in that frame decide whether
+    its projection falls inside; an error in that decision only happens within rounding of an
+    edge, where the face and the edge give the same distance to rounding. Outside, the nearest
+    of the three edges (projections on segments are backward stable) gives the point. A triangle
+    whose height is at most 2⁻⁵³ of its longest edge is its three edges.
+    """
+    d, out[0], out[1], out[2] = _closest_sq(p[0], p[1], p[2], a[0], a[1], a[2], b[0], b[1],
+                                            b[2], c[0], c[1], c[2])
+    return d
 
 
 def distance_rounding(distance, diameter) -> float:

@@ -31,10 +31,15 @@ bound of their own rounding (:func:`~.metric.bracket_rounding`, the error model 
 measured points, built by interpolation, may lie from A), so it holds the exact value, also 0
 for a surface against any refinement of itself, slivers included.
 
+Bracket only (``estimates=False``): steps 2 and 3 run on the few triangles that a cascade of
+cheap bounds from A's vertex distances leaves above the lower bound + ``tol``
+(:mod:`.cascade`); the other triangles are never sampled, and there are no mean and RMS
+estimates.
+
 The package: :mod:`.metric` the public :func:`hausdorff`, :class:`HausdorffResult` and the
-one-sided driver; :mod:`.refine` the sampled upper bounds and their refinement;
-:mod:`.polygon` the bounds of a triangle cut into convex pieces; :mod:`.pieces` the geometry of
-those pieces and of the planes that cut them.
+one-sided driver; :mod:`.cascade` the cheap bounds of the bracket-only mode; :mod:`.refine` the
+sampled upper bounds and their refinement; :mod:`.polygon` the bounds of a triangle cut into
+convex pieces; :mod:`.pieces` the geometry of those pieces and of the planes that cut them.
 """
 
 from .metric import (

@@ -15,8 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..bvh import TriangleBVH, check_triangles
+from ..bvh import TriangleBVH, check_triangles, compacted, used_vertices
 from ..distance import construction_rounding, distance_rounding, outward
+from .cascade import cascade
 from .refine import _locate_in, _refine, _refine_planes, _sample_upper, _tighten
 
 __all__ = ["HausdorffResult", "hausdorff"]
@@ -42,7 +43,8 @@ class HausdorffResult:
     triangle: corners, edge midpoints, centroid), not bounds. ``location`` (2, 3): the point
     of A where ``max`` is attained and the point of B nearest to it, in the input coordinates.
     ``samples``: points whose exact distance was queried through the tree (vertices, edge
-    midpoints, centroids; the corners visited by the subdivision are not counted).
+    midpoints, centroids, and the cascade's points without ``estimates``; the corners visited
+    by the subdivision are not counted).
     ``refined``: triangles of A bounded against every face near them (the last refinement
     step). ``area``: A's area. ``tol_reached``: ``upper - lower <= tol``.
 
@@ -74,7 +76,8 @@ class HausdorffResult:
 
 
 def hausdorff(va, fa, vb, fb, *, one_sided: bool = True, tol: float | None = None,
-              max_depth: int = DEFAULT_MAX_DEPTH, split: str = "planes") -> HausdorffResult:
+              max_depth: int = DEFAULT_MAX_DEPTH, split: str = "planes",
+              estimates: bool = True) -> HausdorffResult:
     """Certified Hausdorff distance from mesh A (``va`` (N, 3) float, ``fa`` (K, 3) int) to
     mesh B (``vb``, ``fb``), or the symmetric distance (the larger of both directions) when
     ``one_sided`` is False.
@@ -82,12 +85,16 @@ def hausdorff(va, fa, vb, fb, *, one_sided: bool = True, tol: float | None = Non
     ``tol`` (model units, default 1e-4 of A's bounding-box diagonal) is the bracket width to
     reach. ``split`` picks the refinement ("planes" or "midpoint", see the module notes);
     ``max_depth`` limits it: levels of 4-way subdivision, or three plane cuts per level
-    (``tol_reached`` in the result says whether the width was reached). Unreferenced vertices
+    (``tol_reached`` in the result says whether the width was reached). ``estimates`` (default
+    True) also gives the sample estimates ``mean`` and ``rms``, which measure every vertex,
+    edge midpoint and centroid of A; with False only the bracket is computed, through a cascade
+    of cheap bounds that leaves most of A unmeasured (:mod:`.cascade`; much faster where A is
+    fine), and ``mean``/``rms`` are NaN. Unreferenced vertices
     are ignored, also when their coordinates are not finite; degenerate triangles are allowed
     (measured as their edges). Refused with ValueError naming the input: bad shapes, no
     triangles, non-integer or out-of-range indices, non-finite coordinates of used vertices;
     and a negative or non-finite ``tol``, a ``max_depth`` outside [0, 30], an unknown
-    ``split``; a ``one_sided`` that is not a bool with TypeError.
+    ``split``; a ``one_sided`` or ``estimates`` that is not a bool with TypeError.
     """
     start = time.perf_counter()
     va, fa = check_triangles(va, fa, "A (va, fa)")
@@ -100,7 +107,7 @@ def hausdorff(va, fa, vb, fb, *, one_sided: bool = True, tol: float | None = Non
     max_depth = int(max_depth)
     if split not in SPLITS:
         raise ValueError(f"split must be one of {SPLITS}, got {split!r}")
-    used_a = np.unique(fa)
+    used_a = used_vertices(fa, len(va))
     lo, hi = va[used_a].min(axis=0), va[used_a].max(axis=0)
     origin = 0.5 * (lo + hi)
     if tol is None:
@@ -111,10 +118,13 @@ def hausdorff(va, fa, vb, fb, *, one_sided: bool = True, tol: float | None = Non
 
     a = _Surface(va - origin, fa)
     b = _Surface(vb - origin, fb)
-    forward = _one_sided(a, b, tol, max_depth, split, origin, start)
+    if not isinstance(estimates, (bool, np.bool_)):
+        raise TypeError(f"estimates must be True or False, got {estimates!r}")
+    forward = _one_sided(a, b, tol, max_depth, split, origin, start, bool(estimates))
     if one_sided:
         return forward
-    backward = _one_sided(b, a, tol, max_depth, split, origin, time.perf_counter())
+    backward = _one_sided(b, a, tol, max_depth, split, origin, time.perf_counter(),
+                          bool(estimates))
     top = forward if forward.lower >= backward.lower else backward
     area = forward.area + backward.area
     if area > 0:
@@ -138,9 +148,8 @@ class _Surface:
     """A mesh near the origin with its used vertices compacted, and its tree built on demand."""
 
     def __init__(self, vertices: np.ndarray, triangles: np.ndarray):
-        used, inverse = np.unique(triangles, return_inverse=True)
+        used, self.triangles = compacted(triangles, len(vertices))
         self.vertices = np.ascontiguousarray(vertices[used])
-        self.triangles = inverse.reshape(triangles.shape).astype(np.int64)
         self._bvh = None
         self._neighbours = None
 
@@ -158,12 +167,63 @@ class _Surface:
 
 
 def _one_sided(a: _Surface, b: _Surface, tol: float, max_depth: int, split: str,
-               origin: np.ndarray, start: float) -> HausdorffResult:
+               origin: np.ndarray, start: float, estimates: bool) -> HausdorffResult:
     bvh = b.bvh
-    v, f = a.vertices, a.triangles
-    nv = len(v)
-    corners = np.ascontiguousarray(v[f])  # (K, 3, 3)
+    all_corners = np.ascontiguousarray(a.vertices[a.triangles])  # (K, 3, 3)
+    lower, point_a, point_b = -1.0, None, None
+    pruned_upper, queries = -1.0, 0
+    if estimates:
+        v, f = a.vertices, a.triangles
+    else:
+        # bracket only: bound every triangle cheaply, refine those that may hold the maximum
+        first = cascade(a.vertices, a.triangles, bvh, b.neighbours, tol)
+        lower, point_a, point_b, queries = first.lower, first.point_a, first.point_b, \
+            first.queries
+        keep = first.upper > lower + tol
+        if (~keep).any():
+            pruned_upper = float(first.upper[~keep].max())
+        used, f = compacted(a.triangles[keep], len(a.vertices))
+        v = np.ascontiguousarray(a.vertices[used])
+    corners = np.ascontiguousarray(v[f])
+    upper = np.full(len(f), -1.0)
+    refined = 0
+    if len(f):
+        (lower, point_a, point_b, samples, refined,
+         (dv, dm, dc, tri_edge)) = _bound_triangles(v, f, corners, b, upper, lower, point_a,
+                                                    point_b, tol, max_depth, split)
+        queries += samples
 
+    # round the bracket outward by the bound of its own rounding (the error model of
+    # workbench.algo.distance): distances to B's faces, and the points they were measured at,
+    # built by up to `levels` interpolations (samples, cuts or midpoints, the translation)
+    estimate = lower
+    top = max(float(upper.max(initial=-1.0)), pruned_upper, lower)
+    lower, global_upper = outward(lower, top, bracket_rounding(a.vertices, bvh.corners, top,
+                                                               split, max_depth))
+    area2 = np.linalg.norm(np.cross(all_corners[:, 1] - all_corners[:, 0],
+                                    all_corners[:, 2] - all_corners[:, 0]), axis=1)
+    area = 0.5 * float(area2.sum())
+    if estimates:
+        weights = area2 if area > 0 else np.ones(len(f))
+        mean = float(_quadrature(dv[f], dm[tri_edge], dc, weights, 1))
+        rms = float(np.sqrt(_quadrature(dv[f], dm[tri_edge], dc, weights, 2)))
+    else:
+        mean = rms = float("nan")
+    return HausdorffResult(
+        max=estimate, lower=lower, upper=global_upper, mean=mean, rms=rms,
+        location=np.stack([point_a + origin, point_b + origin]),
+        samples=queries, seconds=time.perf_counter() - start, tol=tol,
+        tol_reached=global_upper - lower <= tol, refined=int(refined), area=area)
+
+
+def _bound_triangles(v, f, corners, b, upper, lower, point_a, point_b, tol, max_depth, split):
+    """Exact samples of the triangles ``f`` of A (vertices ``v``, corners ``corners``), their
+    first upper bounds and the refinement (steps 2–4 of the method), starting from a lower
+    bound ``lower`` attained at ``point_a`` (-1 and None for none). Writes each triangle's upper
+    bound into ``upper``; returns (lower, point_a, point_b, samples queried, triangles refined,
+    (vertex, edge-midpoint and centroid distances, each triangle's edges))."""
+    bvh = b.bvh
+    nv = len(v)
     # unique edges and, per triangle, its edges (01, 12, 20)
     pairs = np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
     keys, tri_edge = np.unique(pairs[:, 0] * nv + pairs[:, 1], return_inverse=True)
@@ -177,9 +237,7 @@ def _one_sided(a: _Surface, b: _Surface, tol: float, max_depth: int, split: str,
     centroids = (corners[:, 0] + corners[:, 1] + corners[:, 2]) / 3.0
     dc, fc, pc = bvh.nearest(centroids, hint=fm[tri_edge[:, 0]])
 
-    samples = [(dv, v, pv), (dm, midpoints, pm), (dc, centroids, pc)]
-    lower, point_a, point_b = -1.0, None, None
-    for d, pts, near in samples:
+    for d, pts, near in ((dv, v, pv), (dm, midpoints, pm), (dc, centroids, pc)):
         i = int(np.argmax(d))
         if d[i] > lower:
             lower, point_a, point_b = float(d[i]), pts[i], near[i]
@@ -187,12 +245,12 @@ def _one_sided(a: _Surface, b: _Surface, tol: float, max_depth: int, split: str,
     # first upper bound per triangle from its samples' nearest faces
     candidates = np.concatenate([fv[f], fm[tri_edge], fc[:, None]], axis=1)
     candidates = np.sort(candidates, axis=1)
-    upper = np.empty(len(f))
     _sample_upper(corners, candidates, bvh.corners, upper)
 
     # refine the triangles that can hold a larger distance, largest first
+    refined = 0
     if split == "planes":
-        eps = _ROUNDING * max(np.abs(v).max(), np.abs(bvh.corners).max())
+        eps = _rounding_eps(v, bvh.corners)
         _tighten(corners, np.flatnonzero(upper > lower + tol), candidates, b.neighbours, upper,
                  lower + tol, 3 * max_depth, eps, bvh.arrays())
     order = np.argsort(-upper, kind="stable")
@@ -215,25 +273,14 @@ def _one_sided(a: _Surface, b: _Surface, tol: float, max_depth: int, split: str,
                 _, _, near = bvh.nearest(point[None])
                 point_a, point_b = point, near[0]
             lower = max(found, new_lower)
+    samples = len(v) + len(edges) + len(f)
+    return lower, point_a, point_b, samples, refined, (dv, dm, dc, tri_edge)
 
-    # round the bracket outward by the bound of its own rounding (the error model of
-    # workbench.algo.distance): distances to B's faces, and the points they were measured at,
-    # built by up to `levels` interpolations (samples, cuts or midpoints, the translation)
-    estimate = lower
-    lower, global_upper = outward(lower, max(float(upper.max()), lower),
-                                  bracket_rounding(v, b.bvh.corners, max(lower, upper.max()),
-                                                   split, max_depth))
-    area2 = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]),
-                           axis=1)
-    area = 0.5 * float(area2.sum())
-    weights = area2 if area > 0 else np.ones(len(f))
-    mean = float(_quadrature(dv[f], dm[tri_edge], dc, weights, 1))
-    rms = float(np.sqrt(_quadrature(dv[f], dm[tri_edge], dc, weights, 2)))
-    return HausdorffResult(
-        max=estimate, lower=lower, upper=global_upper, mean=mean, rms=rms,
-        location=np.stack([point_a + origin, point_b + origin]),
-        samples=len(v) + len(edges) + len(f), seconds=time.perf_counter() - start, tol=tol,
-        tol_reached=global_upper - lower <= tol, refined=int(refined), area=area)
+
+def _rounding_eps(vertices, faces) -> float:
+    """How close (model units) a piece's bound may come to its largest vertex distance to be
+    final in the plane cuts: ``_ROUNDING`` of the largest coordinate."""
+    return _ROUNDING * max(np.abs(vertices).max(), np.abs(faces).max())
 
 
 def bracket_rounding(vertices, faces, distance, split, max_depth) -> float:
@@ -246,8 +293,10 @@ def bracket_rounding(vertices, faces, distance, split, max_depth) -> float:
     does not depend on the origin or on which surface came first."""
     edges = faces[:, [1, 2, 0]] - faces
     longest = float(np.sqrt((edges ** 2).sum(axis=2).max())) if len(faces) else 0.0
-    both = np.concatenate([vertices, faces.reshape(-1, 3)])
-    magnitude = float(np.linalg.norm(both.max(axis=0) - both.min(axis=0)))
+    corners = faces.reshape(-1, 3)
+    lo = np.minimum(vertices.min(axis=0), corners.min(axis=0))
+    hi = np.maximum(vertices.max(axis=0), corners.max(axis=0))
+    magnitude = float(np.linalg.norm(hi - lo))
     levels = (3 * max_depth if split == "planes" else max_depth) + 3
     return distance_rounding(distance, longest) + construction_rounding(magnitude, levels)
 
