@@ -4,6 +4,7 @@ what its tables show in its quick form (slow)."""
 import pytest
 from device_column import own_columns
 
+from workbench.algo.distance import DISTANCE_ERROR, UNIT_ROUNDOFF
 from workbench.experiment.tables import read_table
 
 NAME = "table_bvh_distance"
@@ -49,7 +50,10 @@ def check_hierarchies(rows, models: int) -> None:
     checked = [r for r in ours if r.get("checked_nodes")]
     assert len(checked) == models
     for r in checked:
-        assert r["max_rel_error"] <= 1e-12 and r["same_nodes_within"] is True
+        # against exact rational arithmetic: within the kernel's documented error, 64 u of the
+        # distance plus the nearest triangle's size, both far below 10^4 mm on these models
+        assert r["max_abs_error_mm"] <= DISTANCE_ERROR * UNIT_ROUNDOFF * 1e4
+        assert r["same_nodes_within"] is True
     assert [r for r in ours if r.get("max_change_translated_1e6_mm") is not None][0][
         "max_change_translated_1e6_mm"] <= 1e-9
     assert sum(str(r["scene"]).startswith("paper") for r in rows) == 4

@@ -425,3 +425,71 @@ def test_refusals():
     for f in (part_distances, connectivity, brute_force_part_distances):
         with pytest.raises(ValueError, match="no elements"):
             f(empty, 1.0)
+
+
+# --------------------------------------------------------------------------- accuracy
+def sliver_sheets(rng, eps, offset):
+    """Four parts, moved by ``offset``: a fan of thin triangles (pairs of rim corners eps apart,
+    as degenerate quads), a sheet just below it, needles (a corner eps from another) and small
+    triangles with a corner on a needle's face (where the old region walk overstated the
+    distance by up to a quarter of the needle's size)."""
+    n = 12
+    angles = np.sort(rng.uniform(0, 2 * np.pi, n))
+    rim = np.stack([np.cos(angles), np.sin(angles), np.zeros(n)], axis=1)
+    rim[1::2] = rim[0::2] + eps * rng.normal(size=(n // 2, 3))  # pairs of close rim nodes
+    nodes = [np.vstack([[0.0, 0.0, 0.0], rim])]
+    elements = [[0, 1 + i, 1 + (i + 1) % n, 1 + (i + 1) % n] for i in range(n)]
+    parts = [1] * n
+    sheet = np.array([[-1.2, -1.2, -0.3], [1.2, -1.2, -0.3], [1.2, 1.2, -0.25],
+                      [-1.2, 1.2, -0.3]]) + eps * rng.normal(size=(4, 3))
+    nodes.append(sheet)
+    elements.append([n + 1, n + 2, n + 3, n + 4])
+    parts.append(2)
+    at = n + 5
+    for _ in range(4):
+        a, b = rng.normal(size=3) * 0.8, rng.normal(size=3) * 0.8
+        c = b + eps * rng.normal(size=3)
+        q = b + rng.uniform(0.05, 0.95) * (a - b) + rng.uniform(0, 1) * (c - b)
+        nodes += [np.array([a, b, c]), np.array([q, q + [0, 0, 0.5], q + [0.5, 0, 0.5]])]
+        elements += [[at, at + 1, at + 2, at + 2], [at + 3, at + 4, at + 5, at + 5]]
+        parts += [3, 4]
+        at += 6
+    return FEMesh(nodes=np.vstack(nodes) + offset, elements=np.array(elements, np.int64),
+                  parts=np.array(parts))
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2 ** 32 - 1), log_eps=st.floats(-14, -3),
+       log_offset=st.floats(0, 6), far=st.booleans())
+def test_distances_are_within_the_kernel_bound_of_exact_arithmetic(seed, log_eps, log_offset,
+                                                                   far):
+    """Every path's distances against exact rational arithmetic (no shared code), on slivers
+    and far from the origin: within the kernel's documented error, DISTANCE_ERROR · u times the
+    distance plus the nearest triangle's size (the mesh's diagonal bounds both here)."""
+    from workbench.algo.distance import DISTANCE_ERROR, UNIT_ROUNDOFF
+    from workbench.reliability.exact import nearest_distance
+
+    rng = np.random.default_rng(seed)
+    offset = rng.normal(size=3) * 10.0 ** log_offset if far else np.zeros(3)
+    mesh = sliver_sheets(rng, 10.0 ** log_eps, offset)
+    used = np.unique(mesh.elements)
+    local = mesh.nodes - local_origin(mesh.nodes, used)
+    tr = mesh.triangulation
+    tri_part = mesh.parts[tr.element_of]
+    ptr, own = node_parts(mesh)
+    exact = np.full(mesh.n_nodes, np.inf)
+    for i in used:
+        others = ~np.isin(tri_part, own[ptr[i]:ptr[i + 1]])
+        if others.any():
+            exact[i] = nearest_distance(local[i], local[tr.triangles[others]])
+    exact[exact > 2.0] = np.inf
+    diagonal = float(np.linalg.norm(np.ptp(local[used], axis=0)))
+    bound = DISTANCE_ERROR * UNIT_ROUNDOFF * 2 * diagonal
+    for r in (part_distances(mesh, 2.0), batched_part_distances(mesh, 2.0),
+              brute_force_part_distances(mesh, 2.0)):
+        distance = r[0] if isinstance(r, tuple) else r.distance
+        finite = np.isfinite(exact)
+        # within the cut-off to rounding on the same nodes
+        assert (np.isfinite(distance[finite]) | (exact[finite] > 2.0 - bound)).all()
+        both = finite & np.isfinite(distance)
+        assert np.abs(distance[both] - exact[both]).max(initial=0.0) <= bound
