@@ -163,7 +163,7 @@ def simplification_error(case: Case, model) -> dict:
     if model.params.d > 0:
         tol = min(tol, BRACKET_OF_D * model.params.d)
     h = hausdorff(orig.positions, orig.triangles, simp.positions, simp.triangles,
-                  one_sided=True, tol=tol)
+                  one_sided=True, tol=tol, estimates=False)
     return {"hausdorff_mm": h.upper, "hausdorff_lower_mm": h.lower,
             "hausdorff_pct_diag": 100.0 * h.upper / diag, "hausdorff_s": h.seconds,
             "within_d": bool(h.upper <= model.params.d)}

@@ -124,4 +124,5 @@ def _bound(c: np.ndarray, a: np.ndarray, b: np.ndarray, tol: float) -> float:
     local = c[nodes]
     ia = inverse[:a.size].reshape(a.shape)
     ib = inverse[a.size:].reshape(b.shape)
-    return float(hausdorff(local, ia, local, ib, one_sided=True, tol=tol).upper)
+    return float(hausdorff(local, ia, local, ib, one_sided=True, tol=tol,
+                           estimates=False).upper)
