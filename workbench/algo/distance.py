@@ -1,12 +1,16 @@
-"""Exact float64 point-to-triangle distances and certified bounds of a triangle's farthest point.
+"""Backward-stable float64 point-to-triangle distances, their error model, and bounds of a
+triangle's farthest point.
 
 The building blocks of the Hausdorff metric (:mod:`workbench.algo.hausdorff`) and of the
 Hausdorff-bounded decimator (:mod:`workbench.algo.simplify`), compiled with numba:
 
-* :func:`closest_point_on_triangle` -- the closest point of a triangle to a point, by the
-  Voronoi-region walk of Ericson (*Real-Time Collision Detection*, §5.1.5). A degenerate
-  triangle (repeated vertices, collinear vertices, zero area to rounding) is the union of its
-  three edges and is treated as such, so the result is never NaN.
+* :func:`closest_point_on_triangle` -- the closest point of a triangle to a point, in a frame
+  set on the triangle's longest edge and orthogonalised twice, so that slivers, needles and
+  collinear corners keep their accuracy (the Voronoi-region walk of Ericson, *Real-Time
+  Collision Detection* §5.1.5, loses it to cancellation: up to a third of the triangle's size
+  for a corner 1e-7…1e-11 of it from an edge or another corner). A triangle whose height is
+  at most 2⁻⁵³ of its longest edge is the union of its three edges, so the result is never
+  NaN.
 * :func:`triangle_bounds` -- lower and upper bounds of ``max_{p ∈ T} d(p, F)``, the farthest a
   point of triangle T gets from a set F of triangles. The distance to one triangle is a convex
   function of p, so on T it peaks at a corner: ``max_{p∈T} d(p, f) = max_i d(t_i, f)`` and
