@@ -16,6 +16,7 @@ from meshes import quad_grid
 from workbench.experiment.measure import measure
 from workbench.gl import Camera, Framebuffer
 from workbench.paths import PATHS, ColorScale, MeshPath, Style, colormap_lut, make_path, scale_for
+from workbench.paths.colormap import NO_RESULT_COLOR
 from workbench.paths.fields import provoking_vertices
 from workbench.scene.mesh import FEMesh
 
@@ -505,9 +506,9 @@ def test_time_dependent_node_field_goes_up_with_the_step(ctx):
     path.release()
 
 
-def test_missing_element_values_are_drawn_in_the_base_colour(ctx):
+def test_missing_element_values_are_drawn_in_the_no_result_colour(ctx):
     # 2 × 2 elements, element 3 without a value (a rigid shell's stress): its block is the
-    # uncoloured base colour, the others keep their colormap colours
+    # no-result colour (not the base colour), the others keep their colormap colours
     mesh = grid(2, 2)
     mesh.element_fields["cell"][3] = np.nan
     base = (0.5, 0.5, 0.5)
@@ -516,7 +517,7 @@ def test_missing_element_values_are_drawn_in_the_base_colour(ctx):
                              hide_range=hide)
         assert path.missing_values == 1
         missing = image[16:32, 32:48, :3].reshape(-1, 3)  # element 3: top right (rows go up in y)
-        assert np.abs(missing.astype(int) - 128).max() <= 1  # lit face-on: factor 1
+        assert (missing == np.rint(np.multiply(NO_RESULT_COLOR, 255))).all()  # lit face-on
         if hide is None:
             scale = scale_for(mesh, "cell")
             block = image[16:32, 16:32, :3].reshape(-1, 3)
@@ -525,15 +526,15 @@ def test_missing_element_values_are_drawn_in_the_base_colour(ctx):
             assert covered(image).sum() == 16 * 16
 
 
-def test_missing_node_value_greys_its_triangles(ctx):
+def test_missing_node_value_draws_its_triangles_in_the_no_result_colour(ctx):
     mesh = grid(2, 2)
     mesh.node_fields["x"] = mesh.node_fields["x"].copy()
     mesh.node_fields["x"][8] = np.nan  # the top right corner node
     image, path = render(ctx, "pixel_color", mesh, camera(), field="x", base_color=(0.5, 0.5, 0.5))
     assert path.missing_values == 1
-    grey = (np.abs(image[..., :3].astype(int) - 128) <= 1).all(axis=-1)
-    # the top right element's triangles touching node 8 are grey, the far corner element is not
-    assert grey[17:22, 42:47].all() and not grey[40:47, 17:30].any()
+    green = (image[..., :3] == np.rint(np.multiply(NO_RESULT_COLOR, 255))).all(axis=-1)
+    # the top right element's triangles touching node 8 are green, the far corner element is not
+    assert green[17:22, 42:47].all() and not green[40:47, 17:30].any()
 
 
 def test_unreferenced_nodes_are_not_uploaded(ctx):

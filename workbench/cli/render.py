@@ -234,7 +234,7 @@ def cmd_render(args) -> int:
     out = Path(args.output)
     field = args.field if args.field is not None else getattr(path.style, "field", None)
     write_image(out, result.image, path, field if is_mesh else None, args,
-                 f"{scene.name} ({path_name})")
+                f"{scene.name} ({path_name})", scene=scene if is_mesh else None)
     strips = f", {path.strips} strip{'s' * (path.strips != 1)}" if path.strips else ""
     print(f"{out}: {result.row['scene']}, {path.triangles} triangles, {path.vertices_sent} "
           f"vertices sent{strips}, path {path_name}"

@@ -79,7 +79,7 @@ def render_domains(args, mesh, path, camera, size) -> int:
     elif args.write_chunked is None:
         path.prepare(None, mesh, camera)
     write_image(out, color, path, args.field, args,
-                f"{mesh.name} ({path.name}, {args.domains} domains)")
+                f"{mesh.name} ({path.name}, {args.domains} domains)", scene=mesh)
     print(f"{out}: {mesh.name}, {len(mesh.triangles)} triangles in {args.domains} domains "
           f"by {args.split} on {stats.workers} workers; {args.composite} compositing "
           f"{stats.composite_s:.3f} s, {stats.bytes_moved / 1e6:.1f} MB moved between workers")
@@ -132,14 +132,17 @@ def render_chunked_scene(args) -> int:
 
 def _write_chunked_image(out: Path, color, manifest: dict, args, title: str) -> None:
     """The image of a chunked scene, with the colour bar of its field and scale (unless
-    ``--raw``)."""
+    ``--raw``), stating the triangles drawn in the no-result colour where there are any."""
     from ..experiment.figures import save_field_figure, save_png
+    from ..paths.colormap import no_result_label
 
     out.parent.mkdir(parents=True, exist_ok=True)
     scale = manifest.get("scale")
     if manifest.get("field") and scale is not None and not args.raw:
+        count = sum(int(d.get("no_result", 0)) for d in manifest["domains"])
         save_field_figure(out, color, value_range=tuple(scale["value_range"]),
                           colormap=scale["colormap"], label=manifest["field"], units=args.units,
-                          title=title, bands=scale["bands"])
+                          title=title, bands=scale["bands"],
+                          no_result=no_result_label(count, "triangle") if count else None)
     else:
         save_png(out, color)

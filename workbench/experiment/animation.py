@@ -32,6 +32,7 @@ import numpy as np
 
 from ..paths.backends import as_backend
 from ..paths.base import RenderPath
+from ..paths.colormap import missing_count, no_result_label
 from ..paths.mesh import MeshPath
 from ..paths.registry import make_path, path_class
 from .measure import WHITE, prepared
@@ -60,7 +61,9 @@ class Frame:
     None without a field), ``upload_ms`` (wall ms of the state's uploads, waited for:
     ``set_step``, or with a per-step scale the whole preparation), ``draw_ms`` (wall ms of the
     draw and the read-back, the clear before it excluded), ``bytes_uploaded`` (what those
-    uploads sent) and ``bytes_per_step`` (the prepared path's own count of one ``set_step``)."""
+    uploads sent), ``bytes_per_step`` (the prepared path's own count of one ``set_step``) and
+    ``no_result`` (the legend text of the field's values without one in that state, say ``no
+    result: 12 nodes``; None where every value is finite or without a field)."""
 
     step: int
     time: float | None
@@ -70,6 +73,7 @@ class Frame:
     draw_ms: float
     bytes_uploaded: int
     bytes_per_step: int
+    no_result: str | None = None
 
 
 def state_value_range(mesh: FEMesh, field: str, step: int) -> tuple[float, float]:
@@ -164,6 +168,14 @@ class FrameLoop:
         self.prepare_ms = 0.0
         self.prepare_bytes = 0
 
+    def no_result(self, step: int) -> str | None:
+        """The legend text of the field's non-finite values in state ``step``
+        (:func:`~workbench.paths.colormap.no_result_label`); None where there are none."""
+        if self.field is None:
+            return None
+        count, per = missing_count(self.mesh, self.field, step)
+        return no_result_label(count, per) if count else None
+
     def time_of(self, step: int) -> float | None:
         """The mesh's time of state ``step`` (None for a mesh without times)."""
         times = self.mesh.times
@@ -189,7 +201,7 @@ class FrameLoop:
                 upload_ms = (time.perf_counter() - start) * 1e3
                 image, draw_ms = self._draw(ready)
                 yield Frame(k, self.time_of(k), image, value_range, upload_ms, draw_ms, sent,
-                            ready.path.bytes_per_step)
+                            ready.path.bytes_per_step, self.no_result(k))
 
     def _per_step(self) -> Iterator[Frame]:
         """Prepared again for every state, with that state's value range."""
@@ -204,7 +216,7 @@ class FrameLoop:
                 self.prepare_bytes += sent
                 image, draw_ms = self._draw(ready)
                 yield Frame(k, self.time_of(k), image, value_range, ready.prepare_ms, draw_ms,
-                            sent, ready.path.bytes_per_step)
+                            sent, ready.path.bytes_per_step, self.no_result(k))
 
     def _draw(self, ready) -> tuple[np.ndarray, float]:
         """(image, ms): the target cleared to white and waited for outside the clock, then the

@@ -1,5 +1,6 @@
 """What is drawn around the frames of an animation: the state's time stamp above the image and,
-where a field is shown, the colour bar of the frame's scale beside it.
+where a field is shown, the colour bar of the frame's scale beside it (with the no-result
+colour and its count under it in a frame whose field has non-finite values).
 
 The layout is that of ``workbench render``'s field images (:func:`~workbench.experiment.
 figures.field_figure`: the image at its native resolution, or each pixel repeated k × k under
@@ -79,7 +80,7 @@ class Decoration:
         if self.field is not None and frame.value_range is not None:
             fig = field_figure(frame.image, value_range=frame.value_range,
                                colormap=self.colormap, label=self.field, units=self.units,
-                               title=title, bands=self.bands)
+                               title=title, bands=self.bands, no_result=frame.no_result)
         else:
             fig = _titled_figure(frame.image, title)
         fig.canvas.draw()

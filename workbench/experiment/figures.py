@@ -27,6 +27,7 @@ DPI = 100
 MARGIN = 10  # pixels around panels
 TITLE_HEIGHT = 28
 BAR_GAP, BAR_WIDTH, BAR_LABELS = 12, 18, 110  # colour bar: gap, bar, ticks + label (pixels)
+NO_RESULT_KEY = 30  # pixels of the bar's column the no-result swatch and its two lines take
 MIN_PANEL_HEIGHT = 160  # smaller images are enlarged by pixel repetition
 
 
@@ -165,25 +166,30 @@ def _enlarge(image: np.ndarray, scale: int) -> np.ndarray:
 def save_field_figure(path: str | os.PathLike[str], image: ArrayLike, *,
                       value_range: tuple[float, float], colormap: str | Colormap | ArrayLike,
                       label: str, units: str, title: str | None = None, bands: int = 0,
-                      log: bool = False) -> Path:
+                      log: bool = False, no_result: str | None = None) -> Path:
     """A rendered field image with a colour bar ``label [units]`` (:func:`field_figure`)
     written as a PNG; returns the path."""
     return _write_figure(field_figure(image, value_range=value_range, colormap=colormap,
                                       label=label, units=units, title=title, bands=bands,
-                                      log=log), path)
+                                      log=log, no_result=no_result), path)
 
 
 def field_figure(image: ArrayLike, *, value_range: tuple[float, float],
                  colormap: str | Colormap | ArrayLike, label: str, units: str,
-                 title: str | None = None, bands: int = 0, log: bool = False):
+                 title: str | None = None, bands: int = 0, log: bool = False,
+                 no_result: str | None = None):
     """The matplotlib ``Figure`` (on an Agg canvas, 100 dpi) of a rendered field image with a
     colour bar ``label [units]``, as :func:`save_field_figure` writes it.
 
     ``value_range`` = (low, high) is the field range the render mapped onto ``colormap`` (a
     matplotlib name, a ``Colormap`` or the (N, 3|4) colour table the render path used);
     ``bands`` > 0 shows a colour bar of that many equal bands (band contours), ticked at the
-    band edges; ``log`` a logarithmic scale. The image keeps its pixels (native resolution, or
-    each pixel repeated k × k when it is under 160 pixels high); axes are hidden. Refuses a
+    band edges; ``log`` a logarithmic scale. ``no_result`` (the drawn field had non-finite
+    values: :func:`~workbench.paths.colormap.no_result_label`, say ``no result: 12 nodes``)
+    adds under the bar a swatch of :data:`~workbench.paths.colormap.NO_RESULT_COLOR` with that
+    text (the bar shortened by :data:`NO_RESULT_KEY` pixels). The image keeps its pixels
+    (native resolution, or each pixel repeated k × k when it is under 160 pixels high); axes
+    are hidden. Refuses a
     non-uint8 image, an empty or non-finite range, a non-positive range with ``log`` and a
     negative band count.
     """
@@ -196,7 +202,11 @@ def field_figure(image: ArrayLike, *, value_range: tuple[float, float],
     top = TITLE_HEIGHT if title else MARGIN
     fig = _new_figure(MARGIN + w + BAR_GAP + BAR_WIDTH + BAR_LABELS, MARGIN + h + top)
     _show(_axes_px(fig, MARGIN, MARGIN, w, h), image)
-    bar = fig.colorbar(mappable, cax=_axes_px(fig, MARGIN + w + BAR_GAP, MARGIN, BAR_WIDTH, h))
+    key = NO_RESULT_KEY if no_result else 0
+    bar = fig.colorbar(mappable, cax=_axes_px(fig, MARGIN + w + BAR_GAP, MARGIN + key,
+                                              BAR_WIDTH, h - key))
+    if no_result:
+        _no_result_key(fig, MARGIN + w + BAR_GAP, MARGIN, no_result)
     if edges is not None and bands <= 12:
         bar.set_ticks(edges)
         bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
@@ -205,6 +215,22 @@ def field_figure(image: ArrayLike, *, value_range: tuple[float, float],
         fig.text(0.5, 1.0 - (TITLE_HEIGHT / 2) / (MARGIN + h + top), title, ha="center",
                  va="center")
     return fig
+
+
+def _no_result_key(fig, left: int, bottom: int, text: str) -> None:
+    """The no-result swatch (:data:`~workbench.paths.colormap.NO_RESULT_COLOR`, the bar's width,
+    12 pixels high) at pixel (``left``, ``bottom``) with ``text`` beside it, broken after its
+    colon onto two small lines."""
+    from matplotlib.patches import Rectangle
+
+    from ..paths.colormap import NO_RESULT_COLOR
+
+    fw, fh = fig.get_size_inches() * DPI
+    fig.add_artist(Rectangle((left / fw, (bottom + 2) / fh), BAR_WIDTH / fw, 12 / fh,
+                             facecolor=NO_RESULT_COLOR, edgecolor="black", linewidth=0.5,
+                             transform=fig.transFigure))
+    fig.text((left + BAR_WIDTH + 4) / fw, (bottom + 8) / fh, text.replace(": ", ":\n", 1),
+             fontsize=7, va="center", ha="left", linespacing=1.0)
 
 
 def save_image_grid(path: str | os.PathLike[str], images: Sequence[ArrayLike],

@@ -19,10 +19,12 @@ Conventions every path follows (a reference renderer can match them exactly):
   triangle. A zero normal gets the ambient 0.25 only.
 * **Colour scales**: see :mod:`workbench.paths.colormap` (1-D texture, smooth or bands,
   transfer-function α with an alpha test that discards fragments with α < ½). A field value
-  that is not finite (the stress of a rigid shell in a d3plot, a thickness nobody gave) is
-  drawn in ``Style.base_color``, never hidden and never given a colour of the scale; per node,
-  every fragment interpolated from such a vertex takes that colour. ``missing_values`` counts
-  them for the step drawn.
+  that is not finite (the stress of a rigid shell in a d3plot, a thickness nobody gave) has no
+  colour of the scale: every triangle that has such a value at a vertex (node fields) or as
+  its element's (element fields) is drawn whole in the no-result colour
+  (:data:`~workbench.paths.colormap.NO_RESULT_COLOR`, pure green), lit, never hidden — the
+  rule and its mechanism are in :mod:`workbench.paths.colormap`. ``missing_values`` counts the
+  node or element values without one at the step drawn.
 * **Clip planes**: up to four world-space float64 planes ``(a, b, c, d)``; points with
   ``a·x + b·y + c·z + d ≥ 0`` are kept. The plane is moved to the upload origin in float64
   (``d' = d + (a, b, c)·origin``) and applied with ``gl_ClipDistance``.

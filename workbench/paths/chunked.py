@@ -11,11 +11,16 @@ partition of its triangles (:func:`workbench.scene.domains.split_domains`) and w
 * ``domain-NNNNN/vertices.parquet`` — per vertex the float64 drawn coordinates ``x, y, z``
   (model units, deformation applied), and where the path uses them the float32 normals
   ``nx, ny, nz`` and the normalised field ``value`` (float64, computed on the whole scene, so a
-  domain is coloured and lit as in the whole scene);
+  domain is coloured and lit as in the whole scene; NaN where a node has no value, so a domain
+  draws the no-result rule of :mod:`~.colormap` as the whole scene does);
 * ``domain-NNNNN/triangles.parquet`` — per triangle its vertices ``a, b, c`` (int32, into the
   domain's vertices), its global index ``id`` (int64: the index one process drawing the whole
   scene gives it, which breaks depth ties when frames are composited) and, for element paths,
-  its normalised ``value``.
+  its normalised ``value`` (NaN: none).
+
+Each domain's manifest entry counts its triangles drawn in the no-result colour
+(``no_result``), which a legend states. Scenes written before NaN was kept hold the sentinel
+:data:`~.colormap.NO_VALUE` instead: values below −1e29 are read as NaN.
 
 Parquet (pyarrow) keeps the columns typed and compressed; :class:`ChunkedScene` reads the
 manifest and :meth:`ChunkedScene.load` one domain. :meth:`DomainChunk.render` draws a domain into
@@ -44,6 +49,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..algo.softraster import Frame, RasterOptions, Shading, render
+from .colormap import NO_VALUE
 
 if TYPE_CHECKING:
     from ..gl import Camera
@@ -210,19 +216,22 @@ def _write_domain(folder: Path, inputs, ids: np.ndarray, first_id: int = 0) -> d
     if inputs.normals is not None:
         n = inputs.normals[used]
         columns |= {"nx": n[:, 0], "ny": n[:, 1], "nz": n[:, 2]}
+    no_result = 0
     if inputs.values is not None:
         columns["value"] = inputs.values[used]
+        no_result = int((~np.isfinite(inputs.values[tris])).any(axis=1).sum())
     folder.mkdir(parents=True)
     pq.write_table(pa.table(columns), folder / "vertices.parquet")
     triangle_columns = {"a": local[:, 0], "b": local[:, 1], "c": local[:, 2],
                         "id": ids + np.int64(first_id)}
     if inputs.triangle_values is not None:
         triangle_columns["value"] = inputs.triangle_values[ids]
+        no_result = int((~np.isfinite(inputs.triangle_values[ids])).sum())
     pq.write_table(pa.table(triangle_columns), folder / "triangles.parquet")
     lo = xyz.min(axis=0) if len(xyz) else np.zeros(3)
     hi = xyz.max(axis=0) if len(xyz) else np.zeros(3)
     return {"triangles": int(len(ids)), "vertices": int(len(used)),
-            "bounds": [lo.tolist(), hi.tolist()]}
+            "bounds": [lo.tolist(), hi.tolist()], "no_result": no_result}
 
 
 # --------------------------------------------------------------------------- reading
@@ -302,6 +311,12 @@ class ChunkedScene:
     def triangles(self) -> int:
         return int(self.manifest["triangles"])
 
+    @property
+    def no_result(self) -> int:
+        """Triangles drawn in the no-result colour, over all domains (0 for a scene written
+        before the manifest counted them)."""
+        return sum(int(d.get("no_result", 0)) for d in self.manifest["domains"])
+
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) float64 corners of the whole scene (model units)."""
         lo, hi = self.manifest["bounds"]
@@ -342,12 +357,19 @@ class ChunkedScene:
         coordinates = np.column_stack([column(vertices, c, np.float64) for c in "xyz"])
         normals = (np.column_stack([column(vertices, c, np.float32) for c in ("nx", "ny", "nz")])
                    if "nx" in names else None)
-        values = column(vertices, "value", np.float64) if "value" in names else None
+        values = _no_sentinel(column(vertices, "value", np.float64)) if "value" in names \
+            else None
         tris = np.column_stack([column(triangles, c, np.int64) for c in "abc"])
-        triangle_values = (column(triangles, "value", np.float64)
+        triangle_values = (_no_sentinel(column(triangles, "value", np.float64))
                            if "value" in triangles.column_names else None)
         return DomainChunk(coordinates, normals, values, tris, column(triangles, "id", np.int64),
                            triangle_values, self.shading, self.clip_planes)
+
+
+def _no_sentinel(values: np.ndarray) -> np.ndarray:
+    """``values`` with the sentinel of older scenes (below −1e29: :data:`NO_VALUE`) as NaN."""
+    old = values < 0.1 * NO_VALUE
+    return np.where(old, np.nan, values) if old.any() else values
 
 
 def render_chunked(scene: ChunkedScene, camera: Camera, size: tuple[int, int],

@@ -24,11 +24,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..algo.strips import RESTART, unstripify
-from .colormap import NO_VALUE, ColorScale
+from . import colormap
 
 if TYPE_CHECKING:
     from ..scene.crease import GouraudSplit
     from ..scene.mesh import FEMesh
+    from .colormap import ColorScale
     from .style import Style
 
 PRIMITIVES = ("triangles", "triangle_strip")
@@ -133,6 +134,12 @@ class MeshDrawData:
         """Whether the field is the same at every step (uploaded once)."""
         return self.field_per is not None and self._field().ndim == 1
 
+    @property
+    def has_missing(self) -> bool:
+        """Whether the field has a non-finite value at any step: the path then draws the
+        no-result rule (:mod:`~workbench.paths.colormap`) with a missing flag per vertex."""
+        return self.field_per is not None and not bool(np.isfinite(self._field()).all())
+
     def _field(self) -> np.ndarray:
         fields = self.mesh.node_fields if self.field_per == "node" else self.mesh.element_fields
         return fields[self.style.field]
@@ -145,14 +152,15 @@ class MeshDrawData:
             else mesh.element_field(name, step)
         return self.scale.normalise(values)
 
-    def values(self, step: int) -> tuple[np.ndarray, int]:
-        """(V,) float32 normalised field values per vertex at ``step``, non-finite ones as
-        :data:`NO_VALUE`, and how many node or element values were not finite."""
-        t = self.normalised(step)
-        missing = ~np.isfinite(t)
-        if missing.any():
-            t[missing] = NO_VALUE
-        return self.vertex_values(t).astype(np.float32), int(missing.sum())
+    def values(self, step: int) -> tuple[np.ndarray, np.ndarray, int]:
+        """``(values, missing, count)`` at ``step``: (V,) float32 normalised field values per
+        vertex (0 where a node's value is not finite), (V,) float32 missing flags per vertex (1
+        where the vertex's node, or the element it carries, has no finite value; else 0) and
+        how many node or element values were not finite (:func:`~.colormap.mark_missing`)."""
+        t, missing = colormap.mark_missing(self.normalised(step))
+        return (self.vertex_values(t).astype(np.float32),
+                self.vertex_values(missing.astype(np.float64)).astype(np.float32),
+                int(missing.sum()))
 
     def vertex_values(self, t: np.ndarray) -> np.ndarray:
         """(V,) per-vertex values from per-node values, or from per-element values through

@@ -15,6 +15,10 @@ texture of :mod:`workbench.paths.colormap` (smooth or bands, transfer-function Î
   duplicates the assignment needs, and no per-fragment fetch is made (a value texture read by
   ``gl_PrimitiveID`` drew the 1 M-triangle es2008 scene about 30 % slower on llvmpipe).
 
+A non-finite value draws the triangles that use it in the no-result colour (the rule of
+:mod:`workbench.paths.colormap`): the per-vertex paths flag them in the geometry shader
+``no_result.geom.glsl``, ``element_color`` by a flat flag of the element's provoking vertex.
+
 Node fields are drawn by the per-vertex paths and element fields by ``element_color``; the
 other pairing is refused with ValueError naming the path that draws it (averaging an element
 field to the nodes, or a node field to the elements, would be a different field).
@@ -43,6 +47,8 @@ class VertexColorPath(MeshPath):
     name = "vertex_color"
     needs = frozenset({"gouraud"})
     vertex_shader, fragment_shader = "vertex_color.vert.glsl", "vertex_color.frag.glsl"
+    missing_geometry_shader = "no_result.geom.glsl"
+    missing_defines = {"VERTEX_COLOR": 1}
     split = True
     field_per = "node"
 
@@ -53,6 +59,7 @@ class PixelColorPath(MeshPath):
     name = "pixel_color"
     needs = frozenset({"gouraud"})
     vertex_shader, fragment_shader = "pixel_color.vert.glsl", "pixel_color.frag.glsl"
+    missing_geometry_shader = "no_result.geom.glsl"
     split = True
     field_per = "node"
 

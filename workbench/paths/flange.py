@@ -12,7 +12,8 @@ the scalar interpolated and looked up per fragment):
   discarded; the linear texture filter puts the edge at the threshold itself. Nodes with no
   other part within ``cutoff`` are hidden too. What stays are the potential flanges.
 * ``show="distance"``: the distance map over ``[0, cutoff]``, nothing hidden; nodes with no
-  other part within ``cutoff`` are drawn in ``base_color``.
+  other part within ``cutoff`` have no value (NaN), so the triangles that use them are drawn
+  in the no-result colour (:mod:`~workbench.paths.colormap`).
 
 Refused with ValueError: a threshold or cutoff that is not positive and finite, a threshold
 above the cutoff, another ``field``, a ``value_range`` or ``hide_range`` (the path sets
@@ -90,7 +91,7 @@ class FlangePath(PixelColorPath):
 
     def check_mesh(self, mesh: FEMesh) -> ColorScale | None:
         """Install the node field ``part_distance`` on ``mesh`` from its cached distances (far
-        nodes hidden with the flanges, drawn in ``base_color`` on the map), then check as
+        nodes hidden with the flanges, without a value on the map), then check as
         ``pixel_color`` does."""
         if getattr(mesh, "kind", None) != "mesh":
             raise ValueError(f"path {self.name!r} draws an FE mesh, got {type(mesh).__name__}")
@@ -98,7 +99,7 @@ class FlangePath(PixelColorPath):
         distance = np.array(flange_distances(mesh, style.cutoff, style.step).distance,
                             np.float64)
         far = ~np.isfinite(distance)
-        # beyond the distance of interest: hidden with the flanges, the base colour on the map
+        # beyond the distance of interest: hidden with the flanges, no value on the map
         distance[far] = 2.0 * style.threshold if style.show == "flanges" else np.nan
         mesh.node_fields[FIELD] = distance
         return super().check_mesh(mesh)

@@ -10,6 +10,12 @@ vertices with per-vertex normals; otherwise the mesh's referenced nodes without 
 ``field_per`` (None, ``"node"`` or ``"element"``: the field's normalised values go up as a
 per-vertex float attribute ``value``). :meth:`MeshPath.topology` and :meth:`MeshPath.layout`
 may be overridden to number the vertices or lay out the index buffer differently.
+
+A field with a non-finite value at any step is drawn by the no-result rule of
+:mod:`~workbench.paths.colormap`: the shaders are compiled with ``MISSING``, a per-vertex float
+attribute ``missing`` (0 or 1) goes up beside ``value``, and the path's
+``missing_geometry_shader`` (the per-vertex field paths: ``no_result.geom.glsl``) turns it into
+one flag per triangle; an element path's flag rides on the element's provoking vertex.
 """
 
 from __future__ import annotations
@@ -22,7 +28,7 @@ import numpy as np
 from ..algo.strips import RESTART, quad_strips, tri_strips
 from ..gl import Camera, load_program
 from .base import GLPath
-from .colormap import ColorScale, scale_for
+from .colormap import NO_RESULT_COLOR, ColorScale, scale_for
 from .drawdata import Layout, MeshDrawData, Topology, compact, vertex_of_node
 from .style import Style
 
@@ -48,6 +54,9 @@ class MeshPath(GLPath):
 
     vertex_shader: ClassVar[str]
     fragment_shader: ClassVar[str]
+    # the geometry shader of the no-result rule (None: the flag needs none) and its defines
+    missing_geometry_shader: ClassVar[str | None] = None
+    missing_defines: ClassVar[dict] = {}
     split: ClassVar[bool] = False
     field_per: ClassVar[str | None] = None
     style: Style
@@ -171,20 +180,28 @@ class MeshPath(GLPath):
         defines = {"NUM_CLIP": len(style.clip_planes)}
         if style.hide_range is not None and self.field_per is not None:
             defines["HIDE"] = 1
+        missing = data.has_missing
+        geometry = None
+        if missing:
+            defines |= {"MISSING": 1, **self.missing_defines}
+            geometry = self.missing_geometry_shader
         self._program = self._keep(load_program(ctx, self.vertex_shader, self.fragment_shader,
-                                                defines=defines))
+                                                geometry, defines=defines))
         n = data.n_vertices
         self._positions = self._keep(ctx.buffer(reserve=n * 12))
         self._index = self._keep(ctx.buffer(data.index.tobytes()))
         uploaded = data.index.nbytes
         content = [(self._positions, "3f", "position")]
-        self._normals = self._values = None
+        self._normals = self._values = self._missing = None
         if data.split is not None:
             self._normals = self._keep(ctx.buffer(reserve=n * 12))
             content.append((self._normals, "3f", "normal"))
         if self.field_per is not None:
             self._values = self._keep(ctx.buffer(reserve=n * 4))
             content.append((self._values, "1f", "value"))
+        if missing:
+            self._missing = self._keep(ctx.buffer(reserve=n * 4))
+            content.append((self._missing, "1f", "missing"))
         for array, fmt, name in data.attributes:
             content.append((self._keep(ctx.buffer(array.tobytes())), fmt, name))
             uploaded += array.nbytes
@@ -213,7 +230,8 @@ class MeshPath(GLPath):
         texture.filter = (filt, filt)
         texture.repeat_x = texture.repeat_y = False
         self._program["colormap"].value = 0
-        self._program["missing_color"].value = self.style.base_color
+        if "missing_color" in self._uniforms(self._program):  # used with MISSING only
+            self._program["missing_color"].value = NO_RESULT_COLOR
         self._program["colormap_st"].value = scale.coord_transform
         return texels.nbytes
 
@@ -239,10 +257,14 @@ class MeshPath(GLPath):
         return sent
 
     def _upload_values(self, step: int) -> int:
-        """Upload the normalised field values of ``step``; non-finite ones as ``NO_VALUE``."""
-        values, self.missing_values = self.data.values(step)
+        """Upload the normalised field values of ``step`` (non-finite ones as 0) and, for a
+        field with non-finite values, the missing flags beside them; the bytes sent."""
+        values, missing, self.missing_values = self.data.values(step)
         self._values.write(values)
-        return values.nbytes
+        if self._missing is None:
+            return values.nbytes
+        self._missing.write(missing)
+        return values.nbytes + missing.nbytes
 
     def draw(self) -> None:
         self.ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION

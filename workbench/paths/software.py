@@ -5,8 +5,10 @@
 the same image on the CPU with :func:`workbench.algo.softraster.render`: it rasterizes the
 path's own :class:`~.drawdata.MeshDrawData` (the same triangles and quad diagonals, the same
 deformation plot, normals, colour texture, transfer-function alpha test and clip planes), with
-the same pixel rule as llvmpipe. It follows the path protocol (prepare, set_camera, set_step,
-draw, release) so that :func:`workbench.experiment.measure` times it like any path through the
+the same pixel rule as llvmpipe and the no-result rule of :mod:`~.colormap` (a triangle with a
+non-finite value drawn whole in :data:`~.colormap.NO_RESULT_COLOR`). It follows the path
+protocol (prepare, set_camera, set_step, draw, release) so that
+:func:`workbench.experiment.measure` times it like any path through the
 :class:`~workbench.paths.backends.SoftwareRasterizer` backend; it draws into a
 :class:`SoftwareTarget` instead of a GL framebuffer, and needs no GL context.
 
@@ -23,8 +25,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..algo.softraster import Frame, RasterOptions, Shading, render
+from . import colormap
 from .base import RenderPath
-from .colormap import NO_VALUE
 from .registry import path_class
 
 if TYPE_CHECKING:
@@ -46,7 +48,8 @@ SHADING_OF = {"position": "constant", "flat": "flat", "gouraud": "gouraud",
 class RasterInputs:
     """The arrays a software path rasterizes (see :meth:`SoftwarePath.raster_inputs`):
     ``coordinates`` (V, 3) float64 drawn vertex positions (model units), ``normals`` (V, 3)
-    float32 or None, ``values`` (V,) normalised field or None, ``triangle_values`` (K,) or None,
+    float32 or None, ``values`` (V,) normalised field (NaN: no value) or None,
+    ``triangle_values`` (K,) (NaN: no value) or None,
     ``triangles`` (K, 3) int64 into the vertices, the ``shading`` and the model-space
     ``clip_planes`` (P, 4)."""
 
@@ -153,7 +156,7 @@ class SoftwarePath(RenderPath):
         scale = data.scale
         self._shading = Shading(
             kind=SHADING_OF[self.name], base_color=style.base_color,
-            missing_color=style.base_color,
+            missing_color=colormap.NO_RESULT_COLOR,
             texels=None if scale is None else scale.texture_data(),
             linear=False if scale is None else scale.linear,
             coord=(1.0, 0.0) if scale is None else scale.coord_transform,
@@ -189,12 +192,15 @@ class SoftwarePath(RenderPath):
         self._normals = data.normals(shown)
         self._values = self._triangle_values = None
         if data.field_per is not None:
-            t = data.normalised(step)
-            self.missing_values = int((~np.isfinite(t)).sum())
+            # the values GL uploads, NaN where GL uploads a missing flag: the rasterizer flags
+            # the triangles of a non-finite value
+            t, missing = colormap.mark_missing(data.normalised(step))
+            self.missing_values = int(missing.sum())
+            t = np.where(missing, np.nan, t)
             if data.field_per == "node":
-                self._values = _with_no_value(data.vertex_values(t))
+                self._values = data.vertex_values(t)
             else:
-                self._triangle_values = _with_no_value(t[data.triangle_element])
+                self._triangle_values = t[data.triangle_element]
         self.step = step
         return sum(a.nbytes for a in (self._positions, self._normals, self._values,
                                       self._triangle_values) if a is not None)
@@ -247,8 +253,3 @@ class SoftwarePath(RenderPath):
         self.target = None
         self._workspace = {}
 
-
-def _with_no_value(values: np.ndarray) -> np.ndarray:
-    """``values`` (float64) with every non-finite entry replaced by :data:`NO_VALUE` (drawn in
-    the missing colour)."""
-    return np.where(np.isfinite(values), values, NO_VALUE)

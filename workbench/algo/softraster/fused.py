@@ -51,7 +51,7 @@ import numpy as np
 from numba import prange
 
 from . import kernels
-from .kernels import CONSTANT, ELEMENT_COLOR, FLAT, GOURAUD, MISSING_S, VERTEX_COLOR, _flat_light
+from .kernels import CONSTANT, ELEMENT_COLOR, FLAT, GOURAUD, VERTEX_COLOR, _flat_light
 
 DROPPED, SEVERAL = -1, -2  # tile codes of a triangle: drawn nowhere, in more than one tile
 BOX_PIXEL_WORK = 1  # work estimate of a tile: per box pixel tested …
@@ -196,27 +196,33 @@ def place(tris, fx, fy, fz, bits, width, height, shift, tiles_x, code, fill, mem
 
 # ----------------------------------------------------------------------------- tiles
 @numba.njit(cache=True, inline="always")
-def _triangle_color(kind, light, s, base, missing, texels, texf, linear, alpha_test):
+def _triangle_color(kind, light, s, no_value, base, missing, texels, texf, linear,
+                    alpha_test):
     """(packed RGBA8, visible) of a triangle of one colour (constant; flat or element colour
-    with the flat ``light``, element colour at texture coordinate ``s``), as
-    :func:`.kernels.interpolate_color` computes it."""
+    with the flat ``light``, element colour at texture coordinate ``s``, or in the ``missing``
+    colour where ``no_value``), as :func:`.kernels.interpolate_color` computes it."""
     if kind == CONSTANT:
         return kernels.pack(base[0], base[1], base[2]), True
     if kind == FLAT:
         return kernels.pack(base[0] * light, base[1] * light, base[2] * light), True
-    if s < MISSING_S:
+    if no_value:
         return kernels.pack(missing[0] * light, missing[1] * light, missing[2] * light), True
     r, g, b, a = kernels.texel_rgba(texels, texf, linear, s)
     return kernels.pack(r * light, g * light, b * light), not (alpha_test and a < 0.5)
 
 
 @numba.njit(cache=True, inline="always")
-def _pixel_color(kind, pl, i, j, base, missing, texels, texf, linear, alpha_test):
+def _pixel_color(kind, pl, i, j, no_value, base, missing, texels, texf, linear, alpha_test):
     """(packed RGBA8, visible) of the fragment at pixel (i, j) of a triangle whose attribute
-    planes are ``pl[0, 1:, :]``, as :func:`.kernels.interpolate_color` computes it."""
+    planes are ``pl[0, 1:, :]`` (in the ``missing`` colour, lit, where ``no_value``), as
+    :func:`.kernels.interpolate_color` computes it."""
     if kind == GOURAUD:
         light = np.float32(pl[0, 1, 0] + pl[0, 1, 1] * i + pl[0, 1, 2] * j)
         return kernels.pack(base[0] * light, base[1] * light, base[2] * light), True
+    if no_value:  # VERTEX_COLOR (light in plane 5) or PIXEL_COLOR (plane 2)
+        q = 5 if kind == VERTEX_COLOR else 2
+        light = np.float32(pl[0, q, 0] + pl[0, q, 1] * i + pl[0, q, 2] * j)
+        return kernels.pack(missing[0] * light, missing[1] * light, missing[2] * light), True
     if kind == VERTEX_COLOR:
         r = np.float32(pl[0, 1, 0] + pl[0, 1, 1] * i + pl[0, 1, 2] * j)
         g = np.float32(pl[0, 2, 0] + pl[0, 2, 1] * i + pl[0, 2, 2] * j)
@@ -226,8 +232,6 @@ def _pixel_color(kind, pl, i, j, base, missing, texels, texf, linear, alpha_test
     # PIXEL_COLOR
     s = np.float32(pl[0, 1, 0] + pl[0, 1, 1] * i + pl[0, 1, 2] * j)
     light = np.float32(pl[0, 2, 0] + pl[0, 2, 1] * i + pl[0, 2, 2] * j)
-    if s < MISSING_S:
-        return kernels.pack(missing[0] * light, missing[1] * light, missing[2] * light), True
     r, g, b, a = kernels.texel_rgba(texels, texf, linear, s)
     return kernels.pack(r * light, g * light, b * light), not (alpha_test and a < 0.5)
 
@@ -254,12 +258,14 @@ def _block_max(depth, bmax, nmax, b, i0, j0, block):
 
 @numba.njit(cache=True, parallel=True)
 def draw_tiles(order, start, members, mxy, mz, tris, ids, fx, fy, attr, clipd,
-               pos32, view32, tri_s, kind, base, missing, texels, texf, linear, alpha_test, early,
-               shift, tiles_x, bits, depth, color, triangle, covered):
+               pos32, view32, tri_s, tri_missing, any_missing, kind, base, missing, texels,
+               texf, linear, alpha_test, early, shift, tiles_x, bits, depth, color, triangle,
+               covered):
     """Every tile of ``order`` (:func:`layout`), each by one thread, drawn into ``depth``,
     ``color`` (packed RGBA8) and ``triangle``: its triangles (``members``) in index order, each
     set up, its box within the tile tested against the edge functions, each covered fragment
-    depth tested, clipped, coloured and written. With ``early``, the depth test comes first,
+    depth tested, clipped, coloured and written; a triangle flagged in ``tri_missing`` (read
+    where ``any_missing``) in the ``missing`` colour. With ``early``, the depth test comes first,
     and a triangle whose depth plane lies behind the largest depth of the blocks its box meets
     is skipped before its coverage. ``covered[t]``: the fragments tile t generated (pixel
     centres covered by triangles not skipped)."""
@@ -332,6 +338,7 @@ def draw_tiles(order, start, members, mxy, mz, tris, ids, fx, fy, attr, clipd,
             shaded = False
             k = members[q]
             tid = ids[k]
+            no_value = any_missing and tri_missing[k] != 0
             tri_rgba = np.uint32(0)
             tri_visible = True
             for j in range(j0, j1 + 1):
@@ -371,8 +378,8 @@ def draw_tiles(order, start, members, mxy, mz, tris, ids, fx, fy, attr, clipd,
                                 light = _flat_light(pos32, view32, fx, fy, inv, a, b, c)
                             tri_rgba, tri_visible = _triangle_color(
                                 kind, light, tri_s[k] if kind == ELEMENT_COLOR
-                                else np.float32(0.0), base, missing, texels, texf, linear,
-                                alpha_test)
+                                else np.float32(0.0), no_value, base, missing, texels, texf,
+                                linear, alpha_test)
                     clipped = False
                     for p in range(1 + n_attr, 1 + n_attr + n_clip):
                         if pl[0, p, 0] + pl[0, p, 1] * i + pl[0, p, 2] * j < 0.0:
@@ -382,8 +389,8 @@ def draw_tiles(order, start, members, mxy, mz, tris, ids, fx, fy, attr, clipd,
                     if per_triangle:
                         rgba, visible = tri_rgba, tri_visible
                     else:
-                        rgba, visible = _pixel_color(kind, pl, i, j, base, missing, texels,
-                                                     texf, linear, alpha_test)
+                        rgba, visible = _pixel_color(kind, pl, i, j, no_value, base, missing,
+                                                     texels, texf, linear, alpha_test)
                     if not visible:
                         continue
                     d = depth[j, i]
@@ -457,6 +464,7 @@ def _draw(tris, ids, lit, frame, color32, options, look, shading, threads, stats
     for k0 in range(0, len(tris), SESSION):
         k1 = min(k0 + SESSION, len(tris))
         tri_s = lit.tri_s[k0:k1] if len(lit.tri_s) == len(tris) else lit.tri_s
+        tri_missing = lit.tri_missing[k0:k1] if lit.any_missing else lit.tri_missing
         stats.sessions += 1
         code = _lend(workspace, "fused_code", k1 - k0, np.int32)
         runs = RUNS_PER_THREAD * threads
@@ -483,7 +491,8 @@ def _draw(tris, ids, lit, frame, color32, options, look, shading, threads, stats
         with numba.parallel_chunksize(1):  # a thread takes the next tile when it is done
             kernel(draw_tiles)(order, start, members, mxy, mz, tris[k0:k1], ids[k0:k1], lit.fx,
                                lit.fy, lit.attr, lit.clipd, lit.pos32, lit.view32, tri_s,
-                               look.code, look.base, look.missing, look.texels, look.texf,
+                               tri_missing, lit.any_missing, look.code, look.base,
+                               look.missing, look.texels, look.texf,
                                shading.linear, shading.alpha_test, options.early_depth, shift,
                                tiles_x, bits, frame.depth, color32, frame.triangle, covered)
         stats.fragments += int(covered.sum())

@@ -21,7 +21,6 @@ from numba import prange
 
 # shading kinds, one per mesh render path
 CONSTANT, FLAT, GOURAUD, VERTEX_COLOR, PIXEL_COLOR, ELEMENT_COLOR = range(6)
-MISSING_S = -1.0e29  # a texture coordinate below this is the no-value sentinel
 GUARD = float(1 << 29)  # |fixed coordinate| limit: edge functions stay below 2^62
 
 
@@ -111,9 +110,10 @@ def transform(pos, mvp, width, height, bits, fx, fy, fz, ok):
 
 
 @numba.njit(cache=True, parallel=True)
-def light_vertices(kind, view, normals, s, texels, texf, linear, missing, attr):
+def light_vertices(kind, view, normals, s, texels, texf, linear, attr):
     """Per-vertex shading inputs ``attr`` (V, A) float32 for the Gouraud kinds: GOURAUD → the
-    headlight of the crease-split normal; VERTEX_COLOR → lit colour RGB and transfer α;
+    headlight of the crease-split normal; VERTEX_COLOR → lit colour RGB and transfer α, and
+    where A is 5 the headlight (for the missing colour of triangles without a value);
     PIXEL_COLOR → texture coordinate and headlight. ``view`` (3, 3) float32, ``normals`` (V, 3)
     float32, ``s`` (V,) float32 texture coordinates."""
     for v in prange(attr.shape[0]):
@@ -127,14 +127,13 @@ def light_vertices(kind, view, normals, s, texels, texf, linear, missing, attr):
             attr[v, 0] = s[v]
             attr[v, 1] = light
         else:  # VERTEX_COLOR
-            if s[v] < MISSING_S:
-                r, g, b, a = missing[0], missing[1], missing[2], np.float32(1.0)
-            else:
-                r, g, b, a = texel_rgba(texels, texf, linear, s[v])
+            r, g, b, a = texel_rgba(texels, texf, linear, s[v])
             attr[v, 0] = r * light
             attr[v, 1] = g * light
             attr[v, 2] = b * light
             attr[v, 3] = a
+            if attr.shape[1] > 4:
+                attr[v, 4] = light
 
 
 @numba.njit(cache=True, inline="always")
@@ -438,10 +437,12 @@ def interpolate_z(frag_start, frag_count, frag_tri, frag_i, frag_j, zplane, plan
 
 @numba.njit(cache=True, parallel=True)
 def interpolate_color(kind, frag_start, frag_count, frag_tri, frag_i, frag_j, planes, kept,
-                      tri_light, tri_s, base, missing, texels, texf, linear, alpha_test, frag_z,
-                      frag_rgba):
+                      tri_light, tri_s, tri_missing, any_missing, base, missing, texels, texf,
+                      linear, alpha_test, frag_z, frag_rgba):
     """Packed RGBA8 of every fragment not yet rejected, as the mesh path of ``kind`` shades it;
-    a fragment whose colour fails the alpha test (α < ½, with ``alpha_test``) is rejected.
+    a fragment whose colour fails the alpha test (α < ½, with ``alpha_test``) is rejected. A
+    fragment of a triangle flagged in ``tri_missing`` (read where ``any_missing``) takes the
+    ``missing`` colour times its light, never alpha tested (the no-result rule).
     The kinds whose colour is one per triangle (constant, flat, element colour) compute it
     once per run of the triangle's fragments."""
     per_triangle = kind == CONSTANT or kind == FLAT or kind == ELEMENT_COLOR
@@ -465,7 +466,7 @@ def interpolate_color(kind, frag_start, frag_count, frag_tri, frag_i, frag_j, pl
                     else:  # ELEMENT_COLOR
                         s = tri_s[kept[m]]
                         light = tri_light[kept[m]]
-                        if s < MISSING_S:
+                        if any_missing and tri_missing[kept[m]] != 0:
                             color = pack(missing[0] * light, missing[1] * light,
                                          missing[2] * light)
                         else:
@@ -479,6 +480,10 @@ def interpolate_color(kind, frag_start, frag_count, frag_tri, frag_i, frag_j, pl
             elif kind == GOURAUD:
                 light = np.float32(planes[m, 0, 0] + planes[m, 0, 1] * i + planes[m, 0, 2] * j)
                 frag_rgba[f] = pack(base[0] * light, base[1] * light, base[2] * light)
+            elif any_missing and tri_missing[kept[m]] != 0:  # VERTEX_COLOR or PIXEL_COLOR
+                q = 4 if kind == VERTEX_COLOR else 1  # the light's plane
+                light = np.float32(planes[m, q, 0] + planes[m, q, 1] * i + planes[m, q, 2] * j)
+                frag_rgba[f] = pack(missing[0] * light, missing[1] * light, missing[2] * light)
             elif kind == VERTEX_COLOR:
                 r = np.float32(planes[m, 0, 0] + planes[m, 0, 1] * i + planes[m, 0, 2] * j)
                 g = np.float32(planes[m, 1, 0] + planes[m, 1, 1] * i + planes[m, 1, 2] * j)
@@ -491,10 +496,6 @@ def interpolate_color(kind, frag_start, frag_count, frag_tri, frag_i, frag_j, pl
             else:  # PIXEL_COLOR
                 s = np.float32(planes[m, 0, 0] + planes[m, 0, 1] * i + planes[m, 0, 2] * j)
                 light = np.float32(planes[m, 1, 0] + planes[m, 1, 1] * i + planes[m, 1, 2] * j)
-                if s < MISSING_S:
-                    frag_rgba[f] = pack(missing[0] * light, missing[1] * light,
-                                        missing[2] * light)
-                    continue
                 r, g, b, a = texel_rgba(texels, texf, linear, s)
                 if alpha_test and a < 0.5:
                     frag_z[f] = np.float32(np.inf)

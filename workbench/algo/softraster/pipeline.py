@@ -79,12 +79,14 @@ class Shading:
     "element_color" (one looked-up colour per triangle, flat lit). ``texels`` (n, 4) uint8 is
     the 1-D colour texture with ``linear`` filtering or nearest, ``coord`` the (scale, offset)
     from normalised value to texture coordinate, ``alpha_test`` discards α < ½,
-    ``missing_color`` draws the no-value sentinel. Colours RGB in [0, 1].
+    ``missing_color`` is the colour of a triangle with a non-finite value (:func:`render`;
+    default the no-result colour of :data:`workbench.paths.colormap.NO_RESULT_COLOR`, pure
+    green). Colours RGB in [0, 1].
     """
 
     kind: str = "constant"
     base_color: tuple = (0.75, 0.75, 0.78)
-    missing_color: tuple = (0.75, 0.75, 0.78)
+    missing_color: tuple = (0.0, 1.0, 0.0)
     texels: np.ndarray | None = None
     linear: bool = False
     coord: tuple = (1.0, 0.0)
@@ -240,8 +242,11 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
     ``ids`` (K,) int64 are the triangles' global indices (default 0..K−1): they break depth
     ties and are written to ``Frame.triangle``. ``normals`` (V, 3), ``values`` (V,)
     normalised field values and ``triangle_values`` (K,) are needed by the shadings that use
-    them (see :class:`Shading`); a non-finite or no-value entry
-    (:data:`workbench.paths.colormap.NO_VALUE`) draws the missing colour. ``clip_planes``
+    them (see :class:`Shading`). The no-result rule of :mod:`workbench.paths.colormap`: a
+    triangle with a non-finite value at any of its vertices (``values``) or of its own
+    (``triangle_values``) is drawn whole in ``Shading.missing_color``, lit as the shading
+    lights the others (the interpolated Gouraud light, the flat light), never alpha tested;
+    no number of it is interpolated. ``clip_planes``
     (P, 4) relative to the origin keep ``a·x + b·y + c·z + d ≥ 0``. ``vectorized=False`` runs
     every step as plain Python (slow; for the step table on small cases). ``workspace``, a
     dict kept by the caller, lends the per-vertex arrays from one draw to the next (no fresh
@@ -351,8 +356,9 @@ class _Lit:
     (fixed point) and depth ``fz``, ``ok`` (placed), ``attr`` (V, n_attr) the shading
     attributes, ``clipd`` (V, P) the clip distances. Per triangle where the shading uses them
     (else one entry): ``tri_light`` the flat light (one entry where it is left to the fused
-    draw), ``tri_s`` the texture coordinate. ``pos32`` and ``view32``: the float32 vertices and
-    view the flat light is computed from."""
+    draw), ``tri_s`` the texture coordinate; ``tri_missing`` (K,) uint8, 1 for a triangle
+    drawn in the missing colour (one 0 entry where ``any_missing`` is False: none is).
+    ``pos32`` and ``view32``: the float32 vertices and view the flat light is computed from."""
 
     fx: np.ndarray
     fy: np.ndarray
@@ -363,6 +369,8 @@ class _Lit:
     clipd: np.ndarray
     tri_light: np.ndarray
     tri_s: np.ndarray
+    tri_missing: np.ndarray
+    any_missing: bool
     pos32: np.ndarray
     view32: np.ndarray
 
@@ -382,20 +390,34 @@ def _transform_and_light(k, pos, tris, view, proj, size, bits: int, shading: Sha
     fx, fy = lend("fx", n_v, np.int64), lend("fy", n_v, np.int64)
     fz, ok = lend("fz", n_v, np.float32), lend("ok", n_v, bool)
     k.transform(rel32, mvp32, width, height, bits, fx, fy, fz, ok)
-    n_attr = _ATTRS[kind]
-    attr = lend("attr", (n_v, n_attr), np.float32)
     scale, offset = (np.float32(v) for v in shading.coord)
+    tri_missing, any_missing = np.zeros(1, np.uint8), False
+    t = tv = None
+    if kind in ("vertex_color", "pixel_color") and values is not None:
+        t = np.asarray(values, np.float64)
+        finite = np.isfinite(t)
+        if not finite.all():  # the no-result rule: a triangle with a non-finite vertex value
+            tri_missing = (~finite[tris]).any(axis=1).astype(np.uint8)
+            any_missing = True
+            t = np.where(finite, t, 0.0)
+    if kind == "element_color":
+        tv = np.asarray(triangle_values, np.float64)
+        finite = np.isfinite(tv)
+        if not finite.all():
+            tri_missing, any_missing = (~finite).astype(np.uint8), True
+            tv = np.where(finite, tv, 0.0)
+    # vertex colours interpolate lit colours: the missing colour needs the light beside them
+    n_attr = _ATTRS[kind] + int(kind == "vertex_color" and any_missing)
+    attr = lend("attr", (n_v, n_attr), np.float32)
     if kind in ("gouraud", "vertex_color", "pixel_color"):
         s = np.zeros(n_v, np.float32)
-        if values is not None:
-            t = np.asarray(values, np.float64)
+        if t is not None:
             s = t.astype(np.float32) * scale + offset
-            s[~np.isfinite(t)] = np.float32(-1e30)
         normals32 = np.asarray(normals)
         if normals32.dtype != np.float32:
             normals32 = normals32.astype(np.float32)
         k.light_vertices(code, np.ascontiguousarray(view[:3, :3], np.float32), normals32,
-                         s, look.texels, look.texf, shading.linear, look.missing, attr)
+                         s, look.texels, look.texf, shading.linear, attr)
     flat = flat_light and kind in ("flat", "element_color")
     tri_light = np.zeros(len(tris) if flat else 1, np.float32)
     view32 = view.astype(np.float32)
@@ -403,15 +425,14 @@ def _transform_and_light(k, pos, tris, view, proj, size, bits: int, shading: Sha
         k.light_triangles(rel32, tris, view32, fx, fy, bits, tri_light)
     tri_s = np.zeros(1, np.float32)
     if kind == "element_color":
-        tv = np.asarray(triangle_values, np.float64)
         tri_s = tv.astype(np.float32) * scale + offset
-        tri_s[~np.isfinite(tv)] = np.float32(-1e30)
     clipd = np.zeros((n_v, len(planes)), np.float32)
     if len(planes):
         p32, w32 = planes[:, :3].astype(np.float32), planes[:, 3].astype(np.float32)
         clipd = np.ascontiguousarray((rel32 @ p32.T) + w32, np.float32)
     return _Lit(fx=fx, fy=fy, fz=fz, ok=ok, attr=attr, n_attr=n_attr, clipd=clipd,
-                tri_light=tri_light, tri_s=tri_s, pos32=rel32, view32=view32)
+                tri_light=tri_light, tri_s=tri_s, tri_missing=tri_missing,
+                any_missing=any_missing, pos32=rel32, view32=view32)
 
 
 @dataclass
@@ -487,7 +508,8 @@ class _Sessions:
         clock.lap("interpolate z")
         frag_rgba = np.empty(slots, np.uint32)
         k.interpolate_color(look.code, frag_start, frag_count, frag_tri, frag_i, frag_j,
-                            planes_m, kept, lit.tri_light, lit.tri_s, look.base, look.missing,
+                            planes_m, kept, lit.tri_light, lit.tri_s, lit.tri_missing,
+                            lit.any_missing, look.base, look.missing,
                             look.texels, look.texf, shading.linear, shading.alpha_test, frag_z,
                             frag_rgba)
         clock.lap("interpolate color")
