@@ -10,10 +10,17 @@ render paths far from the origin, drawn many times and in other processes.
   read compared with the undamaged read, fields included (:func:`run_d3plot_stress`);
 * :mod:`~workbench.reliability.render` — far offsets, the soak and determinism
   (:func:`run_render_stress`);
+* :mod:`~workbench.reliability.numerics` — the numerical suite (:func:`run_numerics_stress`):
+  the geometric kernels and colour paths on adversarial inputs
+  (:mod:`~workbench.reliability.numerics_cases`, :mod:`~workbench.reliability.numerics_scenes`),
+  checked (:mod:`~workbench.reliability.numerics_checks`,
+  :mod:`~workbench.reliability.numerics_images`) against exact rational references
+  (:mod:`~workbench.reliability.exact`, :mod:`~workbench.reliability.exact_planar`);
 * :mod:`~workbench.reliability.faults` — faults injected to show that a check can fail (a
-  path slowed by a known share).
+  path slowed by a known share; the old distance kernel, bounds not rounded outward, a rim
+  around missing values).
 
-``workbench stress readers|render|all`` runs them (:mod:`workbench.cli.stress`).
+``workbench stress readers|render|numerics|all`` runs them (:mod:`workbench.cli.stress`).
 """
 
 from .d3plot import (
@@ -39,6 +46,7 @@ from .decks import (
                     mutated_deck,
                     thickness_deck,
 )
+from .numerics import DEFAULT_N, NumericsReport, Tally, run_numerics_stress
 from .readers import (
                     FAILING,
                     OUTCOMES,
@@ -75,6 +83,7 @@ from .strict import (
 
 __all__ = ["BENIGN", "BeyondReference", "BOM", "check_determinism", "check_far_offset",
            "check_soak", "CHECKED_PATHS", "comma_deck", "compare_read", "D3PLOT_KINDS",
+           "DEFAULT_N", "NumericsReport", "run_numerics_stress", "Tally",
            "D3plotStressReport", "Damage", "damaged_d3plot", "damaged_family", "default_decks",
            "Expected", "expected_mesh", "FAILING", "Failure", "FAMILY_KINDS", "fixed_deck",
            "HARMFUL", "image_digest", "KINDS", "long_deck", "mesh_differences", "mesh_problem",
