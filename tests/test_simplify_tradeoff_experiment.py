@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from workbench.experiment.context import ExperimentContext
+from workbench.experiment.hausdorff_peers import PEER
 from workbench.experiment.tables import read_table
 
 
@@ -128,6 +129,37 @@ def test_the_metric_table_flags_tools_outside_the_bracket(result, car_deck):
     sampled = [r for r in metric if r["tool"].startswith("pymeshlab")]
     assert sampled and not any(r["outside_bracket"] for r in sampled)
     assert any(r["tool"].startswith("open3d") for r in metric)
+    # the other certified bracket: at each of our widths it reaches it and meets ours
+    peer = [r for r in metric if r["tool"].startswith(PEER)]
+    widths = {r["tool"].split("width ")[1] for r in ours}
+    assert peer and {r["tool"].split("width ")[1] for r in peer} <= widths
+    for r in peer:
+        assert r["outside_bracket"] is False and r["width_reached"]
+        assert r["hausdorff_lower_mm"] <= r["hausdorff_mm"]
+
+
+def test_the_peer_table_compares_two_certified_brackets(result):
+    size, _, out_dir = result
+    rows = read_table(out_dir / "hausdorff_peer.csv")
+    assert rows and set(rows[0]) == set(PEER_TABLE_COLUMNS)
+    repeats = {"tiny": 3, "quick": 5}[size]
+    for r in rows:
+        assert r["peer_failure"] is None and r["repeats"] == repeats
+        # the same width, 1e-4 of the original's diagonal, reached by both
+        assert r["tol_share_of_diagonal"] == pytest.approx(1e-4)
+        assert r["ours_tol_reached"] and r["peer_tol_reached"]
+        assert r["ours_upper_mm"] - r["ours_lower_mm"] <= r["tol_mm"]
+        assert r["peer_upper_mm"] - r["peer_lower_mm"] <= r["tol_mm"]
+        # both certify the same value
+        assert r["overlap"] is True
+        assert max(r["ours_lower_mm"], r["peer_lower_mm"]) <= min(
+            r["ours_upper_mm"], r["peer_upper_mm"]) + 1e-9 * r["tol_mm"] / 1e-4
+        for side in ("ours_s", "peer_s", "time_ratio"):
+            assert 0 < r[f"{side}_min"] <= r[side] <= r[f"{side}_max"]
+        faster = ("ours" if r["time_ratio_min"] > 1 else PEER if r["time_ratio_max"] < 1
+                  else "neither (ratios straddle 1)")
+        assert r["faster"] == faster
+        assert r["triangles"] <= r["target_triangles"] < r["input_triangles"]
 
 
 def test_figures_are_written(result):
@@ -149,6 +181,12 @@ EQUAL_ERROR_COLUMNS = [
     "scene", "tol_pct", "method", "scope", "borders", "vertices", "error", "error_pct_diag",
     "triangles", "over_ours", "seconds", "calls", "meshoptimizer_at_this_error", "hausdorff_mm",
     "failure"]
+PEER_TABLE_COLUMNS = [
+    "model", "input_triangles", "target_triangles", "triangles", "decimation", "tol_mm",
+    "tol_share_of_diagonal", "ours_lower_mm", "ours_upper_mm", "ours_tol_reached", "ours_s",
+    "ours_s_min", "ours_s_max", "peer_lower_mm", "peer_upper_mm", "peer_tol_reached", "peer_s",
+    "peer_s_min", "peer_s_max", "time_ratio", "time_ratio_min", "time_ratio_max", "faster",
+    "overlap", "repeats", "peer_failure"]
 METRIC_COLUMNS = [
     "scene", "tool", "value", "hausdorff_lower_mm", "hausdorff_mm", "width_reached", "seconds",
     "sample_points", "outside_bracket", "worst_point_error", "exact_at_worst_point"]
@@ -166,7 +204,8 @@ def test_every_table_with_every_column_and_kind_of_row(result):
     assert {(r["method"], r["scope"]) for r in sweep} == (
         {(OURS, "per part"), (OURS_NO_FEATURES, "per part")} | PEER_KINDS)
     assert sorted(p.name for p in out_dir.glob("*.csv")) == [
-        "equal_error.csv", "metric.csv", "table.csv"]
+        "equal_error.csv", "hausdorff_peer.csv", "metric.csv", "table.csv"]
+    assert set(read_table(out_dir / "hausdorff_peer.csv")[0]) == set(PEER_TABLE_COLUMNS)
 
 
 def test_the_metric_table_has_every_column_and_tool(result, car_deck):
@@ -175,4 +214,4 @@ def test_the_metric_table_has_every_column_and_tool(result, car_deck):
     assert set(metric[0]) == set(METRIC_COLUMNS)
     tools = [r["tool"].split(",")[0].split(" (")[0] for r in metric]
     assert set(tools) == {"ours", "pymeshlab sampled", "libigl hausdorff",
-                          "open3d RaycastingScene"}
+                          "open3d RaycastingScene", PEER}

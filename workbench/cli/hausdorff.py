@@ -1,5 +1,7 @@
 """``workbench hausdorff``: the certified Hausdorff distance between two meshes, as a bracket
-lower <= H <= upper, one-sided (A to B) or symmetric."""
+lower <= H <= upper, one-sided (A to B) or symmetric; with ``--peers`` beside the bracket of an
+independent certified tool (``cascading-upper-bounds``) at the same bracket width, both timed
+interleaved."""
 
 from __future__ import annotations
 
@@ -11,7 +13,10 @@ def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
         "hausdorff", help="certified Hausdorff distance between two meshes",
         description="Exact float64 Hausdorff distance from mesh A to mesh B (or "
-                    "symmetric) as a certified bracket lower <= H <= upper.")
+                    "symmetric) as a certified bracket lower <= H <= upper. With --peers, "
+                    "also the bracket of cascading-upper-bounds (Sacht & Jacobson, SGP 2024) "
+                    "at the same width, both timed interleaved; exit status 1 where the two "
+                    "brackets do not overlap.")
     p.add_argument("mesh_a", help="mesh file or built-in scene name (A, the original)")
     p.add_argument("mesh_b", help="mesh file or built-in scene name (B)")
     p.add_argument("--symmetric", action="store_true", help="max of both directions")
@@ -20,11 +25,19 @@ def add_parser(subparsers) -> None:
     p.add_argument("--step", type=at_least(0), default=0,
                    help="time step of the coordinates (default 0); B's last step where B has "
                         "fewer")
+    p.add_argument("--peers", action="store_true",
+                   help="also cascading-upper-bounds' one-sided bracket at the same width (A to "
+                        "B; with --symmetric both directions), timed against ours interleaved")
+    p.add_argument("--repeats", type=at_least(1), default=3,
+                   help="with --peers: timed rounds of ours then the peer, after one untimed "
+                        "round (default 3)")
     p.set_defaults(func=cmd_hausdorff)
 
 
 def cmd_hausdorff(args) -> int:
-    """Print the bracket, its share of A's diagonal, and where it is attained; 0."""
+    """Print the bracket, its share of A's diagonal, and where it is attained; with
+    ``--peers`` the peer's bracket and times beside ours. 0, or 1 where the brackets of ours
+    and the peer do not overlap."""
     from ..algo.hausdorff import hausdorff
     from ..scene.builtin import load_mesh
 
@@ -46,4 +59,43 @@ def cmd_hausdorff(args) -> int:
     on, other = ("A", "B") if h.forward is None or h.location is h.forward.location else ("B", "A")
     print(f"  attained at {on} ({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g}), nearest {other} point "
           f"({q[0]:.6g}, {q[1]:.6g}, {q[2]:.6g})")
-    return 0
+    if not args.peers:
+        return 0
+    directions = [("A to B", va, fa, vb, fb)]
+    if args.symmetric:
+        directions.append(("B to A", vb, fb, va, fa))
+    agree = True
+    for name, v1, f1, v2, f2 in directions:
+        agree &= _print_peer(name, v1, f1, v2, f2, width, args, units)
+    return 0 if agree else 1
+
+
+def _print_peer(direction: str, va, fa, vb, fb, width: float, args, units: str) -> bool:
+    """Compare ours and the peer one-sided in ``direction`` and print it; whether the brackets
+    overlap (True where the peer failed: nothing contradicts ours)."""
+    from ..experiment.hausdorff_peers import PEER, compare_with_peer
+
+    c = compare_with_peer(va, fa, vb, fb, tol=width, repeats=args.repeats, warmup=1)
+    print(f"{PEER} (Sacht & Jacobson, SGP 2024), one-sided {direction}, the same bracket "
+          f"width {width:.6g} {units} (absolute; {args.width:g} % of A's diagonal); "
+          f"{args.repeats} rounds of ours then the peer after 1 untimed round, wall seconds "
+          f"median [min, max]:")
+    t, t_lo, t_hi = c.ours_time
+    print(f"  ours: {c.ours.lower:.9g} <= H <= {c.ours.upper:.9g} {units} "
+          f"({'reached' if c.ours.tol_reached else 'NOT reached'}), "
+          f"{t:.4g} s [{t_lo:.4g}, {t_hi:.4g}] (all cores)")
+    if c.peer.failure:
+        print(f"  peer: failed: {c.peer.failure}")
+        return True
+    t, t_lo, t_hi = c.peer_time
+    print(f"  peer: {c.peer.lower:.9g} <= H <= {c.peer.upper:.9g} {units} "
+          f"({'reached' if c.peer.tol_reached else 'NOT reached'}), "
+          f"{t:.4g} s [{t_lo:.4g}, {t_hi:.4g}] (one thread)")
+    r, r_lo, r_hi = c.time_ratio
+    faster = {"ours": "ours is faster", PEER: f"{PEER} is faster"}.get(
+        c.faster, "neither is faster in every round")
+    print(f"  peer / ours time {r:.3g} [{r_lo:.3g}, {r_hi:.3g}]: {faster}; the brackets "
+          + ("overlap" if c.overlap else
+             f"DO NOT overlap (peer granted {c.peer.rounding:.3g} for rounding): one of the two "
+             f"is wrong"))
+    return c.overlap
