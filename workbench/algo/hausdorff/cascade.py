@@ -291,13 +291,13 @@ def _straddle(idx, tri, tri_vertices, face, faces, neighbours, out) -> None:
         _straddle_range(idx, tri, tri_vertices, face, faces, neighbours, out)
 
 
-def cascade(vertices: np.ndarray, tri_vertices: np.ndarray, bvh, neighbours: np.ndarray,
-            tol: float) -> Cascade:
+def cascade(vertices: np.ndarray, tri_vertices: np.ndarray, corners: np.ndarray, bvh,
+            neighbours: np.ndarray, tol: float) -> Cascade:
     """Certified upper bounds of the distance to B over every triangle of A (``vertices``
-    (N, 3), all used, ``tri_vertices`` (K, 3) int64), against B's tree ``bvh``
-    (:class:`~workbench.algo.bvh.TriangleBVH`) and face neighbours ``neighbours`` (F, w), -1
-    padded; see the module notes. ``tol``: the bracket
-    width sought (bounds at most the lower bound + tol are not tightened further)."""
+    (N, 3), all used, ``tri_vertices`` (K, 3) int64, their ``corners`` (K, 3, 3)), against B's
+    tree ``bvh`` (:class:`~workbench.algo.bvh.TriangleBVH`) and face neighbours ``neighbours``
+    (F, w), -1 padded; see the module notes. ``tol``: the bracket width sought (bounds at most
+    the lower bound + tol are not tightened further)."""
     order = _morton_order(vertices)
     d_sorted, f_sorted, near_sorted = bvh.nearest(vertices[order])
     dist = np.empty(len(vertices))
@@ -305,7 +305,6 @@ def cascade(vertices: np.ndarray, tri_vertices: np.ndarray, bvh, neighbours: np.
     dist[order], face[order] = d_sorted, f_sorted
     i = int(np.argmax(d_sorted))
     lower, point_a, point_b = float(d_sorted[i]), vertices[order[i]], near_sorted[i]
-    corners = np.ascontiguousarray(vertices[tri_vertices])
     upper = np.empty(len(corners))
     _bound(corners, tri_vertices, dist, face, bvh.corners, lower + tol, upper)
     _straddle(np.flatnonzero(upper > lower + tol), corners, tri_vertices, face, bvh.corners,

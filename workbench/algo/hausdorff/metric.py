@@ -176,7 +176,7 @@ def _one_sided(a: _Surface, b: _Surface, tol: float, max_depth: int, split: str,
         v, f = a.vertices, a.triangles
     else:
         # bracket only: bound every triangle cheaply, refine those that may hold the maximum
-        first = cascade(a.vertices, a.triangles, bvh, b.neighbours, tol)
+        first = cascade(a.vertices, a.triangles, all_corners, bvh, b.neighbours, tol)
         lower, point_a, point_b, queries = first.lower, first.point_a, first.point_b, \
             first.queries
         keep = first.upper > lower + tol
@@ -200,8 +200,7 @@ def _one_sided(a: _Surface, b: _Surface, tol: float, max_depth: int, split: str,
     top = max(float(upper.max(initial=-1.0)), pruned_upper, lower)
     lower, global_upper = outward(lower, top, bracket_rounding(a.vertices, bvh.corners, top,
                                                                split, max_depth))
-    area2 = np.linalg.norm(np.cross(all_corners[:, 1] - all_corners[:, 0],
-                                    all_corners[:, 2] - all_corners[:, 0]), axis=1)
+    area2 = _doubled_areas(all_corners)
     area = 0.5 * float(area2.sum())
     if estimates:
         weights = area2 if area > 0 else np.ones(len(f))
@@ -299,6 +298,16 @@ def bracket_rounding(vertices, faces, distance, split, max_depth) -> float:
     magnitude = float(np.linalg.norm(hi - lo))
     levels = (3 * max_depth if split == "planes" else max_depth) + 3
     return distance_rounding(distance, longest) + construction_rounding(magnitude, levels)
+
+
+def _doubled_areas(corners: np.ndarray) -> np.ndarray:
+    """(K,) twice the area of each triangle of ``corners`` (K, 3, 3): |(b − a) × (c − a)|."""
+    e1 = corners[:, 1] - corners[:, 0]
+    e2 = corners[:, 2] - corners[:, 0]
+    x = e1[:, 1] * e2[:, 2] - e1[:, 2] * e2[:, 1]
+    y = e1[:, 2] * e2[:, 0] - e1[:, 0] * e2[:, 2]
+    z = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    return np.sqrt(x * x + y * y + z * z)
 
 
 def _quadrature(d_corner, d_edge, d_centroid, weights, power):
