@@ -28,7 +28,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from ..bvh import PARALLEL_MIN
+from ..bvh import PARALLEL_MIN, bounding_box
 from ..distance import closest_point_on_triangle
 from .pieces import _shared_edge_plane
 
@@ -48,8 +48,8 @@ class Cascade(NamedTuple):
 
 def _morton_order(points: np.ndarray) -> np.ndarray:
     """Indices that sort ``points`` (N, 3) along a Morton (Z-order) curve of 21 bits a axis."""
-    lo = points.min(axis=0)
-    span = float((points.max(axis=0) - lo).max())
+    lo, hi = bounding_box(points)
+    span = float((hi - lo).max())
     scale = (2 ** 21 - 1) / span if span > 0 else 0.0
     q = np.clip((points - lo) * scale, 0, 2 ** 21 - 1).astype(np.uint64)
     code = np.zeros(len(points), np.uint64)

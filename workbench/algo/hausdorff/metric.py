@@ -13,9 +13,10 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
-from ..bvh import TriangleBVH, check_triangles, compacted, used_vertices
+from ..bvh import TriangleBVH, bounding_box, check_triangles, compacted, used_vertices
 from ..distance import construction_rounding, distance_rounding, outward
 from .cascade import cascade
 from .refine import _locate_in, _refine, _refine_planes, _sample_upper, _tighten
@@ -108,7 +109,7 @@ def hausdorff(va, fa, vb, fb, *, one_sided: bool = True, tol: float | None = Non
     if split not in SPLITS:
         raise ValueError(f"split must be one of {SPLITS}, got {split!r}")
     used_a = used_vertices(fa, len(va))
-    lo, hi = va[used_a].min(axis=0), va[used_a].max(axis=0)
+    lo, hi = bounding_box(va[used_a])
     origin = 0.5 * (lo + hi)
     if tol is None:
         tol = DEFAULT_REL_TOL * float(np.linalg.norm(hi - lo))
@@ -162,7 +163,7 @@ class _Surface:
     @property
     def bvh(self) -> TriangleBVH:
         if self._bvh is None:
-            self._bvh = TriangleBVH(self.vertices, self.triangles, leaf_size=2)
+            self._bvh = TriangleBVH(self.vertices, self.triangles, leaf_size=1)
         return self._bvh
 
 
@@ -293,21 +294,24 @@ def bracket_rounding(vertices, faces, distance, split, max_depth) -> float:
     edges = faces[:, [1, 2, 0]] - faces
     longest = float(np.sqrt((edges ** 2).sum(axis=2).max())) if len(faces) else 0.0
     corners = faces.reshape(-1, 3)
-    lo = np.minimum(vertices.min(axis=0), corners.min(axis=0))
-    hi = np.maximum(vertices.max(axis=0), corners.max(axis=0))
+    (lo_a, hi_a), (lo_b, hi_b) = bounding_box(vertices), bounding_box(corners)
+    lo, hi = np.minimum(lo_a, lo_b), np.maximum(hi_a, hi_b)
     magnitude = float(np.linalg.norm(hi - lo))
     levels = (3 * max_depth if split == "planes" else max_depth) + 3
     return distance_rounding(distance, longest) + construction_rounding(magnitude, levels)
 
 
+@numba.njit(cache=True)
 def _doubled_areas(corners: np.ndarray) -> np.ndarray:
     """(K,) twice the area of each triangle of ``corners`` (K, 3, 3): |(b − a) × (c − a)|."""
-    e1 = corners[:, 1] - corners[:, 0]
-    e2 = corners[:, 2] - corners[:, 0]
-    x = e1[:, 1] * e2[:, 2] - e1[:, 2] * e2[:, 1]
-    y = e1[:, 2] * e2[:, 0] - e1[:, 0] * e2[:, 2]
-    z = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    return np.sqrt(x * x + y * y + z * z)
+    out = np.empty(len(corners))
+    for t in range(len(corners)):
+        a0, a1, a2 = corners[t, 0, 0], corners[t, 0, 1], corners[t, 0, 2]
+        e0, e1, e2 = corners[t, 1, 0] - a0, corners[t, 1, 1] - a1, corners[t, 1, 2] - a2
+        f0, f1, f2 = corners[t, 2, 0] - a0, corners[t, 2, 1] - a1, corners[t, 2, 2] - a2
+        x, y, z = e1 * f2 - e2 * f1, e2 * f0 - e0 * f2, e0 * f1 - e1 * f0
+        out[t] = np.sqrt(x * x + y * y + z * z)
+    return out
 
 
 def _quadrature(d_corner, d_edge, d_centroid, weights, power):
