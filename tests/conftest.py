@@ -1,6 +1,12 @@
 """Test-wide settings and fixtures.
 
 * Property tests draw the same examples on every CI run (set CI=1).
+* ``WORKBENCH_HYPOTHESIS_SCALE=K`` multiplies every property test's ``max_examples`` by ``K``
+  (its own ``@settings`` included, which a loaded profile would not override): a one-off
+  search for examples the everyday run has not met yet, not for CI. Give it a fresh example
+  database so stored examples do not stand in for new ones, e.g.
+  ``WORKBENCH_HYPOTHESIS_SCALE=20 HYPOTHESIS_STORAGE_DIRECTORY=$(mktemp -d) pytest -p
+  no:cacheprovider tests/test_x.py``; ``--hypothesis-show-statistics`` shows the examples run.
 * ``ctx``: an offscreen GL context per test module, skipped with the reason where none can be
   made; a test using it is marked ``gl``.
 * ``car``, ``car_deck``, ``d3plot_file``: the shared LS-DYNA car deck (as a fresh mesh, and as
@@ -27,6 +33,43 @@ if os.environ.get("CI"):
     settings.load_profile("ci")
 
 SHARED_FIXTURES = {"car", "car_deck", "d3plot_file"}
+SCALE_ENV = "WORKBENCH_HYPOTHESIS_SCALE"
+
+
+def _hypothesis_scale() -> float:
+    """The factor ``WORKBENCH_HYPOTHESIS_SCALE`` asks for (1 where unset)."""
+    text = os.environ.get(SCALE_ENV, "").strip()
+    if not text:
+        return 1.0
+    try:
+        scale = float(text)
+    except ValueError:
+        raise pytest.UsageError(f"{SCALE_ENV}={text!r} is not a number") from None
+    if not scale > 0:
+        raise pytest.UsageError(f"{SCALE_ENV}={text!r} must be positive")
+    return scale
+
+
+def _scale_examples(item, scale: float, done: set) -> None:
+    """Give the property test of ``item`` ``scale`` times its ``max_examples``.
+
+    ``@given`` reads its settings from the wrapper's ``_hypothesis_internal_use_settings`` at
+    every call (``@settings`` above or below ``@given`` ends there too), so a child of those
+    settings set there scales the test whatever set the count. The items of a parametrized test
+    share one wrapper (a test method's items reach it through ``__func__``): each is scaled once.
+    """
+    from hypothesis import is_hypothesis_test
+
+    obj = getattr(item, "obj", None)
+    if obj is None or not is_hypothesis_test(obj):
+        return
+    fn = getattr(obj, "__func__", obj)
+    if id(fn) in done:
+        return
+    done.add(id(fn))
+    current = getattr(fn, "_hypothesis_internal_use_settings", None) or settings.default
+    fn._hypothesis_internal_use_settings = settings(
+        parent=current, max_examples=max(1, round(current.max_examples * scale)))
 
 
 @pytest.fixture(autouse=True, scope="session")
@@ -45,7 +88,11 @@ def session_results_store(tmp_path_factory):
 
 
 def pytest_collection_modifyitems(items):
+    scale = _hypothesis_scale()
+    scaled = set()
     for item in items:
+        if scale != 1.0:
+            _scale_examples(item, scale, scaled)
         names = set(getattr(item, "fixturenames", ()))
         if "ctx" in names:
             item.add_marker(pytest.mark.gl)

@@ -116,7 +116,13 @@ def test_far_from_the_origin_and_slivers(seed, offset):
     """Coordinates far from the origin and long slivers (split into several references):
     still bit for bit."""
     corners, tri_part, points, point_set, set_ptr, set_parts = random_case(seed, 60, 200, 3, 4)
-    corners[:10, 1] = corners[:10, 0] + [40.0, 0.5, 0.0]
+    # the tree splits a triangle whose box diagonal exceeds split_factor (4) times the median
+    # diagonal. At least 50 of the 60 diagonals are at most m, the largest of the other 50, so
+    # the median is at most m; a sliver of length L > 4·m (and > 0 where m = 0) is split. With
+    # L = max(40, 5·m) the margin L − 4·m >= 8 dwarfs the rounding of diagonals at 1e7 (1e-8).
+    others = np.linalg.norm(corners[10:].max(axis=1) - corners[10:].min(axis=1), axis=1)
+    length = max(40.0, 5.0 * others.max())
+    corners[:10, 1] = corners[:10, 0] + np.array([1.0, 0.0125, 0.0]) * length
     corners = corners + offset
     points = points + offset
     tree = BatchedTriangleTree(corners, tri_part, leaf_size=2)

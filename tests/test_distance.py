@@ -3,7 +3,7 @@ and repeated corners, far offsets) and dense sampling, and certified triangle bo
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from meshes import barycentric_grid
@@ -30,8 +30,12 @@ def dense_min(p, a, b, c, n=120):
     return np.sqrt(((pts - p) ** 2).sum(axis=1)).min(), spacing
 
 
+TINY = 2.11943693e-119  # a triangle this small once divided by a squared normal that underflowed
+
+
 @settings(max_examples=300, deadline=None)
 @given(p=vec3, a=vec3, b=vec3, c=vec3)
+@example(p=np.zeros(3), a=np.zeros(3), b=np.full(3, TINY), c=np.array([0.0, TINY, TINY]))
 def test_distance_matches_dense_sampling(p, a, b, c):
     d = point_triangle_distance(p, a, b, c)
     brute, spacing = dense_min(p, a, b, c)
@@ -42,6 +46,7 @@ def test_distance_matches_dense_sampling(p, a, b, c):
 
 @settings(max_examples=200, deadline=None)
 @given(p=vec3, a=vec3, b=vec3, c=vec3)
+@example(p=np.zeros(3), a=np.zeros(3), b=np.full(3, TINY), c=np.array([0.0, TINY, TINY]))
 def test_closest_point_lies_on_the_triangle(p, a, b, c):
     out = np.empty(3)
     d2 = closest_point_on_triangle(p, a, b, c, out)
@@ -97,6 +102,17 @@ def test_distance_is_within_the_error_bound_of_the_exact_one(seed, kind, log_eps
     # the point returned lies on the triangle, to the rounding of its coordinates
     scale = np.abs([a, b, c, p]).max()
     assert exact.point_triangle_distance(out, a, b, c) <= 8 * UNIT_ROUNDOFF * scale
+
+
+@pytest.mark.parametrize("scale", [1e-150, 1e-100, 1e-76, 1e-40, 1.0, 1e40, 1e76, 1e100, 1e150])
+def test_tiny_and_huge_triangles_keep_their_accuracy(scale):
+    """Far below or above unit size (where the squared normal, the fourth power of the size,
+    under- or overflows) the kernel measures a scaled copy: within its bound of exact."""
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        a, b, c, p = rng.normal(size=(4, 3)) * scale
+        d = point_triangle_distance(p, a, b, c)
+        assert abs(d - exact.point_triangle_distance(p, a, b, c)) <= kernel_bound(p, a, b, c)
 
 
 def test_the_sliver_example_is_exact():

@@ -108,6 +108,37 @@ def test_element_widths_of_known_shapes():
         element_widths(np.zeros((2, 3, 2)))
 
 
+def outline_reach(corners: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """(points (K, 2), radius (K,)): every corner of the convex elements ``corners`` (M, 4, 2,
+    texels; a triangle repeats one) and how far from it the distance texture's outline can
+    reach, ``reach / sin(φ/2)`` for a corner of angle θ, φ = min(θ, π − θ).
+
+    Derivation. At a texel centre the sampler returns the stored byte b of each channel,
+    ``b = round(127.5 + 127.5·v/WIRE_RANGE)`` of one element's exact signed distance v (the
+    element the centre lies deepest inside, else per channel the smallest among the elements
+    whose ring reaches it; then the element that gives the channel passing the test passes it
+    alone): off by half a byte, plus float32 storage and byte arithmetic (a few roundings at
+    magnitudes under 256, each under 2⁻¹⁷ of a byte, together under 2⁻¹⁴), so the decoded value
+    is within ``WIRE_RANGE·(0.5 + 2⁻¹⁴)/127.5`` texels of v. The shader's test, one channel
+    within h of zero and the other ≥ −h, thus says for that element: one line k with
+    |d_k| ≤ h' and every line with d ≥ −h', h' = ``reach`` = h + that. Beside edge k such a
+    centre lies within h' of it. Beyond a corner O of edge k (edge k along +x from O, inside
+    above, the adjacent edge at angle θ), the region |y| ≤ h', x·sin θ − y·cos θ ≥ −h', x ≤ 0
+    has its corners at (0, ±h'), (−h'·cot(θ/2), −h') and (−h'·tan(θ/2), h'): within
+    h'/min(sin(θ/2), cos(θ/2)) = h'/sin(φ/2) of O."""
+    points, radius = [], []
+    for c in corners:
+        q = c[np.linalg.norm(np.roll(c, -1, axis=0) - c, axis=1) > 1e-9]
+        u, v = np.roll(q, 1, axis=0) - q, np.roll(q, -1, axis=0) - q
+        turn = v[:, 0] * np.roll(v, -1, axis=0)[:, 1] - v[:, 1] * np.roll(v, -1, axis=0)[:, 0]
+        assert (turn > 0).all() or (turn < 0).all(), "the derivation needs convex elements"
+        cos = np.einsum("ij,ij->i", u, v) / np.linalg.norm(u, axis=1) / np.linalg.norm(v, axis=1)
+        theta = np.arccos(np.clip(cos, -1.0, 1.0))
+        points.append(q)
+        radius.append(reach / np.sin(np.minimum(theta, np.pi - theta) / 2))
+    return np.concatenate(points), np.concatenate(radius)
+
+
 # ------------------------------------------------------------------------- the scale rule
 ENCODINGS = {"corners": (wireid.MIN_WIDTH, 1.2, 2.2), "distance": (wiretex.MIN_WIDTH, 2.0, 3.0)}
 
@@ -175,12 +206,19 @@ def test_every_outline_is_decodable_within_a_texel_or_drawn_as_lines(seed, grade
     b = np.roll(corners, -1, axis=1).reshape(-1, 2)
     keep = np.linalg.norm(b - a, axis=1) > 1e-9
     if encoding == "distance":
-        # precision: every texel centre the texture outlines lies within a texel of an edge
+        # precision: every texel centre the texture outlines lies within h' of an edge, or
+        # within h'/sin(φ/2) of a corner of angle φ (outline_reach gives the derivation)
         h, w = o.wire_map.shape[:2]
         jj, ii = np.meshgrid(np.arange(w), np.arange(h))
         centres = np.c_[jj.ravel() + 0.5, ii.ravel() + 0.5]
-        hit = centres[on_outline(o, centres, 0.5)]
-        assert len(hit) and segment_distance(hit, a[keep], b[keep]).max() <= 1.0
+        half = 0.5
+        hit = centres[on_outline(o, centres, half)]
+        reach = half + wiretex.WIRE_RANGE * (0.5 + 2.0 ** -14) / 127.5
+        corner, radius = outline_reach(corners, reach)
+        far = hit[segment_distance(hit, a[keep], b[keep]) > reach]
+        beyond = np.linalg.norm(far[:, None] - corner[None], axis=2) - radius[None]
+        # 1e-9: float64 rounding of these distances (under 1e-12 in atlases < 10⁴ texels)
+        assert len(hit) and (beyond.min(axis=1, initial=np.inf) <= 1e-9).all()
         return
     # element ids and corners: along the middle of every edge the decoded distance is within a
     # quarter texel of zero, and anywhere in an element it is never below the true distance to

@@ -847,10 +847,11 @@ def test_include_uses_the_parameters_of_the_including_deck(tmp_path):
         f"its includes (it defines no parameter) in '&t'")
 
 
-def test_rendering_a_missing_thickness_draws_the_base_colour():
+def test_rendering_a_missing_thickness_draws_the_no_result_colour():
     from workbench.experiment.measure import measure
     from workbench.gl import create_context
     from workbench.paths import Style, make_path
+    from workbench.paths.colormap import NO_RESULT_COLOR
     from workbench.scene.mesh import FEMesh
 
     mesh = FEMesh(np.array([n[1:] for n in SQUARE[:4]]), np.array([[0, 1, 2, 3]]),
@@ -860,10 +861,10 @@ def test_rendering_a_missing_thickness_draws_the_base_colour():
     m = measure(ctx, mesh, path, size=(32, 32), timed=False)
     assert path.missing_values == 1
     drawn = m.image[(m.image[..., :3] != 255).any(axis=-1)][:, :3].astype(float)
-    base = np.array(Style().base_color) * 255
-    # the lit base colour (a grey-blue times the headlight), no colour of the scale
-    light = drawn.sum(axis=1, keepdims=True) / base.sum()
-    assert len(drawn) and (np.abs(drawn - light * base) <= 1.5).all()
+    missing = np.array(NO_RESULT_COLOR) * 255
+    # the lit no-result colour (pure green times the headlight), no colour of the scale
+    light = drawn.sum(axis=1, keepdims=True) / missing.sum()
+    assert len(drawn) and (np.abs(drawn - light * missing) <= 1.5).all()
 
 
 @pytest.mark.parametrize("lines, expected", [

@@ -32,9 +32,12 @@ All inputs are float64 in model units; translate far-away geometry near the orig
   only within 10 u R of an edge line, where face and edge distances agree to that; a segment
   distance carries at most 10 u R. Summed, 32 u R; the constant doubles it. The worst seen
   against exact rational arithmetic on adversarial inputs (``workbench stress numerics``) is
-  under 3 u R. Because R <= d + (the triangle's longest edge), the error of a distance d to a
-  triangle of longest edge D is at most :func:`distance_rounding` (d, D); that also bounds the
-  error of a minimum over triangles of longest edge <= D.
+  under 3 u R. It holds for triangles of any size whose squared distances are in float64's
+  range (distances between about 1e-154 and 1e154; a triangle far below or above unit size is
+  measured scaled by a power of two, exactly). Because R <= d + (the triangle's longest
+  edge), the error of a distance d to a triangle of longest edge D is at most
+  :func:`distance_rounding` (d, D); that also bounds the error of a minimum over triangles of
+  longest edge <= D.
 * A point built from others by one interpolation (``a + t(b − a)``, a midpoint, a centroid, a
   translation of the model) lies within ``CONSTRUCTION_ERROR · u · M`` of the exact point, M the
   largest coordinate norm; L nested constructions within L times that
@@ -48,6 +51,8 @@ the computed values.
 """
 
 from __future__ import annotations
+
+import math
 
 import numba
 import numpy as np
@@ -66,6 +71,10 @@ CONSTRUCTION_ERROR = 8.0
 # a triangle whose height over its longest edge is at most this share of that edge (float64's
 # unit roundoff) is within that height of its edges, and is measured as its three edges
 _FLAT_REL = 2.0 ** -53
+# the squared longest edge the kernel computes with directly: beyond, the squared normal
+# (its fourth power) would underflow or overflow, and the triangle is measured scaled
+_EDGE_SQ_MIN = 2.0 ** -500
+_EDGE_SQ_MAX = 2.0 ** 500
 
 
 @numba.njit(cache=True, inline="always")
@@ -88,8 +97,35 @@ def _segment_sq(p0, p1, p2, a0, a1, a2, e0, e1, e2):
 @numba.njit(cache=True)
 def _closest_sq(p0, p1, p2, a0, a1, a2, b0, b1, b2, c0, c1, c2):
     """(squared distance, closest point x, y, z) from p to triangle abc, from scalars: the
-    kernel of :func:`closest_point_on_triangle` (scalar arguments: no array passing per
-    call)."""
+    kernel of :func:`closest_point_on_triangle` (scalar arguments: no array passing per call).
+
+    A triangle whose longest edge lies outside [2⁻²⁵⁰, 2²⁵⁰] (where the squared normal, the
+    fourth power of its size, would underflow or overflow) is measured with every difference to
+    its first corner scaled by a power of two that brings that edge near 1 (exact), and the
+    result scaled back. A squared distance outside float64's range (a distance below about
+    1e-154 or above about 1e154) underflows to 0 or overflows to inf."""
+    d, o0, o1, o2, fits = _closest_core(p0, p1, p2, a0, a1, a2, b0, b1, b2, c0, c1, c2)
+    if fits:
+        return d, o0, o1, o2
+    longest = max(abs(b0 - a0), abs(b1 - a1), abs(b2 - a2), abs(c0 - a0), abs(c1 - a1),
+                  abs(c2 - a2), abs(c0 - b0), abs(c1 - b1), abs(c2 - b2))
+    k = math.frexp(longest)[1]
+    # 2^-k in two factors: one would overflow for a subnormal edge (k below -1023)
+    f1, f2 = math.ldexp(1.0, -(k // 2)), math.ldexp(1.0, -(k - k // 2))
+    d, o0, o1, o2, _ = _closest_core((p0 - a0) * f1 * f2, (p1 - a1) * f1 * f2,
+                                     (p2 - a2) * f1 * f2, 0.0, 0.0, 0.0, (b0 - a0) * f1 * f2,
+                                     (b1 - a1) * f1 * f2, (b2 - a2) * f1 * f2,
+                                     (c0 - a0) * f1 * f2, (c1 - a1) * f1 * f2,
+                                     (c2 - a2) * f1 * f2)
+    return (math.ldexp(d, 2 * k), a0 + math.ldexp(o0, k), a1 + math.ldexp(o1, k),
+            a2 + math.ldexp(o2, k))
+
+
+@numba.njit(cache=True)
+def _closest_core(p0, p1, p2, a0, a1, a2, b0, b1, b2, c0, c1, c2):
+    """:func:`_closest_sq` for a triangle whose longest edge lies in [2⁻²⁵⁰, 2²⁵⁰], or whose
+    corners are equal: (squared distance, closest point, True); (0, 0, 0, 0, False) for any
+    other."""
     ab0, ab1, ab2 = b0 - a0, b1 - a1, b2 - a2
     bc0, bc1, bc2 = c0 - b0, c1 - b1, c2 - b2
     ca0, ca1, ca2 = a0 - c0, a1 - c1, a2 - c2
@@ -106,6 +142,10 @@ def _closest_sq(p0, p1, p2, a0, a1, a2, b0, b1, b2, c0, c1, c2):
     else:
         o0, o1, o2, e0, e1, e2, w0, w1, w2, ee = c0, c1, c2, ca0, ca1, ca2, -bc0, -bc1, \
             -bc2, lca
+    if ee > _EDGE_SQ_MAX or (ee < _EDGE_SQ_MIN and (ab0 != 0.0 or ab1 != 0.0 or ab2 != 0.0
+                                                     or ca0 != 0.0 or ca1 != 0.0
+                                                     or ca2 != 0.0)):
+        return 0.0, 0.0, 0.0, 0.0, False
     q0, q1, q2 = p0 - o0, p1 - o1, p2 - o2
     if ee > 0.0:
         # h: the third corner's offset orthogonal to e, twice orthogonalised
@@ -126,9 +166,9 @@ def _closest_sq(p0, p1, p2, a0, a1, a2, b0, b1, b2, c0, c1, c2):
                 nn = _dot(n0, n1, n2, n0, n1, n2)
                 qn = _dot(q0, q1, q2, n0, n1, n2)
                 t = qn / nn
-                return qn * t, p0 - t * n0, p1 - t * n1, p2 - t * n2
+                return qn * t, p0 - t * n0, p1 - t * n1, p2 - t * n2, True
     else:  # three equal corners
-        return _dot(q0, q1, q2, q0, q1, q2), a0, a1, a2
+        return _dot(q0, q1, q2, q0, q1, q2), a0, a1, a2, True
     # outside the face (or a flat triangle): the nearest of the three edges
     best, t = _segment_sq(p0, p1, p2, a0, a1, a2, ab0, ab1, ab2)
     s0, s1, s2_, f0, f1, f2 = a0, a1, a2, ab0, ab1, ab2
@@ -138,7 +178,7 @@ def _closest_sq(p0, p1, p2, a0, a1, a2, b0, b1, b2, c0, c1, c2):
     d, u = _segment_sq(p0, p1, p2, c0, c1, c2, ca0, ca1, ca2)
     if d < best:
         best, t, s0, s1, s2_, f0, f1, f2 = d, u, c0, c1, c2, ca0, ca1, ca2
-    return best, s0 + t * f0, s1 + t * f1, s2_ + t * f2
+    return best, s0 + t * f0, s1 + t * f1, s2_ + t * f2, True
 
 
 @numba.njit(cache=True, inline="always")
