@@ -315,6 +315,8 @@ def test_bad_input_is_refused_naming_the_input():
         hausdorff(v, f, v, f, split="random")
     with pytest.raises(TypeError, match="one_sided"):
         hausdorff(v, f, v, f, one_sided="yes")
+    with pytest.raises(TypeError, match="estimates"):
+        hausdorff(v, f, v, f, estimates=None)
 
 
 # --------------------------------------------------------------------------- the car

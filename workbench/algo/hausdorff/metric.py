@@ -102,6 +102,8 @@ def hausdorff(va, fa, vb, fb, *, one_sided: bool = True, tol: float | None = Non
     vb, fb = check_triangles(vb, fb, "B (vb, fb)")
     if not isinstance(one_sided, (bool, np.bool_)):
         raise TypeError(f"one_sided must be True or False, got {one_sided!r}")
+    if not isinstance(estimates, (bool, np.bool_)):
+        raise TypeError(f"estimates must be True or False, got {estimates!r}")
     if int(max_depth) != max_depth or not 0 <= max_depth <= MAX_DEPTH_LIMIT:
         raise ValueError(f"max_depth must be an integer in [0, {MAX_DEPTH_LIMIT}], "
                          f"got {max_depth!r}")
@@ -119,8 +121,6 @@ def hausdorff(va, fa, vb, fb, *, one_sided: bool = True, tol: float | None = Non
 
     a = _Surface(va - origin, fa)
     b = _Surface(vb - origin, fb)
-    if not isinstance(estimates, (bool, np.bool_)):
-        raise TypeError(f"estimates must be True or False, got {estimates!r}")
     forward = _one_sided(a, b, tol, max_depth, split, origin, start, bool(estimates))
     if one_sided:
         return forward
