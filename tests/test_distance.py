@@ -36,6 +36,7 @@ TINY = 2.11943693e-119  # a triangle this small once divided by a squared normal
 @settings(max_examples=300, deadline=None)
 @given(p=vec3, a=vec3, b=vec3, c=vec3)
 @example(p=np.zeros(3), a=np.zeros(3), b=np.full(3, TINY), c=np.array([0.0, TINY, TINY]))
+@example(p=np.ones(3), a=np.zeros(3), b=np.zeros(3), c=np.full(3, 6.9278465e-300))  # a point
 def test_distance_matches_dense_sampling(p, a, b, c):
     d = point_triangle_distance(p, a, b, c)
     brute, spacing = dense_min(p, a, b, c)
@@ -113,6 +114,10 @@ def test_tiny_and_huge_triangles_keep_their_accuracy(scale):
         a, b, c, p = rng.normal(size=(4, 3)) * scale
         d = point_triangle_distance(p, a, b, c)
         assert abs(d - exact.point_triangle_distance(p, a, b, c)) <= kernel_bound(p, a, b, c)
+        # a point at unit distance from the triangle, however small or large it is
+        q = a + rng.normal(size=3)
+        d = point_triangle_distance(q, a, b, c)
+        assert abs(d - exact.point_triangle_distance(q, a, b, c)) <= kernel_bound(q, a, b, c)
 
 
 def test_the_sliver_example_is_exact():

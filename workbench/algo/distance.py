@@ -75,6 +75,9 @@ _FLAT_REL = 2.0 ** -53
 # (its fourth power) would underflow or overflow, and the triangle is measured scaled
 _EDGE_SQ_MIN = 2.0 ** -500
 _EDGE_SQ_MAX = 2.0 ** 500
+# a triangle smaller than 2^-400 of a point's distance is that far a point (scaling it to unit
+# size would overflow the point's offset)
+_POINT_LIKE = 2.0 ** 400
 
 
 @numba.njit(cache=True, inline="always")
@@ -102,13 +105,26 @@ def _closest_sq(p0, p1, p2, a0, a1, a2, b0, b1, b2, c0, c1, c2):
     A triangle whose longest edge lies outside [2⁻²⁵⁰, 2²⁵⁰] (where the squared normal, the
     fourth power of its size, would underflow or overflow) is measured with every difference to
     its first corner scaled by a power of two that brings that edge near 1 (exact), and the
-    result scaled back. A squared distance outside float64's range (a distance below about
+    result scaled back; one smaller than 2⁻⁴⁰⁰ of the point's offset is measured as its nearest
+    corner. A squared distance outside float64's range (a distance below about
     1e-154 or above about 1e154) underflows to 0 or overflows to inf."""
     d, o0, o1, o2, fits = _closest_core(p0, p1, p2, a0, a1, a2, b0, b1, b2, c0, c1, c2)
     if fits:
         return d, o0, o1, o2
     longest = max(abs(b0 - a0), abs(b1 - a1), abs(b2 - a2), abs(c0 - a0), abs(c1 - a1),
                   abs(c2 - a2), abs(c0 - b0), abs(c1 - b1), abs(c2 - b2))
+    reach = max(abs(p0 - a0), abs(p1 - a1), abs(p2 - a2))
+    if reach > _POINT_LIKE * longest:
+        # the triangle is a point at the distance's resolution (its size below 2^-400 of the
+        # distance): the nearest corner, off by at most that size
+        best, o0, o1, o2 = _dot(p0 - a0, p1 - a1, p2 - a2, p0 - a0, p1 - a1, p2 - a2), a0, a1, a2
+        d = _dot(p0 - b0, p1 - b1, p2 - b2, p0 - b0, p1 - b1, p2 - b2)
+        if d < best:
+            best, o0, o1, o2 = d, b0, b1, b2
+        d = _dot(p0 - c0, p1 - c1, p2 - c2, p0 - c0, p1 - c1, p2 - c2)
+        if d < best:
+            best, o0, o1, o2 = d, c0, c1, c2
+        return best, o0, o1, o2
     k = math.frexp(longest)[1]
     # 2^-k in two factors: one would overflow for a subnormal edge (k below -1023)
     f1, f2 = math.ldexp(1.0, -(k // 2)), math.ldexp(1.0, -(k - k // 2))
