@@ -44,7 +44,7 @@ __all__ = ["TriangleBVH", "bounding_box", "check_triangles", "compacted", "corne
            "used_vertices"]
 
 _CHUNK = 256  # points per parallel work item
-PARALLEL_MIN = 4096  # fewer queries than this run on one thread
+PARALLEL_MIN = 1024  # fewer queries than this run on one thread
 
 
 def bounding_box(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -100,15 +100,15 @@ def check_triangles(vertices, triangles, what: str = "mesh") -> tuple[np.ndarray
         raise ValueError(f"{what}: triangle indices must be integers, got {t.dtype}")
     if not np.issubdtype(v.dtype, np.number) or np.issubdtype(v.dtype, np.complexfloating):
         raise ValueError(f"{what}: vertices must be real numbers, got {v.dtype}")
-    t = t.astype(np.int64)
-    bad = np.flatnonzero(((t < 0) | (t >= len(v))).any(axis=1))
-    if len(bad):
+    t = t.astype(np.int64, copy=False)
+    if t.min() < 0 or t.max() >= len(v):  # the per-triangle search only where it finds some
+        bad = np.flatnonzero(((t < 0) | (t >= len(v))).any(axis=1))
         raise ValueError(f"{what}: {len(bad)} triangles index missing vertices (there are "
                          f"{len(v)}), first {[t[i].tolist() for i in bad[:3]]}")
     v = np.ascontiguousarray(v, dtype=np.float64)
     used = used_vertices(t, len(v))
-    finite = np.isfinite(v[used]).all(axis=1)
-    if not finite.all():
+    if not np.isfinite(v[used]).all():
+        finite = np.isfinite(v[used]).all(axis=1)
         raise ValueError(f"{what}: non-finite coordinates at vertices {used[~finite][:5].tolist()}")
     return v, t
 
@@ -409,7 +409,7 @@ def _nearest_parallel(points, hint, bound_sq, box_lo, box_hi, child, first, coun
 
 
 def _nearest_many(points, *args):
-    # starting the thread pool costs more than a few thousand queries
+    # starting the thread pool costs about as much as a few hundred queries
     if len(points) >= PARALLEL_MIN:
         _nearest_parallel(points, *args)
     else:

@@ -28,7 +28,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from ..bvh import PARALLEL_MIN, bounding_box
+from ..bvh import PARALLEL_MIN, bounding_box, nearest_one
 from ..distance import closest_point_on_triangle
 from .pieces import _shared_edge_plane
 
@@ -50,31 +50,32 @@ def _morton_order(points: np.ndarray) -> np.ndarray:
     """Indices that sort ``points`` (N, 3) along a Morton (Z-order) curve of 21 bits a axis."""
     lo, hi = bounding_box(points)
     span = float((hi - lo).max())
-    scale = (2 ** 21 - 1) / span if span > 0 else 0.0
-    q = np.clip((points - lo) * scale, 0, 2 ** 21 - 1).astype(np.uint64)
-    code = np.zeros(len(points), np.uint64)
-    for axis in range(3):
-        x = q[:, axis]
-        x = (x | (x << np.uint64(32))) & np.uint64(0x1F00000000FFFF)
-        x = (x | (x << np.uint64(16))) & np.uint64(0x1F0000FF0000FF)
-        x = (x | (x << np.uint64(8))) & np.uint64(0x100F00F00F00F00F)
-        x = (x | (x << np.uint64(4))) & np.uint64(0x10C30C30C30C30C3)
-        x = (x | (x << np.uint64(2))) & np.uint64(0x1249249249249249)
-        code |= x << np.uint64(axis)
-    return np.argsort(code, kind="stable")
+    return np.argsort(_morton_codes(points, lo, (2 ** 21 - 1) / span if span > 0 else 0.0))
 
 
 @numba.njit(cache=True, inline="always")
-def _corner_max_sq(tri, face, best_sq, tmp):
-    """The largest squared distance of tri's corners to ``face``, stopping once >= best_sq."""
-    worst = 0.0
-    for i in range(3):
-        d = closest_point_on_triangle(tri[i], face[0], face[1], face[2], tmp)
-        if d > worst:
-            worst = d
-            if worst >= best_sq:
-                return worst
-    return worst
+def _spread(x):
+    """The 21 low bits of x spread to every third bit."""
+    x &= 0x1FFFFF
+    x = (x | (x << 32)) & 0x1F00000000FFFF
+    x = (x | (x << 16)) & 0x1F0000FF0000FF
+    x = (x | (x << 8)) & 0x100F00F00F00F00F
+    x = (x | (x << 4)) & 0x10C30C30C30C30C3
+    return (x | (x << 2)) & 0x1249249249249249
+
+
+@numba.njit(cache=True)
+def _morton_codes(points, lo, scale):
+    """(N,) int64 Morton codes of ``points`` on a grid of ``scale`` cells a unit from ``lo``."""
+    out = np.empty(len(points), np.int64)
+    top = 2 ** 21 - 1
+    for i in range(len(points)):
+        code = 0
+        for k in range(3):
+            q = min(max(int((points[i, k] - lo[k]) * scale), 0), top)
+            code |= _spread(q) << k
+        out[i] = code
+    return out
 
 
 @numba.njit(cache=True, inline="always")
@@ -100,21 +101,37 @@ def _cover_radius(t):
 
 @numba.njit(cache=True)
 def _bound_range(begin, end, tri, tri_vertices, dist, face, faces, target, out):
-    """out[t] for t in [begin, end): the least of the Lipschitz bound from t's corners (exact
-    distances ``dist`` of A's vertices; every point of t is within the cover radius of a
-    corner) and, while above ``target``, the convexity bounds against the nearest faces
-    ``face`` of its corners."""
+    """out[t] for t in [begin, end): the least of the Lipschitz bound from t's corners (upper
+    bounds ``dist`` of the distances of A's vertices, each its distance to the vertex's face
+    ``face``; every point of t is within the cover radius of a corner) and, while above
+    ``target``, the convexity bound against each of its corners' faces (a corner on that face
+    already has its distance: only the others are measured; three corners on one face cost
+    nothing)."""
     tmp = np.empty(3)
     for t in range(begin, end):
-        far = 0.0
-        for i in range(3):
-            far = max(far, dist[tri_vertices[t, i]])
+        v0, v1, v2 = tri_vertices[t, 0], tri_vertices[t, 1], tri_vertices[t, 2]
+        far = max(dist[v0], max(dist[v1], dist[v2]))
+        f0, f1, f2 = face[v0], face[v1], face[v2]
+        if f0 == f1 and f1 == f2:  # convexity against their common face
+            out[t] = far
+            continue
         best = far + _cover_radius(tri[t])
         if best > target:
             best_sq = best * best
-            for i in range(3):
-                f = face[tri_vertices[t, i]]
-                best_sq = min(best_sq, _corner_max_sq(tri[t], faces[f], best_sq, tmp))
+            for j in range(3):
+                f = face[tri_vertices[t, j]]
+                worst = 0.0
+                for i in range(3):
+                    v = tri_vertices[t, i]
+                    if face[v] == f:
+                        d = dist[v] * dist[v]
+                    else:
+                        d = closest_point_on_triangle(tri[t, i], faces[f, 0], faces[f, 1],
+                                                      faces[f, 2], tmp)
+                    worst = max(worst, d)
+                    if worst >= best_sq:
+                        break
+                best_sq = min(best_sq, worst)
                 if best_sq <= target * target:
                     break
             best = min(best, np.sqrt(best_sq))
@@ -177,6 +194,7 @@ def _cut(poly, count, pface, k, m, point, normal, other):
     return m + 1
 
 
+STRIDE = 16  # every STRIDE-th vertex of A (Morton order) measured first
 _MAX_FACES = 8  # faces of B a straddling triangle is cut against
 _MAX_PIECES = 8
 
@@ -291,6 +309,81 @@ def _straddle(idx, tri, tri_vertices, face, faces, neighbours, out) -> None:
         _straddle_range(idx, tri, tri_vertices, face, faces, neighbours, out)
 
 
+@numba.njit(cache=True)
+def _vertex_range(begin, end, points, floor_sq, dist_sq, face, exact, neighbours, box_lo,
+                  box_hi, child, first, count, ref_tri, corners, depth):
+    """Squared distance bounds of ``points[begin:end]`` (in Morton order) to B, some measured
+    already (``exact``): every other point is bounded by its distance to the face of the point
+    before it, or else to one of that face's neighbours, and measured through the tree only
+    where the bound exceeds ``floor_sq`` (the largest squared distance measured so far) -- a
+    point bounded below it can neither raise the lower bound nor needs more than a valid
+    bound."""
+    stack = np.empty(depth + 2, np.int64)
+    stack_d = np.empty(depth + 2)
+    tmp = np.empty(3)
+    near = np.empty(3)
+    previous = -1
+    for i in range(begin, end):
+        if exact[i]:
+            previous = face[i]
+            continue
+        if previous >= 0:
+            t = corners[previous]
+            d = closest_point_on_triangle(points[i], t[0], t[1], t[2], tmp)
+            g = previous
+            k = 0
+            while d > floor_sq and k < neighbours.shape[1] and neighbours[previous, k] >= 0:
+                h = neighbours[previous, k]
+                t = corners[h]
+                e = closest_point_on_triangle(points[i], t[0], t[1], t[2], tmp)
+                if e < d:
+                    d, g = e, h
+                k += 1
+            if d <= floor_sq:
+                dist_sq[i], face[i] = d, g
+                previous = g
+                continue
+        d, f = nearest_one(points[i], previous, np.inf, box_lo, box_hi, child, first, count,
+                           ref_tri, corners, depth, stack, stack_d, tmp, near)
+        dist_sq[i], face[i], exact[i] = d, f, True
+        floor_sq = max(floor_sq, d)  # a measured distance: the lower bound is at least it
+        previous = f
+
+
+@numba.njit(cache=True, parallel=True)
+def _vertex_parallel(points, floor_sq, dist_sq, face, exact, neighbours, box_lo, box_hi, child,
+                     first, count, ref_tri, corners, depth):
+    n = len(points)
+    per = 256
+    for chunk in numba.prange((n + per - 1) // per):
+        _vertex_range(chunk * per, min(n, (chunk + 1) * per), points, floor_sq, dist_sq, face,
+                      exact, neighbours, box_lo, box_hi, child, first, count, ref_tri, corners,
+                      depth)
+
+
+def _vertex_distances(points: np.ndarray, bvh,
+                      neighbours: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(distance bounds, faces, which are exact) of ``points`` (in Morton order) to B: every
+    ``STRIDE``-th point measured first, the others bounded through their neighbour's face (or
+    its neighbours, ``neighbours`` (F, w)) and measured only where that bound exceeds the
+    largest measured distance (:func:`_vertex_range`). The largest exact distance is the
+    largest distance of all."""
+    n = len(points)
+    dist_sq = np.empty(n)
+    face = np.empty(n, np.int64)
+    exact = np.zeros(n, np.bool_)
+    sampled = np.arange(0, n, STRIDE)
+    d, f, _ = bvh.nearest(points[sampled])
+    dist_sq[sampled], face[sampled], exact[sampled] = d * d, f, True
+    args = (points, float(np.max(d * d)), dist_sq, face, exact, neighbours) + \
+        tuple(bvh.arrays())
+    if n >= PARALLEL_MIN:
+        _vertex_parallel(*args)
+    else:
+        _vertex_range(0, n, *args)
+    return np.sqrt(dist_sq), face, exact
+
+
 def cascade(vertices: np.ndarray, tri_vertices: np.ndarray, corners: np.ndarray, bvh,
             neighbours: np.ndarray, tol: float) -> Cascade:
     """Certified upper bounds of the distance to B over every triangle of A (``vertices``
@@ -299,14 +392,17 @@ def cascade(vertices: np.ndarray, tri_vertices: np.ndarray, corners: np.ndarray,
     (F, w), -1 padded; see the module notes. ``tol``: the bracket width sought (bounds at most
     the lower bound + tol are not tightened further)."""
     order = _morton_order(vertices)
-    d_sorted, f_sorted, near_sorted = bvh.nearest(vertices[order])
+    d_sorted, f_sorted, exact = _vertex_distances(np.ascontiguousarray(vertices[order]), bvh,
+                                                  neighbours)
     dist = np.empty(len(vertices))
     face = np.empty(len(vertices), np.int64)
     dist[order], face[order] = d_sorted, f_sorted
-    i = int(np.argmax(d_sorted))
-    lower, point_a, point_b = float(d_sorted[i]), vertices[order[i]], near_sorted[i]
+    i = order[int(np.argmax(np.where(exact, d_sorted, -1.0)))]
+    lower, point_a = float(dist[i]), vertices[i]
+    _, _, near = bvh.nearest(point_a[None])
+    point_b = near[0]
     upper = np.empty(len(corners))
     _bound(corners, tri_vertices, dist, face, bvh.corners, lower + tol, upper)
     _straddle(np.flatnonzero(upper > lower + tol), corners, tri_vertices, face, bvh.corners,
               neighbours, upper)
-    return Cascade(upper, lower, point_a, point_b, len(vertices))
+    return Cascade(upper, lower, point_a, point_b, int(exact.sum()))

@@ -33,22 +33,27 @@ def _ball_radius(t, upper):
     return c, (upper + rho) * (1.0 + _BALL_SLACK)
 
 
+@numba.njit(cache=True, inline="always")
+def _same_point(f, i, g, j):
+    return f[i, 0] == g[j, 0] and f[i, 1] == g[j, 1] and f[i, 2] == g[j, 2]
+
+
 @numba.njit(cache=True)
 def _shared_edge_plane(f, g, normal):
     """The plane through the edge that faces f and g (3, 3) share (equal corner coordinates),
     bisecting the angle between them: writes its unit normal (pointing into f's side) and
     returns the index of a corner of f on it, or -1 when they share no edge or fold onto
-    each other."""
-    shared = np.empty(2, np.int64)
+    each other. Scalars only: no array is allocated."""
+    s0 = s1 = -1
     n_shared = 0
     f_only = -1
     for i in range(3):
-        hit = False
-        for j in range(3):
-            if f[i, 0] == g[j, 0] and f[i, 1] == g[j, 1] and f[i, 2] == g[j, 2]:
-                hit = True
+        hit = _same_point(f, i, g, 0) or _same_point(f, i, g, 1) or _same_point(f, i, g, 2)
         if hit and n_shared < 2:
-            shared[n_shared] = i
+            if n_shared == 0:
+                s0 = i
+            else:
+                s1 = i
             n_shared += 1
         elif not hit:
             f_only = i
@@ -56,32 +61,31 @@ def _shared_edge_plane(f, g, normal):
         return -1
     g_only = -1
     for j in range(3):
-        if not ((g[j, 0] == f[shared[0], 0] and g[j, 1] == f[shared[0], 1]
-                 and g[j, 2] == f[shared[0], 2])
-                or (g[j, 0] == f[shared[1], 0] and g[j, 1] == f[shared[1], 1]
-                    and g[j, 2] == f[shared[1], 2])):
+        if not (_same_point(g, j, f, s0) or _same_point(g, j, f, s1)):
             g_only = j
     if g_only < 0:
         return -1
-    p = f[shared[0]]
-    e = f[shared[1]] - p
-    ee = e[0] * e[0] + e[1] * e[1] + e[2] * e[2]
+    p0, p1, p2 = f[s0, 0], f[s0, 1], f[s0, 2]
+    e0, e1, e2 = f[s1, 0] - p0, f[s1, 1] - p1, f[s1, 2] - p2
+    ee = e0 * e0 + e1 * e1 + e2 * e2
     if ee == 0.0:
         return -1
-    u = f[f_only] - p
-    u = u - (u[0] * e[0] + u[1] * e[1] + u[2] * e[2]) / ee * e
-    w = g[g_only] - p
-    w = w - (w[0] * e[0] + w[1] * e[1] + w[2] * e[2]) / ee * e
-    nu = np.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
-    nw = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    u0, u1, u2 = f[f_only, 0] - p0, f[f_only, 1] - p1, f[f_only, 2] - p2
+    k = (u0 * e0 + u1 * e1 + u2 * e2) / ee
+    u0, u1, u2 = u0 - k * e0, u1 - k * e1, u2 - k * e2
+    w0, w1, w2 = g[g_only, 0] - p0, g[g_only, 1] - p1, g[g_only, 2] - p2
+    k = (w0 * e0 + w1 * e1 + w2 * e2) / ee
+    w0, w1, w2 = w0 - k * e0, w1 - k * e1, w2 - k * e2
+    nu = np.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    nw = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
     if nu == 0.0 or nw == 0.0:
         return -1
-    m = u / nu - w / nw
-    nm = np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2])
+    m0, m1, m2 = u0 / nu - w0 / nw, u1 / nu - w1 / nw, u2 / nu - w2 / nw
+    nm = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
     if not nm > 1e-9:
         return -1
-    normal[:] = m / nm
-    return shared[0]
+    normal[0], normal[1], normal[2] = m0 / nm, m1 / nm, m2 / nm
+    return s0
 
 
 @numba.njit(cache=True)
