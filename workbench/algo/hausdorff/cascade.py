@@ -2,17 +2,22 @@
 hold the largest distance go through the exact refinement (the bracket-only mode of
 :func:`~workbench.algo.hausdorff.hausdorff`, ``estimates=False``).
 
-The distance to B is 1-Lipschitz and, to one face, convex. :func:`cascade` measures every
-vertex of A through B's tree (in Morton order, so that each search starts near the last one's
-answer); their largest distance is the first lower bound. Each triangle T of A is then bounded
-by the cheapest rule that brings it to the lower bound + tol:
+The distance to B is 1-Lipschitz and, to one face, convex. :func:`cascade` first bounds every
+vertex v of A by its distance to one face of B, ``face[v]`` (:func:`_vertex_distances`, in
+Morton order): every ``STRIDE``-th vertex is measured through B's tree, every other one takes
+the face of the vertex before it (or one of that face's neighbours), and is measured through
+the tree only where that bound exceeds the largest distance measured so far. The largest
+measured distance is then the largest of all vertices', the first lower bound, and each bound
+``dist[v] = d(v, face[v])`` is at least the vertex's distance. Each triangle T of A is then
+bounded by the cheapest rule that brings it to the lower bound + tol:
 
 1. **Lipschitz**: every point of T is within its cover radius r (:func:`_cover_radius`) of a
-   corner, so ``max_{p ∈ T} d(p, B) <= max_i d(t_i, B) + r``.
+   corner, so ``max_{p ∈ T} d(p, B) <= max_i dist[t_i] + r``.
 2. **Convexity**: ``max_{p ∈ T} d(p, B) <= max_i d(t_i, g)`` for any face g of B; here the
-   corners' nearest faces.
-3. **Cut along B's edges** (:func:`_straddle_range`): a T whose corners are nearest to
-   different faces straddles their common edges; cut along the planes that bisect those edges
+   corners' faces (a corner's distance to its own face is ``dist``: three corners on one face
+   need no further distance).
+3. **Cut along B's edges** (:func:`_straddle_range`): a T whose corners have different faces
+   straddles their common edges; cut along the planes that bisect those edges
    (the corners' faces and the faces between them, up to ``_MAX_PIECES`` pieces), each piece
    is bounded by rule 2 against its own face, and the pieces cover T.
 
