@@ -1,8 +1,10 @@
 """The two nearest-point hierarchies on the same triangles: TriangleBVH against ElementHierarchy.
 
-:class:`~workbench.algo.bvh.TriangleBVH` (an AABB tree over triangles, with split references of
+:class:`~workbench.algo.nearest.bvh.TriangleBVH` (an AABB tree over triangles, with split
+references of
 long triangles, used by the Hausdorff metric) and
-:class:`~workbench.algo.hierarchy.ElementHierarchy` (the per-part AABB/OBB forest of crash2000
+:class:`~workbench.algo.nearest.hierarchy.ElementHierarchy` (the per-part AABB/OBB forest of
+crash2000
 §4, used for part distances and force-tube section cuts) are built on the same surface: the
 shared LS-DYNA car deck refined 4 x 4 (:func:`workbench.scene.generators.refine`; ``--quick``:
 the plain deck). Both start from the FEMesh: the BVH's build includes triangulating the elements
@@ -38,8 +40,8 @@ import numba
 import numpy as np
 
 from workbench import data
-from workbench.algo.bvh import TriangleBVH
-from workbench.algo.hierarchy import ElementHierarchy, local_origin, used_nodes
+from workbench.algo.nearest.bvh import TriangleBVH
+from workbench.algo.nearest.hierarchy import ElementHierarchy, local_origin, used_nodes
 from workbench.scene.generators import refine
 from workbench.scene.readers import load
 

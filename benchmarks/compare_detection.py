@@ -17,15 +17,15 @@ import itertools
 import tempfile
 from pathlib import Path
 
-from workbench.experiment.measure import Together, measure_together
-from workbench.experiment.provenance import machine_fingerprint, run_record
-from workbench.experiment.run_compare import compare_runs
-from workbench.experiment.stats import StoppingRule
-from workbench.experiment.store import ResultsStore
 from workbench.gl import create_context
 from workbench.gl.context import describe
+from workbench.measurement.rows import Together, measure_together
+from workbench.measurement.stats import StoppingRule
 from workbench.paths import Style, make_path
 from workbench.reliability.faults import slowed
+from workbench.results.compare import compare_runs
+from workbench.results.provenance import machine_fingerprint, run_record
+from workbench.results.store import ResultsStore
 from workbench.scene import generators
 
 PATHS = (("position", {}), ("flat", {}), ("gouraud", {}),

@@ -3,13 +3,13 @@
 The es2008 benchmark (8 semi-cylindrical sheets of 250 × 250 quads, 1 M triangles, seen from
 the front at 1000 × 1000 with per-pixel distance bands, as the compositing table of
 ``table_software_raster`` draws it) is split into 8 domains by space
-(:func:`workbench.scene.domains.split_domains`) and each domain drawn by the software
+(:func:`workbench.distributed.domains.split_domains`) and each domain drawn by the software
 rasterizer. The 8 frames are then composited, in this process, by:
 
-* full-frame binary tree and binary swap (:mod:`workbench.algo.softraster.composite`: whole
+* full-frame binary tree and binary swap (:mod:`workbench.algo.composite.merge`: whole
   frames or halves sent, 16 bytes a pixel);
 * active-pixel binary tree, binary swap and radix-k with factors 2x2x2, 2x4, 4x2 and 8 (direct
-  send) (:mod:`workbench.algo.softraster.active`: bounding box + run lengths of the drawn
+  send) (:mod:`workbench.algo.composite.active`: bounding box + run lengths of the drawn
   pixels sent).
 
 Per schedule: bytes sent between ranks (as the schedule counts them), their share of the
@@ -33,12 +33,12 @@ import time
 
 import numpy as np
 
-from workbench.algo.softraster.active_schedules import active_radix, active_swap, active_tree
-from workbench.algo.softraster.composite import binary_swap, binary_tree, composite
-from workbench.experiment.measure import default_camera
-from workbench.experiment.sortlast import SoftwareDomains
+from workbench.algo.composite.merge import binary_swap, binary_tree, composite
+from workbench.algo.composite.schedules import active_radix, active_swap, active_tree
+from workbench.distributed.domains import split_domains
+from workbench.distributed.sortlast import SoftwareDomains
+from workbench.measurement.rows import default_camera
 from workbench.paths import Style
-from workbench.scene.domains import split_domains
 from workbench.scene.generators import semicylinders
 
 BANDS = dict(field="distance", bands=10)  # the compositing table's shading

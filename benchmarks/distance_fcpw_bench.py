@@ -5,14 +5,14 @@ distance to the nearest triangle of another part within ``--cutoff`` mm (1.5). T
 same model (the shared LS-DYNA car deck refined k x k by
 :func:`workbench.scene.generators.refine`, as the experiment builds it):
 
-* ``ours`` -- :func:`workbench.algo.part_distance.batched_part_distances`: one 4-wide tree
+* ``ours`` -- :func:`workbench.algo.nearest.parts.batched_part_distances`: one 4-wide tree
   searched by groups of nearby nodes, exact float64, numba threads. Query time: each node's
   own parts, the grouping, the search and the results (the tree's build apart).
-* ``fcpw`` -- :mod:`workbench.experiment.distance_refs` tool "fcpw": one vectorized fcpw scene
+* ``fcpw`` -- :mod:`workbench.references.distances` tool "fcpw": one vectorized fcpw scene
   per excluded part set (17 on the car), ``find_closest_points`` with the cut-off as search
   radius, float32, all cores. Query time: the ``find_closest_points`` calls only (not the
   builds, not reading the distances out of fcpw's interaction list).
-* ``hierarchy`` (``--hierarchy``) -- :func:`~workbench.algo.part_distance.part_distances`,
+* ``hierarchy`` (``--hierarchy``) -- :func:`~workbench.algo.nearest.parts.part_distances`,
   the crash2000 AABB hierarchy with one element per leaf (the experiment's Table 2 row).
 
 Checks before timing: our distances equal the hierarchy's to the last bit and those of every
@@ -42,10 +42,10 @@ import numba
 import numpy as np
 
 from workbench import data
-from workbench.algo.distance import points_triangles_distance
-from workbench.algo.hierarchy import local_origin
-from workbench.algo.part_distance import batched_part_distances, node_parts, part_distances
-from workbench.experiment.distance_refs import compare_with_exact, reference_part_distances
+from workbench.algo.nearest.hierarchy import local_origin
+from workbench.algo.nearest.parts import batched_part_distances, node_parts, part_distances
+from workbench.algo.nearest.triangle import points_triangles_distance
+from workbench.references.distances import compare_with_exact, reference_part_distances
 from workbench.scene.generators import refine
 from workbench.scene.readers import load
 

@@ -3,7 +3,7 @@ versions of the point-triangle kernel interleaved.
 
 Times, after one warm-up of each (numba kernels compile or load from their cache):
 
-* ``part_distance`` -- :func:`workbench.algo.part_distance.batched_part_distances`, every
+* ``part_distance`` -- :func:`workbench.algo.nearest.parts.batched_part_distances`, every
   node against the other parts within ``--cutoff`` mm (crash2000 §4.1); query seconds.
 * ``hausdorff_fine_to_coarse`` -- :func:`workbench.algo.hausdorff.hausdorff` from the refined
   car to the car (default tolerance, 1e-4 of the diagonal); seconds.
@@ -56,7 +56,7 @@ def _model(k: int):
 
 def _tasks(car, fine, cutoff):
     from workbench.algo.hausdorff import hausdorff
-    from workbench.algo.part_distance import batched_part_distances
+    from workbench.algo.nearest.parts import batched_part_distances
 
     vc, fc = car.coordinates(0), np.asarray(car.triangulation.triangles, np.int64)
     vf, ff = fine.coordinates(0), np.asarray(fine.triangulation.triangles, np.int64)
@@ -119,7 +119,7 @@ def main() -> None:
         return
     if args.rounds < 1 or args.refine < 1 or not args.cutoff > 0:
         ap.error("--rounds and --refine must be >= 1, --cutoff > 0")
-    import workbench.algo.distance as kernel
+    import workbench.algo.nearest.triangle as kernel
 
     car, fine = _model(args.refine)
     tasks = _tasks(car, fine, args.cutoff)

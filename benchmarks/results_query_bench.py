@@ -28,7 +28,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from workbench.experiment.store import ResultsStore
+from workbench.results.store import ResultsStore
 
 SCENES = ["semicylinders:32", "car", "flange", "membrane", "forcetube"]
 PATHS = ["position", "flat", "gouraud", "vertex_color", "pixel_color", "texture", "software"]

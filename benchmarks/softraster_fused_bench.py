@@ -24,7 +24,7 @@ import time
 from contextlib import ExitStack
 
 from workbench.algo.softraster import RasterOptions
-from workbench.experiment.measure import default_camera, prepared
+from workbench.measurement.rows import default_camera, prepared
 from workbench.paths import SoftwareRasterizer, Style
 from workbench.scene.generators import semicylinders
 

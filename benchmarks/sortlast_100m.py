@@ -2,10 +2,10 @@
 workers, each loading only its own domains from a chunked scene on disk.
 
 Steps: write ``--sheets`` sheets of ``--n``×``--n`` quads (default 8 × 2500²: 100 M triangles)
-as a chunked scene, one domain per sheet (:func:`workbench.experiment.bigscene.
+as a chunked scene, one domain per sheet (:func:`workbench.distributed.bigscene.
 write_semicylinders_chunked`; the writer holds one sheet at a time); start a LocalCluster of
 ``--workers`` worker processes (one thread each); render at ``--size`` with ``--method``
-compositing (default ``local``; :func:`~workbench.experiment.bigscene.run_chunked_sortlast`; a
+compositing (default ``local``; :func:`~workbench.distributed.bigscene.run_chunked_sortlast`; a
 small scene of as many domains first, so that the workers' kernels are compiled), then render
 the reference in this process domain by domain and compare. Printed: triangles, write time, render
 and composite time, triangles/s, bytes moved, each worker's peak resident memory next to the
@@ -46,8 +46,8 @@ def main(argv=None) -> int:
     import dask
     from distributed import Client, LocalCluster
 
-    from workbench.experiment.bigscene import run_chunked_sortlast, write_semicylinders_chunked
-    from workbench.experiment.sortlast import reset_peak_memory
+    from workbench.distributed.bigscene import run_chunked_sortlast, write_semicylinders_chunked
+    from workbench.distributed.sortlast import reset_peak_memory
 
     root = Path(args.folder) if args.folder else Path(tempfile.mkdtemp(prefix="sortlast-100m-"))
     folder = root / "scene"

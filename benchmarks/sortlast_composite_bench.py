@@ -3,7 +3,7 @@
 The es2008 scene (1 M triangles, ``--n``² quads per sheet) is split into ``--domains`` spatial
 domains (default 8), rendered at ``--size`` (default 1000×1000) by the software rasterizer on
 ``--workers`` worker processes (default 2, one thread each), and composited on the workers by
-every schedule of :func:`workbench.experiment.sortlast.render_sortlast`: ``tree`` and
+every schedule of :func:`workbench.distributed.sortlast.render_sortlast`: ``tree`` and
 ``swap`` (whole frames, as before), ``active-tree``, ``active-swap``, ``radix`` (direct
 send, and 2×4) and ``local`` (each worker's domains composited there, one piece sent per
 other worker). The client fetches the final colour (``color_only``, what a display needs) or
@@ -43,11 +43,11 @@ def main(argv=None) -> int:
     import dask
     from distributed import Client, LocalCluster
 
-    from workbench.experiment.measure import default_camera
-    from workbench.experiment.sortlast import GLDomains, SoftwareDomains, render_sortlast
+    from workbench.distributed.domains import split_domains
+    from workbench.distributed.sortlast import GLDomains, SoftwareDomains, render_sortlast
+    from workbench.measurement.rows import default_camera
     from workbench.paths import Style
     from workbench.scene.builtin import fresh_scene
-    from workbench.scene.domains import split_domains
 
     scene = f"semicylinders:{args.n}"
     size = (args.size, args.size)

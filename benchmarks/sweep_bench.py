@@ -133,7 +133,7 @@ def _stamps(points: Path) -> dict[str, tuple[int, int]]:
 
 
 def _stable(out: Path) -> list[dict]:
-    from workbench.experiment.tables import read_table
+    from workbench.output.tables import read_table
     from workbench.sweep import stable_row
 
     return [stable_row(r) for r in read_table(out / "table.csv")]

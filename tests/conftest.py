@@ -6,7 +6,7 @@
   search for examples the everyday run has not met yet, not for CI. Give it a fresh example
   database so stored examples do not stand in for new ones, e.g.
   ``WORKBENCH_HYPOTHESIS_SCALE=20 HYPOTHESIS_STORAGE_DIRECTORY=$(mktemp -d) pytest -p
-  no:cacheprovider tests/test_x.py``; ``--hypothesis-show-statistics`` shows the examples run.
+  no:cacheprovider tests/algo/test_x.py``; ``--hypothesis-show-statistics`` shows the examples run.
 * ``ctx``: an offscreen GL context per test module, skipped with the reason where none can be
   made; a test using it is marked ``gl``.
 * ``car``, ``car_deck``, ``d3plot_file``: the shared LS-DYNA car deck (as a fresh mesh, and as
@@ -75,7 +75,7 @@ def _scale_examples(item, scale: float, done: set) -> None:
 @pytest.fixture(autouse=True, scope="session")
 def session_results_store(tmp_path_factory):
     """The results store of the session: set as ``WORKBENCH_RESULTS`` for every test."""
-    from workbench.experiment.store import RESULTS_ENV
+    from workbench.results.store import RESULTS_ENV
 
     root = tmp_path_factory.mktemp("results")
     before = os.environ.get(RESULTS_ENV)

@@ -151,3 +151,53 @@ def write_keyword_deck(mesh, file, parts: bool = False) -> None:
               for i, (e, pid) in enumerate(zip(mesh.elements, mesh.parts))]
     lines.append("*END")
     file.write_text("\n".join(lines) + "\n")
+
+
+# a two-part keyword deck
+DECK = """*KEYWORD
+*NODE
+       1             0.0             0.0             0.0
+       2           100.0             0.0             0.0
+       3           100.0           100.0             0.0
+       4             0.0           100.0             0.0
+*ELEMENT_SHELL
+       1       1       1       2       3       4
+*END
+"""
+
+
+def write_d3plot(folder, rigid=False):
+    """A two-shell, two-part, three-state d3plot written with lasso-python into ``folder``
+    (its path): stresses on three layers, plastic strain, thickness, and one shell deleted at
+    the last state (``rigid``: the second part rigid, without results, nothing deleted)."""
+    from lasso.dyna import ArrayType, D3plot
+
+    plot = D3plot()
+    coords = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0]], np.float32)
+    plot.arrays[ArrayType.node_coordinates] = coords
+    plot.arrays[ArrayType.node_ids] = np.array([10, 20, 30, 40, 50], np.int32)
+    plot.arrays[ArrayType.element_shell_node_indexes] = np.array([[0, 1, 2, 3], [1, 4, 2, 2]],
+                                                                 np.int32)
+    plot.arrays[ArrayType.element_shell_part_indexes] = np.array([0, 1], np.int32)
+    plot.arrays[ArrayType.element_shell_ids] = np.array([7, 8], np.int32)
+    plot.arrays[ArrayType.part_ids] = np.array([5, 9], np.int32)
+    plot.arrays[ArrayType.global_timesteps] = np.array([0.0, 1e-3, 2e-3], np.float32)
+    plot.arrays[ArrayType.node_displacement] = np.stack(
+        [coords + [0.0, 0.0, 0.5 * t] for t in range(3)]).astype(np.float32)
+    n = 1 if rigid else 2
+    stress = np.zeros((3, n, 3, 6), np.float32)
+    stress[:, :, 0, 0] = 100.0  # mid surface (first of 3 layers): uniaxial 100
+    stress[:, :, 1:, 3] = 50.0  # inner and outer: shear, which must not be picked
+    plot.arrays[ArrayType.element_shell_stress] = stress
+    plastic = np.zeros((3, n, 3), np.float32)
+    plastic[:, :, 0] = [[0.0], [0.01], [0.02]]
+    plot.arrays[ArrayType.element_shell_effective_plastic_strain] = plastic
+    plot.arrays[ArrayType.element_shell_thickness] = np.full((3, n), 1.5, np.float32)
+    if rigid:
+        plot.arrays[ArrayType.part_material_type] = np.array([3, 20], np.int32)
+    else:
+        plot.arrays[ArrayType.element_shell_is_alive] = np.array([[1, 1], [1, 1], [1, 0]],
+                                                                  np.float32)
+    path = folder / "d3plot"
+    plot.write_d3plot(str(path))
+    return path

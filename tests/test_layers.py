@@ -2,8 +2,10 @@
 circle, and no private name is imported across packages.
 
 Layers, bottom to top: ``gl`` (with the shaders, ``glsl``), ``scene`` (with ``data``) →
-``algo`` → ``paths`` → ``experiment`` → ``sweep`` → ``reliability`` → ``cli`` (beside it the
-live Jupyter view, ``viewer``), and the experiment scripts (``reproductions``) on top. A module
+``algo`` → ``paths`` → ``measurement`` and ``output`` → ``references``, ``results``,
+``distributed`` and ``animation`` → ``experiment`` → ``sweep`` → ``reliability`` → ``cli``
+(beside it the live Jupyter view, ``viewer``), and the experiment scripts (``reproductions``)
+on top. A module
 may import its own layer and the layers below. Imports inside functions count: a lazy import
 that points up, or closes a circle, is the same coupling. The one exception is named in
 ``ROOT_FACADE``: the package root (layer 0, since ``sweep`` reads its ``__version__``) hands
@@ -19,8 +21,10 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-LAYERS = {"gl": 0, "scene": 0, "data": 0, "algo": 1, "paths": 2, "experiment": 3, "sweep": 4,
-          "reliability": 5, "cli": 6, "viewer": 6, "reproductions": 7, "glsl": 0, "__init__": 0}
+LAYERS = {"gl": 0, "scene": 0, "data": 0, "glsl": 0, "__init__": 0, "algo": 1, "paths": 2,
+          "measurement": 3, "output": 3, "references": 4, "results": 4, "distributed": 4,
+          "animation": 4, "experiment": 5, "sweep": 6, "reliability": 7, "cli": 8, "viewer": 8,
+          "reproductions": 9}
 # upward imports allowed by name: the package root's lazy ``workbench.view``
 ROOT_FACADE = {("workbench", "workbench.viewer")}
 PACKAGE_DIRS = {"workbench": ROOT / "workbench"}

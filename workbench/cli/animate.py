@@ -2,9 +2,9 @@
 and fields per state) played over its states, written as an MP4 or GIF.
 
 The path is prepared once and each state uploads only its coordinates, normals and field
-values (:class:`~workbench.experiment.animation.FrameLoop`); every frame is the image
+values (:class:`~workbench.animation.frames.FrameLoop`); every frame is the image
 ``workbench render MESH --step K --raw`` draws with the same options, decorated with the
-state's time and, with a field, the colour bar (:mod:`workbench.experiment.decoration`).
+state's time and, with a field, the colour bar (:mod:`workbench.animation.decoration`).
 Printed: what was written, what preparing cost, and per state the median and range of the
 upload and of the draw with its read-back (ms), with the bytes each state uploaded.
 """
@@ -147,10 +147,10 @@ def _progress(total: int):
 
 def cmd_animate(args) -> int:
     """Draw the selected states, write ``--output``, print the costs; 0."""
-    from ..experiment.animation import FrameLoop, check_animated_path
-    from ..experiment.decoration import Decoration
-    from ..experiment.video import check_even, video_target, write_video
+    from ..animation.decoration import Decoration
+    from ..animation.frames import FrameLoop, check_animated_path
     from ..gl import create_context
+    from ..output.video import check_even, video_target, write_video
     from ..paths.registry import scene_path
     from ..scene.builtin import load_mesh
 

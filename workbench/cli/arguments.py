@@ -133,6 +133,6 @@ def apply_process_options(args) -> None:
     if getattr(args, "device", None) is not None:
         os.environ[DEVICE_ENV] = str(device_index(args.device))
     if getattr(args, "verbose", False):
-        from ..experiment.cluster import VERBOSE_ENV
+        from ..distributed.cluster import VERBOSE_ENV
 
         os.environ[VERBOSE_ENV] = "1"

@@ -123,7 +123,7 @@ def check_numba_cache() -> Check:
 
 
 def check_dask(scheduler: str | None) -> Check:
-    from ..experiment.cluster import sweep_cluster
+    from ..distributed.cluster import sweep_cluster
 
     start = time.perf_counter()
     try:

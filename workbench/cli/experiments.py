@@ -50,9 +50,9 @@ def cmd_list(args) -> int:
 
 
 def start_recording(args, command: str):
-    """The :class:`~workbench.experiment.recording.Recorder` of this command's run in the
+    """The :class:`~workbench.results.recording.Recorder` of this command's run in the
     store ``--results`` (or the environment, or ``<figures>/results``) names."""
-    from ..experiment.recording import start_run
+    from ..results.recording import start_run
 
     size = "quick" if getattr(args, "quick", False) else "full"
     return start_run(store_of(args, args.figures).root, command, size=size)

@@ -1,5 +1,5 @@
 """``workbench explode``: the ghost2013 exploded-view animation of one part, offscreen
-(:func:`workbench.experiment.exploded.explode_animation`).
+(:func:`workbench.animation.exploded.explode_animation`).
 
 Each frame is drawn, counting the focus part's visible pixels as it is drawn; the occlusion
 ratio r then advances the offset of the two halves
@@ -78,11 +78,11 @@ def _focus_mesh(spec: str, focus: int):
 
 def cmd_explode(args) -> int:
     """Animate, print a line per frame, write ``--output`` and the reveal; 0."""
-    from ..experiment.exploded import explode_animation
-    from ..experiment.figures import save_animation
-    from ..experiment.measure import default_camera
-    from ..experiment.targets import output_target
+    from ..animation.exploded import explode_animation
     from ..gl import create_context
+    from ..measurement.rows import default_camera
+    from ..output.figures import save_animation
+    from ..output.targets import output_target
     from ..paths import make_path
     from ..paths.exploded import exploded_camera
 

@@ -73,7 +73,7 @@ def cmd_hausdorff(args) -> int:
 def _print_peer(direction: str, va, fa, vb, fb, width: float, args, units: str) -> bool:
     """Compare ours and the peer one-sided in ``direction`` and print it; whether the brackets
     overlap (True where the peer failed: nothing contradicts ours)."""
-    from ..experiment.hausdorff_peers import PEER, compare_with_peer
+    from ..references.cascading_upper_bounds import PEER, compare_with_peer
 
     c = compare_with_peer(va, fa, vb, fb, tol=width, repeats=args.repeats, warmup=1)
     print(f"{PEER} (Sacht & Jacobson, SGP 2024), one-sided {direction}, the same bracket "

@@ -20,7 +20,7 @@ from .arguments import (
 )
 from .render_image import check_drawn, check_extent, write_image
 
-# workbench.experiment.sortlast.METHODS, not imported here: it imports Dask
+# workbench.distributed.sortlast.METHODS, not imported here: it imports Dask
 COMPOSITE_METHODS = ("local", "tree", "swap", "active-tree", "active-swap", "radix")
 
 
@@ -161,7 +161,7 @@ def _render_options(args, kind: str) -> dict:
 def _check_output_and_cluster(args, chunked: bool) -> None:
     """Refuse (ValueError) an output that exists and is not a regular file, one that is not a
     PNG file name, and Dask options without ``--domains`` (or a ``chunked`` scene)."""
-    from ..experiment.targets import output_target
+    from ..output.targets import output_target
 
     if output_target(args.output).suffix.lower() != ".png":
         raise ValueError(f"-o {args.output}: render writes a PNG image; give a file name "
@@ -198,7 +198,7 @@ def _backend(args, path):
 
 def cmd_render(args) -> int:
     """Draw the scene, write ``--output``, print what was drawn; 0."""
-    from ..experiment.measure import measure
+    from ..measurement.rows import measure
     from ..paths import make_path, path_class
     from ..paths.registry import scene_path
     from ..scene.builtin import load_scene

@@ -11,7 +11,7 @@ def write_image(out: Path, image, path, field: str | None, args, title: str,
     """``image`` as a PNG at ``out``: with a colour bar of ``field`` when there is one and a
     colour scale, unless ``--raw``; where ``scene`` (the mesh drawn, at ``args.step``) has
     non-finite values of the field, the bar states the no-result colour and their count."""
-    from ..experiment.figures import save_field_figure, save_png
+    from ..output.figures import save_field_figure, save_png
     from ..paths.colormap import missing_count, no_result_label
 
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -72,8 +72,8 @@ def check_drawn(image, scene, camera, size: tuple[int, int], step: int) -> None:
     far out (1e20 mm among millimetre-sized elements) makes the view that wide."""
     import numpy as np
 
-    from ..experiment.compare import coverage
-    from ..experiment.measure import WHITE
+    from ..measurement.images import coverage
+    from ..measurement.rows import WHITE
 
     if coverage(image, WHITE).any():
         return

@@ -21,7 +21,7 @@ FIXED_BY_CHUNKED = {"field": None, "path": None, "option": None, "wireframe": Fa
 
 def is_chunked_scene(name: str) -> bool:
     """Whether ``name`` is a folder holding a chunked scene's manifest."""
-    from ..paths.chunked import MANIFEST
+    from ..distributed.chunked import MANIFEST
 
     return (Path(name) / MANIFEST).is_file()
 
@@ -44,9 +44,9 @@ def render_domains(args, mesh, path, camera, size) -> int:
     software rasterizer or (``--rasterizer gl``) each worker's own EGL context — or, with
     ``--write-chunked``, written as a chunked scene and drawn from it — composited by depth
     and written like a plain render."""
-    from ..experiment.cluster import sweep_cluster
-    from ..experiment.sortlast import ChunkDomains, GLDomains, SoftwareDomains, render_sortlast
-    from ..scene.domains import split_domains
+    from ..distributed.cluster import sweep_cluster
+    from ..distributed.domains import split_domains
+    from ..distributed.sortlast import ChunkDomains, GLDomains, SoftwareDomains, render_sortlast
 
     if args.all_faces:
         raise ValueError("--domains loads the scene again on each worker; --all-faces is not "
@@ -54,7 +54,7 @@ def render_domains(args, mesh, path, camera, size) -> int:
     domains = split_domains(mesh, args.domains, by=args.split)
     gl = args.rasterizer == "gl"
     if args.write_chunked is not None:
-        from ..paths.chunked import write_chunked
+        from ..distributed.chunked import write_chunked
 
         path.prepare(None, mesh, camera)
         folder = write_chunked(path, domains, args.write_chunked)
@@ -92,11 +92,11 @@ def render_chunked_scene(args) -> int:
     ``--composite`` and written with the colour bar of its field. Refused (ValueError): the
     flags of the path and style, which the scene fixed when it was written, and a view that
     is not orthographic."""
-    from ..experiment.cluster import sweep_cluster
-    from ..experiment.compare import coverage
-    from ..experiment.measure import WHITE
-    from ..experiment.sortlast import ChunkDomains, render_sortlast
-    from ..paths.chunked import ChunkedScene
+    from ..distributed.chunked import ChunkedScene
+    from ..distributed.cluster import sweep_cluster
+    from ..distributed.sortlast import ChunkDomains, render_sortlast
+    from ..measurement.images import coverage
+    from ..measurement.rows import WHITE
     from ..paths.software import SoftwarePath
 
     given = [name for name, default in FIXED_BY_CHUNKED.items()
@@ -133,7 +133,7 @@ def render_chunked_scene(args) -> int:
 def _write_chunked_image(out: Path, color, manifest: dict, args, title: str) -> None:
     """The image of a chunked scene, with the colour bar of its field and scale (unless
     ``--raw``), stating the triangles drawn in the no-result colour where there are any."""
-    from ..experiment.figures import save_field_figure, save_png
+    from ..output.figures import save_field_figure, save_png
     from ..paths.colormap import no_result_label
 
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -21,9 +21,9 @@ def add_results_option(parser) -> None:
 
 
 def store_of(args, figures: str | Path = "figures"):
-    """The :class:`~workbench.experiment.store.ResultsStore` that ``args.results`` (or the
+    """The :class:`~workbench.results.store.ResultsStore` that ``args.results`` (or the
     environment, or ``figures``) names."""
-    from ..experiment.store import ResultsStore, results_root
+    from ..results.store import ResultsStore, results_root
 
     return ResultsStore(results_root(getattr(args, "results", None), figures=figures))
 
@@ -96,7 +96,7 @@ def add_parser(subparsers) -> None:
 
 
 def _print_table(table, limit: int | None = None) -> None:
-    from ..experiment.tables import markdown_table
+    from ..output.tables import markdown_table
 
     rows = table.to_pylist()
     shown = rows if limit is None else rows[:limit]
@@ -109,7 +109,7 @@ def cmd_query(args) -> int:
     """``workbench results query``: print the result (or write it as CSV); 0."""
     import duckdb
 
-    from ..experiment.tables import write_table
+    from ..output.tables import write_table
 
     store = store_of(args)
     try:
@@ -129,8 +129,8 @@ def cmd_query(args) -> int:
 def cmd_compare(args) -> int:
     """``workbench results compare A B``: the flagged pairs (or all), a summary line; 1 when a
     change is flagged, 0 otherwise."""
-    from ..experiment.run_compare import THRESHOLD, compare_runs, summary
-    from ..experiment.tables import markdown_table, write_table
+    from ..output.tables import markdown_table, write_table
+    from ..results.compare import THRESHOLD, compare_runs, summary
 
     threshold = THRESHOLD if args.threshold is None else args.threshold
     lines = compare_runs(store_of(args), args.a, args.b, threshold=threshold,
@@ -174,7 +174,7 @@ def cmd_pareto(args) -> int:
 def cmd_report(args) -> int:
     """``workbench results report``: rewrite the README's claims and docs/results.md; 0."""
     from ..experiment.report import write_report
-    from ..experiment.targets import output_target
+    from ..output.targets import output_target
 
     # refused before the README is read: reading a FIFO would block
     written = write_report(store_of(args), *map(output_target, (args.readme, args.doc)))

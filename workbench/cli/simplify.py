@@ -20,8 +20,8 @@ def add_parser(subparsers) -> None:
 def cmd_simplify(args) -> int:
     """Print the triangle counts, time, tolerance and collapses, and write ``--output``; 0."""
     from ..algo.simplify import hausdorff_decimate
-    from ..experiment.export import write_surface
-    from ..experiment.targets import output_target
+    from ..output.export import write_surface
+    from ..output.targets import output_target
     from ..scene.builtin import load_mesh
 
     if args.output:

@@ -16,7 +16,7 @@ from .results import add_results_option, store_of
 
 def cmd_sweep(args) -> int:
     """``workbench sweep``: run the config, print the summary; 1 when a point failed."""
-    from ..experiment.recording import start_run
+    from ..results.recording import start_run
     from ..sweep import load_config, run_sweep
 
     config = load_config(args.config)

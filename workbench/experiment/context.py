@@ -23,17 +23,17 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from ..data import shared_file
-from .stats import StoppingRule
-from .tables import write_table
-from .timing import empty_gpu_note
+from ..measurement.stats import StoppingRule
+from ..measurement.timing import empty_gpu_note
+from ..output.tables import write_table
 
 if TYPE_CHECKING:
     import moderngl
 
+    from ..measurement.rows import Measurement
     from ..paths.backends import Backend
     from ..paths.base import RenderPath
     from ..scene.protocol import Scene
-    from .measure import Measurement
 
 T = TypeVar("T")
 
@@ -116,7 +116,7 @@ class ExperimentContext:
         return FULL_STOP if self.size == "full" else QUICK_STOP
 
     def ratio_stop(self, max_samples: int | None = None) -> StoppingRule:
-        """When interleaved pairs stop (:mod:`workbench.experiment.interleave`): the ratio's
+        """When interleaved pairs stop (:mod:`workbench.measurement.interleave`): the ratio's
         95 % interval within ±2 % (full, 9 to 61 pairs) or ±5 % (quick, 5 to 11); 5 pairs at
         tiny size. ``max_samples`` lowers the most pairs (for slow peers)."""
         rule = self.pick(FULL_RATIO_STOP, QUICK_RATIO_STOP, TINY_RATIO_STOP)
@@ -222,10 +222,10 @@ class ExperimentContext:
     def measure(self, scene: Scene, path: str | RenderPath, style: object | None = None, *,
                 backend: moderngl.Context | Backend | None = None,
                 **options: Any) -> Measurement:
-        """:func:`~workbench.experiment.measure.measure` on ``backend`` (default the run's GL
+        """:func:`~workbench.measurement.rows.measure` on ``backend`` (default the run's GL
         context) with this run's repeats and stopping rule unless ``repeats`` or ``stop`` is
         given."""
-        from .measure import measure
+        from ..measurement.rows import measure
 
         options.setdefault("repeats", self.repeats)
         options.setdefault("stop", self.stop)

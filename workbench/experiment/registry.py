@@ -22,14 +22,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ..measurement.timing import empty_gpu_note
+from ..output.tables import current_umask, write_table
+from ..output.targets import output_folder
+from ..results.store import process_alive
 from .context import SIZES, ExperimentContext
-from .store import process_alive
-from .tables import current_umask, write_table
-from .targets import output_folder
-from .timing import empty_gpu_note
 
 if TYPE_CHECKING:
-    from .recording import Recorder
+    from ..results.recording import Recorder
 
 Progress = Callable[[str], None]
 RunFunction = Callable[[ExperimentContext], list]

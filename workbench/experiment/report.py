@@ -19,10 +19,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from .tables import atomic_write_text, format_number, markdown_table
+from ..output.tables import atomic_write_text, format_number, markdown_table
 
 if TYPE_CHECKING:
-    from .store import ResultsStore
+    from ..results.store import ResultsStore
 
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
 Tables = Callable[[str], list[dict[str, Any]]]

@@ -1,6 +1,6 @@
 """What draws a path: a headless GL context, or the es2008 software rasterizer on the CPU.
 
-A backend gives the measurement function (:func:`workbench.experiment.measure.measure`) all it
+A backend gives the measurement function (:func:`workbench.measurement.rows.measure`) all it
 needs to draw and time a path the same way on either renderer:
 
 * :meth:`path` — the drawable for a registry name or a path: the GL path itself, or its

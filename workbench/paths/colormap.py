@@ -48,7 +48,7 @@ field has no non-finite value at any step compile neither (nothing changes for t
 :data:`NO_RESULT_COLOR` is pure green, (0, 1, 0). Lit by any headlight factor in [0.25, 1] it
 stays at least 24/255 (in the largest channel difference) from every colour of viridis, plasma,
 inferno, magma, cividis, turbo, jet, coolwarm, RdBu, Spectral, rainbow, hot, gray, cool and
-spring lit by any factor in [0.25, 1] (tests/test_no_result.py checks it); maps that hold pure
+spring lit by any factor in [0.25, 1] (tests/paths/test_no_result.py checks it); maps that hold pure
 green themselves (hsv, brg, Greens, …) cannot tell it apart. Legends state it with the count of
 values that had none (:func:`no_result_label`). :func:`scale_colour_pixels` counts the pixels
 of a scale's colours in and around a region of an image: the check that no rim of scale colours

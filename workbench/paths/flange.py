@@ -2,7 +2,7 @@
 and the geometry farther than a threshold hidden by an RGBα 1-D texture and the alpha test.
 
 The distance is the derived item ``part_distances``
-(:func:`workbench.algo.part_distance.flange_distances`: exact, float64, to the nearest element of
+(:func:`workbench.algo.nearest.parts.flange_distances`: exact, float64, to the nearest element of
 any part the node does not belong to, up to the distance of interest ``cutoff``), installed on the
 mesh as the node field ``"part_distance"`` and drawn per pixel like ``pixel_color`` (Gouraud light,
 the scalar interpolated and looked up per fragment):
@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..algo.part_distance import flange_distances
+from ..algo.nearest.parts import flange_distances
 from .fields import PixelColorPath
 from .style import Style
 

@@ -8,7 +8,7 @@ deformation plot, normals, colour texture, transfer-function alpha test and clip
 the same pixel rule as llvmpipe and the no-result rule of :mod:`~.colormap` (a triangle with a
 non-finite value drawn whole in :data:`~.colormap.NO_RESULT_COLOR`). It follows the path
 protocol (prepare, set_camera, set_step, draw, release) so that
-:func:`workbench.experiment.measure` times it like any path through the
+:func:`workbench.measurement.rows` times it like any path through the
 :class:`~workbench.paths.backends.SoftwareRasterizer` backend; it draws into a
 :class:`SoftwareTarget` instead of a GL framebuffer, and needs no GL context.
 
@@ -237,7 +237,7 @@ class SoftwarePath(RenderPath):
 
     def raster_inputs(self) -> RasterInputs:
         """What :meth:`draw` rasterizes at the current step, for writing it elsewhere
-        (:func:`workbench.paths.chunked.write_chunked`): float64 drawn vertex coordinates,
+        (:func:`workbench.distributed.chunked.write_chunked`): float64 drawn vertex coordinates,
         normals, values, triangles, shading and model-space clip planes."""
         if self.mesh is None:
             raise ValueError(f"software path {self.name!r} is not prepared")

@@ -66,7 +66,8 @@ def region_walk_closest_point(p, a, b, c, out):
     """The point–triangle kernel before the backward-stable one: Ericson's Voronoi-region walk
     (*Real-Time Collision Detection* §5.1.5) on barycentric dot products, which overstates the
     distance to slivers by up to tens of percent of their size. Same signature as
-    :func:`workbench.algo.distance.closest_point_on_triangle` (writes the point into ``out``,
+    :func:`workbench.algo.nearest.triangle.closest_point_on_triangle` (writes the point into
+    ``out``,
     returns the squared distance)."""
     ab0, ab1, ab2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
     ac0, ac1, ac2 = c[0] - a[0], c[1] - a[1], c[2] - a[2]
@@ -134,9 +135,9 @@ def replaced(module: Any, name: str, value: Any) -> Iterator[Any]:
 @contextmanager
 def region_walk_kernel() -> Iterator[None]:
     """Fault 1: :func:`region_walk_closest_point` as the point–triangle kernel that Python
-    callers look up (``workbench.algo.distance.closest_point_on_triangle``; compiled callers
+    callers look up (``workbench.algo.nearest.triangle.closest_point_on_triangle``; compiled callers
     keep the kernel they were compiled with). The suite's distance check must fail."""
-    from ..algo import distance
+    from ..algo.nearest import triangle as distance
 
     with replaced(distance, "closest_point_on_triangle", region_walk_closest_point):
         yield

@@ -2,14 +2,14 @@
 each against exact rational arithmetic (:mod:`~workbench.reliability.exact`,
 :mod:`~workbench.reliability.exact_planar`). Promises, in model units, with u = 2⁻⁵³:
 
-a. **point–triangle distance** (:func:`workbench.algo.distance.closest_point_on_triangle`,
+a. **point–triangle distance** (:func:`workbench.algo.nearest.triangle.closest_point_on_triangle`,
    looked up on its module at every query, so that a test may replace it): the distance
    within 1e-12·R of the exact one, R = max_i |p − corner_i| (the issue's target; the row
    reports it in those units and its note in units of the documented 64·u·R, which also
    bounds it); the returned point within :data:`POINT_ULPS`·u·M of the triangle (exactly
    measured; M the largest coordinate magnitude of p and the corners).
 b. **part distances** (batched, both hierarchies and the brute force of
-   :mod:`workbench.algo.part_distance`): each node's distance within the documented rounding
+   :mod:`workbench.algo.nearest.parts`): each node's distance within the documented rounding
    (64·u·(d + D) + 2·8·u·M: the kernel, and the translation of the node and of the corners; D
    the longest edge, M the largest coordinate norm) of the exact distance to the other parts,
    inf exactly when that lies beyond the cut-off (either within the rounding of it), and the
@@ -74,9 +74,10 @@ SAMPLE_WEIGHTS = _sample_weights()
 
 def _documented_rounding(distance: float, longest: float, magnitude: float,
                          levels: int) -> float:
-    """The rounding bound of the error model of :mod:`workbench.algo.distance` (its constants,
+    """The rounding bound of the error model of :mod:`workbench.algo.nearest.triangle` (its
+    constants,
     recomputed here so that a fault in its helpers cannot move the check)."""
-    from ..algo.distance import CONSTRUCTION_ERROR, DISTANCE_ERROR
+    from ..algo.nearest.triangle import CONSTRUCTION_ERROR, DISTANCE_ERROR
 
     return (DISTANCE_ERROR * U * (distance + longest)
             + CONSTRUCTION_ERROR * U * magnitude * levels) * (1 + 1e-12)
@@ -85,8 +86,8 @@ def _documented_rounding(distance: float, longest: float, magnitude: float,
 # --------------------------------------------------------------------------- a.
 def check_distances(report, n: int, seed: int) -> None:
     """Check a over ``n`` cases (8 queries each) of every distance generator."""
-    from ..algo import distance as kernels  # the kernel is looked up on it at every query
-    from ..algo.distance import DISTANCE_ERROR
+    from ..algo.nearest import triangle as kernels  # the kernel is looked up on it at every query
+    from ..algo.nearest.triangle import DISTANCE_ERROR
 
     out = np.empty(3)
     for kind in DISTANCE_KINDS:
@@ -152,7 +153,7 @@ def exact_part_minima(mesh) -> list[dict[int, Fraction]]:
 
 def check_part_distances(report, count: int, seed: int) -> None:
     """Check b over ``count`` models of every part generator."""
-    from ..algo import part_distance as pd
+    from ..algo.nearest import parts as pd
 
     functions = {
         "batched": lambda m, c: pd.batched_part_distances(m, c),

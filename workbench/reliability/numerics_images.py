@@ -9,10 +9,10 @@ e. **rasterizer coverage** (:func:`workbench.algo.softraster.render`, fused and 
    covered by exactly one of its (front) triangles ("exactly once", a property of the rule);
    and the rasterizer covers exactly the pixels the rule says, with the triangle it says (its
    triangle index image, and its fragment count against the exact total, back faces too).
-f. **GL against software images** (:func:`workbench.experiment.measure` on the EGL context and
+f. **GL against software images** (:func:`workbench.measurement.rows` on the EGL context and
    on :class:`~workbench.paths.SoftwareRasterizer`) of the fan, the closed mesh, a sliver sheet
    and a sliver sheet 1e7 away, from two views: the share of differing pixels at most the
-   tolerances of tests/test_software_path.py (0 for ``position`` on llvmpipe, 0.5 % for the
+   tolerances of tests/paths/test_software_path.py (0 for ``position`` on llvmpipe, 0.5 % for the
    shaded paths, here counting the pixels off by more than 1/255: the sliver sheets' sloped
    faces put up to 2.3 % of the pixels one level apart in one channel, the rounding of the
    interpolated light; the note gives that share).
@@ -52,7 +52,7 @@ from .numerics_scenes import (
 )
 
 IMAGE_SIZE = (96, 72)
-SHADED_LIMIT = 0.005  # tests/test_software_path.py: shaded paths within 0.5 % of the pixels
+SHADED_LIMIT = 0.005  # tests/paths/test_software_path.py: shaded paths within 0.5 % of the pixels
 SHADED_STEP = 1  # … counting pixels off by more than this (1/255: the rounding of the light)
 COLOUR_TOLERANCE = 3  # in 1/255: texture filtering and interpolation (colormap notes)
 RIM_K = 2  # pixels around a missing region where no scale colour may be
@@ -133,7 +133,7 @@ def gl_context(gl: bool = True):
 
 
 def _image(backend, mesh, name, style, camera, size=IMAGE_SIZE) -> np.ndarray:
-    from ..experiment.measure import measure
+    from ..measurement.rows import measure
 
     return measure(backend, mesh, name, style, camera=camera, size=size, timed=False).image
 
@@ -141,7 +141,7 @@ def _image(backend, mesh, name, style, camera, size=IMAGE_SIZE) -> np.ndarray:
 # --------------------------------------------------------------------------- f.
 def check_gl_against_software(report, seed: int, gl: bool = True) -> None:
     """Check f: every scene generator once, four paths, two views."""
-    from ..experiment.measure import default_camera
+    from ..measurement.rows import default_camera
     from ..paths import SoftwareRasterizer, Style
 
     ctx, renderer = gl_context(gl)

@@ -1,6 +1,6 @@
 """Reliability of the render paths: far from the origin, drawn many times, in another process.
 
-Three checks, each through the one measurement function (:func:`workbench.experiment.measure`):
+Three checks, each through the one measurement function (:func:`workbench.measurement.rows`):
 
 * **far offset** — every checked path draws a scene and the same scene moved 10³ and 10⁷ model
   units away (the camera follows): geometry is uploaded relative to a float64 origin, so the
@@ -79,7 +79,7 @@ def _style(name: str):
 
 
 def _image(ctx, mesh, name: str) -> np.ndarray:
-    from ..experiment.measure import measure
+    from ..measurement.rows import measure
 
     return measure(ctx, mesh, name, _style(name), size=SIZE, timed=False).image
 
@@ -107,7 +107,7 @@ def resident_mib() -> float:
 def check_soak(ctx, report: RenderStressReport, cycles: int, name: str = "pixel_color") -> None:
     """``cycles`` prepare/draw/read/release cycles of path ``name``: no GL object kept after a
     release, RSS growth after :data:`WARMUP_CYCLES` within :data:`RSS_LIMIT_MIB`."""
-    from ..experiment.measure import measure
+    from ..measurement.rows import measure
     from ..paths import make_path
 
     mesh = stress_scene()

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from workbench.experiment.tables import atomic_open
+from workbench.output.tables import atomic_open
 
 
 def save_tradeoff_figure(path: Path, rows: list[dict], title: str) -> None:

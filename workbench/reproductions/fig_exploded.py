@@ -68,15 +68,11 @@ import numpy as np
 
 from workbench.algo.explode import o_max_of, occlusion_ratio, uniform_explosion
 from workbench.experiment.context import Case, ExperimentContext
-from workbench.experiment.figures import (
-    save_animation,
-    save_image_grid,
-    with_progress_bar,
-)
-from workbench.experiment.measure import default_camera
 from workbench.experiment.registry import experiment
 from workbench.gl import Framebuffer, GpuTimer
 from workbench.gl.camera import up_frame
+from workbench.measurement.rows import default_camera
+from workbench.output.figures import save_animation, save_image_grid, with_progress_bar
 from workbench.paths import make_path
 from workbench.paths.exploded import exploded_camera
 from workbench.scene import generators

@@ -63,15 +63,15 @@ from workbench.algo.spacetime.scene import (
     window,
 )
 from workbench.algo.spacetime.slicing import TimeSlicer, polygon_areas, quadrisect, slice_at
-from workbench.experiment.compare import crack_pixels
 from workbench.experiment.context import ExperimentContext
-from workbench.experiment.figures import save_field_figure, save_image_grid
-from workbench.experiment.interleave import draw_clock, interleaved_ratios
-from workbench.experiment.measure import prepared
 from workbench.experiment.registry import experiment
-from workbench.experiment.tables import atomic_open
-from workbench.experiment.timing import time_call
 from workbench.gl import Camera
+from workbench.measurement.images import crack_pixels
+from workbench.measurement.interleave import draw_clock, interleaved_ratios
+from workbench.measurement.rows import prepared
+from workbench.measurement.timing import time_call
+from workbench.output.figures import save_field_figure, save_image_grid
+from workbench.output.tables import atomic_open
 from workbench.paths.colormap import colormap_lut
 from workbench.paths.spacetime import OVERDRAWS, SpacetimeStyle, spacetime_path, top_camera
 

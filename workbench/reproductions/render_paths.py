@@ -8,7 +8,7 @@ over the pixels either draws, and what the path's ``needs`` saved: ``derive_ms``
 crease-split Gouraud vertices), ``skipped_ms`` and ``skipped_bytes`` of the rest, which a scene
 deriving everything would have computed for nothing (both from nothing, on a fresh copy of the
 mesh). A scene's paths are measured together by
-:func:`workbench.experiment.measure.measure_together` (their draws interleaved, each time with
+:func:`workbench.measurement.rows.measure_together` (their draws interleaved, each time with
 its 95 % interval); GPU time is recorded only where the renderer's timer queries time the draw
 (not on llvmpipe, where wall time — draw + ``finish`` — is the time).
 In the same run the same triangles are drawn by pyrender and by pyvista/VTK through EGL at the
@@ -26,19 +26,19 @@ from dataclasses import replace
 
 import numpy as np
 
-from workbench.experiment.compare import compare_drawn, difference_image
 from workbench.experiment.context import ExperimentContext
-from workbench.experiment.figures import save_field_figure, save_image_grid
-from workbench.experiment.interleave import Clock, draw_clock, interleaved_ratios
-from workbench.experiment.measure import Together, measure_together, prepared
-from workbench.experiment.reference import PyrenderReference
-from workbench.experiment.reference_vtk import LIGHTING as VTK_LIGHTING
-from workbench.experiment.reference_vtk import PyvistaReference
 from workbench.experiment.registry import experiment
-from workbench.experiment.timing import time_call
 from workbench.gl import Camera
+from workbench.measurement.images import compare_drawn, difference_image
+from workbench.measurement.interleave import Clock, draw_clock, interleaved_ratios
+from workbench.measurement.rows import Together, measure_together, prepared
+from workbench.measurement.timing import time_call
+from workbench.output.figures import save_field_figure, save_image_grid
 from workbench.paths import Style, make_path
 from workbench.paths.colormap import scale_for
+from workbench.references.pyrender import PyrenderReference
+from workbench.references.pyvista import LIGHTING as VTK_LIGHTING
+from workbench.references.pyvista import PyvistaReference
 from workbench.scene import generators
 from workbench.scene.needs import MESH_ITEMS, derivation_cost
 
@@ -100,7 +100,7 @@ def path_rows(exp: ExperimentContext, label: str, mesh, configs, camera: Camera,
     """One row per path configuration of :func:`path_configs` on ``mesh`` at ``size`` (W, H):
     the measurement, what the path's needs saved, and the colour error against its reference
     configuration where it has one. The configurations are measured together, their draws
-    interleaved (:func:`~workbench.experiment.measure.measure_together`), so that their times
+    interleaved (:func:`~workbench.measurement.rows.measure_together`), so that their times
     hold against each other and against another run. Returns the rows and the images by
     configuration."""
     rows, images = [], {}
@@ -192,7 +192,7 @@ def pyvista_row(exp: ExperimentContext, label: str, mesh, step: int, camera: Cam
 def interleaved_targets(exp: ExperimentContext, mesh, configs: dict, camera: Camera, size,
                         ref: PyrenderReference, vtk: PyvistaReference) -> dict:
     """The ratios the targets state, each measured interleaved (A B A B …, see
-    :mod:`workbench.experiment.interleave`) with its 95 % interval: per-pixel bands over the
+    :mod:`workbench.measurement.interleave`) with its 95 % interval: per-pixel bands over the
     position-only draw; per-pixel bands with 4× MSAA and read-back over pyrender and over
     pyvista/VTK (both read back in their render); and Gouraud with 4× MSAA and read-back (the
     same triangles) over pyvista/VTK. The peers' ratios come from one run, every side drawn

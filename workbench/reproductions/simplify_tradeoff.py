@@ -8,7 +8,7 @@ counts pymeshlab's quadric edge collapse (also with its vertices kept), libigl's
 ``decimate``, open3d's quadric decimation and meshoptimizer's ``simplify``, each run two ways:
 on the whole mesh (free to collapse across part borders) and per part (each part asked for our
 count of that part) with the part borders locked where the tool can lock them (see
-:mod:`workbench.experiment.simplifiers`). Every row states its constraints (``scope``,
+:mod:`workbench.references.simplifiers`). Every row states its constraints (``scope``,
 ``borders``, ``vertices`` kept or moved), the share of the parts' border vertices it kept in
 place, and ``stopped_at`` when the tool could not reach our count. Every result is measured
 with the certified metric
@@ -25,7 +25,7 @@ our bracket.
 
 The metric table also holds cascading-upper-bounds (Sacht & Jacobson, SGP 2024), an
 independent certified bracket (one-sided, one thread; see
-:mod:`workbench.experiment.hausdorff_peers`), at our bracket widths from 1 % to 0.01 % (not
+:mod:`workbench.references.cascading_upper_bounds`), at our bracket widths from 1 % to 0.01 % (not
 1e-6 %: it subdivides one triangle at a time), flagged when its bracket does not overlap our
 tightest.
 
@@ -60,11 +60,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from workbench.algo.bvh import TriangleBVH
 from workbench.algo.hausdorff import hausdorff
+from workbench.algo.nearest.bvh import TriangleBVH
 from workbench.algo.simplify import hausdorff_decimate
 from workbench.experiment.context import ExperimentContext
-from workbench.experiment.hausdorff_peers import (
+from workbench.experiment.registry import experiment
+from workbench.references.cascading_upper_bounds import (
     OUR_BRACKET_CONSTRAINTS,
     PEER,
     PEER_CONSTRAINTS,
@@ -72,8 +73,7 @@ from workbench.experiment.hausdorff_peers import (
     compare_with_peer,
     peer_hausdorff,
 )
-from workbench.experiment.registry import experiment
-from workbench.experiment.simplifiers import (
+from workbench.references.simplifiers import (
     PART_SIMPLIFIERS,
     SIMPLIFIERS,
     igl_hausdorff,

@@ -2,7 +2,7 @@
 today's distance queries beside them, connectivity of parts, flanges and force tubes.
 
 **Hierarchies** (``table.md``): for every node, the float64 distance (within the kernel's
-error bound of the exact one, :mod:`workbench.algo.distance`) to the nearest
+error bound of the exact one, :mod:`workbench.algo.nearest.triangle`) to the nearest
 element of another part within 1.5 mm (the paper's distance of interest), on the car deck and
 its 4 × 4 and 8 × 8 refinements (quick: the car and its 2 × 2 and 4 × 4; tiny: the car and
 its 2 × 2, exact checks on samples, the references on the car alone, small images, 2 crush
@@ -16,7 +16,7 @@ The paper's Table 2 (627 parts, 209 838 elements, SGI Octane R12K/300 MHz) is be
 
 **References** (``references.md``): the same queries through our two exact paths -- the
 crash2000 AABB hierarchy of the main table and the batched 4-wide tree
-(:func:`~workbench.algo.part_distance.batched_part_distances`, median of 3 runs, checked equal
+(:func:`~workbench.algo.nearest.parts.batched_part_distances`, median of 3 runs, checked equal
 to the hierarchy to the last bit) -- and through libigl, open3d (float32; with a local origin
 and on the raw coordinates), trimesh (a sample), coal and fcpw (float32, the cut-off as its
 search radius), per excluded part set (none of them knows parts), with queries/s, the ratio to
@@ -57,19 +57,15 @@ from workbench.algo.forcetube import (
     with_tube,
 )
 from workbench.algo.membrane import with_membrane_stress
-from workbench.algo.part_distance import (
-    batched_part_distances,
-    connectivity,
-    part_distances,
-)
+from workbench.algo.nearest.parts import batched_part_distances, connectivity, part_distances
 from workbench.experiment.context import ExperimentContext
-from workbench.experiment.distance_refs import TOOLS, compare_with_exact, reference_part_distances
-from workbench.experiment.figures import save_field_figure, save_image_grid
-from workbench.experiment.measure import default_camera
 from workbench.experiment.registry import experiment
-from workbench.experiment.tables import atomic_open
+from workbench.measurement.rows import default_camera
+from workbench.output.figures import save_field_figure, save_image_grid
+from workbench.output.tables import atomic_open
 from workbench.paths import Style
 from workbench.paths.flange import FlangeStyle
+from workbench.references.distances import TOOLS, compare_with_exact, reference_part_distances
 from workbench.scene import generators
 
 CUTOFF = 1.5  # mm, crash2000 §4.1
@@ -129,7 +125,7 @@ def _exact_sample(mesh, nodes: np.ndarray) -> np.ndarray:
     """Exact distances (rational arithmetic, rounded to float64) of ``nodes`` to the triangles
     of the parts not their own, inf beyond the cut-off; in the same local coordinates as ours
     (the centre of the used nodes' box)."""
-    from workbench.algo.part_distance import node_parts
+    from workbench.algo.nearest.parts import node_parts
     from workbench.reliability.exact import nearest_distance
 
     coords = mesh.coordinates(0)

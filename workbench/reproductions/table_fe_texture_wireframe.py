@@ -22,7 +22,7 @@ panels) and each of the paper's parameter sets A and B
   ``d``, whichever is smaller, model units and % of the diagonal, beside ``d``), wire-frame
   fidelity against the line-overdraw image (precision, recall and IoU of wire pixels with a
   one-pixel tolerance,
-  :func:`workbench.experiment.compare.wire_agreement`), and SSIM of the image against the
+  :func:`workbench.measurement.images.wire_agreement`), and SSIM of the image against the
   ``reference`` (shaded paths against "original, shaded", wire paths against the overdraw);
   Set A's rows come also built with the paper's rules (``[paper]``), with the certified
   distance bound alone (``[certified d, paper texture]``) and with the distance texture under
@@ -67,12 +67,12 @@ from workbench.algo.fepatch.pipeline import (
     build_model,
 )
 from workbench.algo.hausdorff import hausdorff
-from workbench.experiment.compare import compare_images, wire_agreement
 from workbench.experiment.context import Case, ExperimentContext
-from workbench.experiment.figures import save_image_grid
 from workbench.experiment.registry import experiment
-from workbench.experiment.tables import atomic_open
 from workbench.gl import Camera
+from workbench.measurement.images import compare_images, wire_agreement
+from workbench.output.figures import save_image_grid
+from workbench.output.tables import atomic_open
 from workbench.paths import Style
 from workbench.scene import generators
 from workbench.scene.mesh import FEMesh
@@ -179,7 +179,7 @@ class Drawer:
         self.camera = Camera.fit_box(lo, hi, aspect=size[0] / size[1], **VIEW)
 
     def draw(self, name: str, style: Style, scene=None):
-        """The :class:`~workbench.experiment.measure.Measurement` of path ``name`` drawing
+        """The :class:`~workbench.measurement.rows.Measurement` of path ``name`` drawing
         ``scene`` (default the mesh; or a TexturedSurface built by the caller)."""
         return self.exp.measure(self.mesh if scene is None else scene, name, style,
                                 camera=self.camera, size=self.size)

@@ -29,13 +29,13 @@ from itertools import islice
 from pathlib import Path
 
 from workbench.algo.strips import quad_strips, tri_strips
-from workbench.experiment.compare import difference_map, wire_agreement
 from workbench.experiment.context import Case, ExperimentContext
-from workbench.experiment.figures import save_image_grid
 from workbench.experiment.registry import experiment
-from workbench.experiment.tables import atomic_open
-from workbench.experiment.timing import time_call
 from workbench.gl import Camera, VertexShaderInvocations
+from workbench.measurement.images import difference_map, wire_agreement
+from workbench.measurement.timing import time_call
+from workbench.output.figures import save_image_grid
+from workbench.output.tables import atomic_open
 from workbench.paths import Style
 from workbench.scene import generators
 

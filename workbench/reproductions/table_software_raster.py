@@ -8,7 +8,7 @@ by the EGL paths on the GL context (position-only, the floor; flat; per-pixel ba
 and by the software rasterizer (:mod:`workbench.algo.softraster`) with the same shading: with
 llvmpipe's pixel rule (half-space generator, 8 sub-pixel bits, with and without early depth
 rejection), with 0 sub-pixel bits, and with the span table for S = 10, 15, 20. Per row: wall
-time (median of the timed draws, through :func:`~workbench.experiment.measure.measure`),
+time (median of the timed draws, through :func:`~workbench.measurement.rows.measure`),
 triangles/s, the speed against llvmpipe's position-only draw and against llvmpipe's draw of the
 same shading in this run, fragments, table-fit share, and the image against the EGL image of
 the same shading (share of differing pixels, largest difference; the EGL row named in
@@ -57,13 +57,13 @@ from workbench.algo.softraster.spantable import (
     forget_tables,
     span_table,
 )
-from workbench.experiment.compare import compare_images, difference_map
 from workbench.experiment.context import ExperimentContext
-from workbench.experiment.figures import save_image_grid
-from workbench.experiment.interleave import draw_clock, interleaved_ratios
-from workbench.experiment.measure import default_camera, prepared
 from workbench.experiment.registry import experiment
-from workbench.experiment.tables import atomic_open
+from workbench.measurement.images import compare_images, difference_map
+from workbench.measurement.interleave import draw_clock, interleaved_ratios
+from workbench.measurement.rows import default_camera, prepared
+from workbench.output.figures import save_image_grid
+from workbench.output.tables import atomic_open
 from workbench.paths import SoftwareRasterizer, Style
 from workbench.paths.software import SoftwarePath
 from workbench.scene.generators import semicylinders
@@ -350,9 +350,9 @@ def composite_rows(exp: ExperimentContext) -> list[dict]:
     tiny 16 × 16 at 100 × 100) split into D = 1, 2, 4, 8 domains (tiny 1, 2) by space and by
     part, drawn on a LocalCluster of 2 worker processes and composited by every schedule of
     :data:`COMPOSITE_METHODS`, against the one-process image."""
-    from workbench.experiment.cluster import sweep_cluster
-    from workbench.experiment.sortlast import SoftwareDomains, render_sortlast
-    from workbench.scene.domains import split_domains
+    from workbench.distributed.cluster import sweep_cluster
+    from workbench.distributed.domains import split_domains
+    from workbench.distributed.sortlast import SoftwareDomains, render_sortlast
 
     n = exp.pick(250, 64, 16)
     spec = f"semicylinders:{n}"

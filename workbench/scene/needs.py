@@ -15,7 +15,7 @@ The items registered here are the mesh's own:
 
 Algorithms register theirs next to their code: ``fepatch`` (the fe2003 model of
 ``Style.fepatch``, :mod:`workbench.algo.fepatch.model`) and ``part_distances`` (every node's
-distance to the nearest other part, :mod:`workbench.algo.part_distance`).
+distance to the nearest other part, :mod:`workbench.algo.nearest.parts`).
 
 Cache keys are tuples ``(name, *parameters)``: ``("triangles",)``, ``("gouraud", 30.0)``,
 ``("fepatch", "A")``, ``("part_distances", 50.0, 0)``. :func:`derived_items` lists the keys a

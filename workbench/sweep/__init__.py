@@ -36,7 +36,7 @@ value when written as such; a list of them sweeps them.
 
 **Simplification**: ``simplifier`` names "ours"
 (:func:`workbench.algo.simplify.hausdorff_decimate`), a reference simplifier of
-:mod:`workbench.experiment.simplifiers` ("pymeshlab quadric", "open3d quadric",
+:mod:`workbench.references.simplifiers` ("pymeshlab quadric", "open3d quadric",
 "meshoptimizer simplify", "libigl qslim", "libigl decimate") or "none";
 ``tolerance`` is in % of each part's bounding-sphere diameter (default 0.5), and the reference
 simplifiers aim at the triangle count ours reaches at that tolerance.

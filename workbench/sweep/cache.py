@@ -6,8 +6,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..experiment.tables import atomic_write_text
-from ..experiment.targets import output_folder
+from ..output.tables import atomic_write_text
+from ..output.targets import output_folder
 from .points import Point
 
 

@@ -158,7 +158,7 @@ def load_config(path) -> SweepConfig:
     a grid key that none of the grid's paths takes, option values a path's style refuses,
     ``repeats`` < 5, a ``metric`` the sweep cannot give; OSError for a missing file.
     """
-    from ..experiment.timing import MIN_REPEATS
+    from ..measurement.timing import MIN_REPEATS
     from ..paths import path_options
 
     path = Path(path)

@@ -7,7 +7,7 @@ import itertools
 import math
 from pathlib import Path
 
-from ..experiment.tables import finite_number
+from ..output.tables import finite_number
 
 
 def pareto_front(points: list[tuple[float, float]]) -> list[int]:
@@ -47,7 +47,7 @@ def save_pareto(path: Path, rows: list[dict], *, time_column: str, metric: str |
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from ..experiment.tables import atomic_write_bytes
+    from ..output.tables import atomic_write_bytes
 
     fig = Figure(figsize=(8, 5.5), dpi=100)
     FigureCanvasAgg(fig)

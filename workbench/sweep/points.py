@@ -3,7 +3,7 @@
 
 A point loads a fresh copy of its scene (so ``derive_ms``/``derive_bytes`` do not depend on
 which points a worker ran before), optionally simplifies it, draws it with its path through
-:func:`workbench.experiment.measure.measure` (timed under the host's draw lock, or once
+:func:`workbench.measurement.rows.measure` (timed under the host's draw lock, or once
 untimed) and compares the image with the reference path's image of the unsimplified scene
 with the same options. Simplification, the certified Hausdorff distance and the reference
 image are error-only work and take no lock.
@@ -19,7 +19,7 @@ from functools import lru_cache
 
 import numpy as np
 
-# simplifier names a grid may use: ours, the references of workbench.experiment.simplifiers,
+# simplifier names a grid may use: ours, the references of workbench.references.simplifiers,
 # and "none" (the scene as it is: Hausdorff distance 0)
 OURS = "ours"
 NO_SIMPLIFIER = "none"
@@ -29,8 +29,8 @@ HAUSDORFF_BRACKET = 1e-6
 
 def simplifier_names() -> tuple[str, ...]:
     """Every simplifier a grid may name: "none", "ours" (Hausdorff-bounded decimation), then
-    the reference simplifiers of :data:`workbench.experiment.simplifiers.SIMPLIFIERS`."""
-    from ..experiment.simplifiers import SIMPLIFIERS
+    the reference simplifiers of :data:`workbench.references.simplifiers.SIMPLIFIERS`."""
+    from ..references.simplifiers import SIMPLIFIERS
 
     return (NO_SIMPLIFIER, OURS, *SIMPLIFIERS)
 
@@ -139,7 +139,7 @@ def simplified_scene(mesh, point: Point):
     fails or returns nothing raises RuntimeError; a scene that is no FE mesh, ValueError.
     """
     from ..algo.hausdorff import hausdorff
-    from ..experiment.simplifiers import simplify_with
+    from ..references.simplifiers import simplify_with
     from ..scene.mesh import FEMesh
     if mesh.kind != "mesh":
         raise ValueError(f"simplifier {point.simplifier!r} needs an FE mesh scene, "
@@ -180,7 +180,7 @@ def simplified_scene(mesh, point: Point):
 def _reference_image(ctx, point: Point, scene, camera, measured):
     """The reference path's image of the unsimplified, unsplit scene with the point's options:
     the point's own image when it draws the reference path on that very scene."""
-    from ..experiment.measure import measure
+    from ..measurement.rows import measure
 
     if point.reference == point.path and point.simplifier in (None, NO_SIMPLIFIER) \
             and point.quadrisection is None:
@@ -199,9 +199,9 @@ def measured_columns(point: Point, ctx) -> dict:
     mean absolute difference in 1/255, share of pixels differing, PSNR in dB, SSIM) against the
     reference image. ValueError when the image shows nothing of the scene (no pixel differs
     from the background)."""
-    from ..experiment.cluster import draw_lock
-    from ..experiment.compare import compare_images
-    from ..experiment.measure import measure
+    from ..distributed.cluster import draw_lock
+    from ..measurement.images import compare_images
+    from ..measurement.rows import measure
     from ..paths import SoftwareRasterizer, make_path
     from ..scene.builtin import fresh_scene
 
@@ -250,7 +250,7 @@ def run_point(point: Point, workers: int, run_id: str) -> dict:
     cluster's worker count), ``host``, ``egl_device`` (the identity of the worker's EGL
     device), ``run_id`` (the run that computed it) — or, when the point raises, its columns
     with ``error`` (one line ``Type: message``)."""
-    from ..experiment.cluster import worker_context, worker_device
+    from ..distributed.cluster import worker_context, worker_device
 
     start = time.perf_counter()
     extra = dict(workers=workers, host=socket.gethostname(), egl_device=worker_device(),

@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..experiment.tables import table_columns, write_table
-from ..experiment.targets import output_folder, output_target
+from ..output.tables import table_columns, write_table
+from ..output.targets import output_folder, output_target
 from .cache import cached_row, json_default, store_row
 from .config import SweepConfig, grid_points, load_config
 from .pareto import save_pareto
@@ -23,7 +23,7 @@ from .sources import point_key
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-    from ..experiment.recording import Recorder
+    from ..results.recording import Recorder
 
 # what every worker imports once its context exists, so that the first point's time is not
 # spent importing
@@ -88,7 +88,7 @@ def run_sweep(config: SweepConfig | str | Path, out_dir, *, workers: int | None 
     ``verbose`` shows Dask's INFO log lines (default: as :func:`sweep_cluster`
     decides).
     """
-    from ..experiment.cluster import sweep_cluster
+    from ..distributed.cluster import sweep_cluster
 
     if not isinstance(config, SweepConfig):
         config = load_config(config)

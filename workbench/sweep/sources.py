@@ -71,17 +71,17 @@ def package_modules(*names: str) -> set[Path]:
 # what every point's row depends on: the path protocol and the mesh paths' common code, the
 # measurement function and the worker's side of a sweep point
 POINT_MODULES = ("paths/base", "paths/colormap", "paths/mesh", "paths/drawdata", "paths/style",
-                 "paths/backends", "experiment/measure", "sweep/points")
-REFERENCE_MODULES = ("experiment/compare",)
-SIMPLIFIER_MODULES = ("algo/simplify", "algo/hausdorff", "experiment/simplifiers")
+                 "paths/backends", "measurement/rows", "sweep/points")
+REFERENCE_MODULES = ("measurement/images",)
+SIMPLIFIER_MODULES = ("algo/simplify", "algo/hausdorff", "references/simplifiers")
 SOFTWARE_MODULES = ("paths/software", "algo/softraster")
 
 
 def point_sources(point: Point, glsl_dir=None) -> dict[str, str]:
     """The source files whose text decides ``point``'s row, name → sha256 of the text: the
     modules of its path and of the reference path, :data:`POINT_MODULES` (``paths/base.py``,
-    ``paths/colormap.py``, ``experiment/measure.py``, ``sweep/points.py`` …),
-    ``experiment/compare.py`` with a reference, the decimation, Hausdorff and simplifier
+    ``paths/colormap.py``, ``measurement/rows.py``, ``sweep/points.py`` …),
+    ``measurement/images.py`` with a reference, the decimation, Hausdorff and simplifier
     modules with a simplifier, the software rasterizer with ``rasterizer = "software"``, the
     modules that make the scene and derive from it (:func:`_scene_modules`), and the shaders
     those path modules name, with their includes, from ``glsl_dir`` (default the workbench's

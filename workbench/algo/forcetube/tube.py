@@ -96,7 +96,7 @@ def force_tube(mesh: FEMesh, control_points, *, steps=None, per_segment: int = 8
     counted crossed element with NaN stress makes that plane's force NaN.
 
     The elements a plane cuts are found through an AABB hierarchy of the step's coordinates
-    (:meth:`workbench.algo.hierarchy.ElementHierarchy.cut_by_plane`, as crash2000 does), or,
+    (:meth:`workbench.algo.nearest.hierarchy.ElementHierarchy.cut_by_plane`, as crash2000 does), or,
     with ``cut=BRUTE_FORCE``, by testing every element; ``cut(step)`` may also return any plane
     query ``(point, normal) -> element indices`` for that step. A trace line that cuts nothing
     yields zero forces.
@@ -189,7 +189,7 @@ def _plane_query(mesh: FEMesh, step: int, cut) -> Callable | None:
     :func:`force_tube`'s ``cut``: an AABB hierarchy of the step (``cut`` None), the
     caller's ``cut(step)``, or None for brute force (``cut`` :data:`BRUTE_FORCE`)."""
     if cut is None:  # the elements a plane cuts, found through a hierarchy of this step
-        from ..hierarchy import ElementHierarchy
+        from ..nearest.hierarchy import ElementHierarchy
 
         query = ElementHierarchy(mesh, step=step).cut_by_plane
     else:

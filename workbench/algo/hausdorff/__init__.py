@@ -6,7 +6,8 @@ only ever gives a lower bound, and sampled tools do not say how far below H they
 
 1. Both meshes are translated by one float64 origin (the centre of A's bounding box), so
    coordinates far from the origin keep their digits in the differences.
-2. **Lower bound**: exact distances (through :class:`~workbench.algo.bvh.TriangleBVH`) of A's
+2. **Lower bound**: exact distances (through :class:`~workbench.algo.nearest.bvh.TriangleBVH`) of
+   A's
    vertices, edge midpoints and face centroids; each is the distance of a point of A, so their
    largest is <= H.
 3. **Upper bound** per triangle T of A: the distance to one face f of B is convex in p, so over
@@ -19,7 +20,7 @@ only ever gives a lower bound, and sampled tools do not say how far below H they
    largest vertex distance: first against the samples' faces and their neighbours only, then,
    for the triangles still above, against every face near each piece, whose exact vertex
    distances raise the lower bound. With ``split="midpoint"`` the triangles are subdivided
-   4 ways by :func:`~workbench.algo.distance.triangle_bounds` against the faces near them
+   4 ways by :func:`~workbench.algo.nearest.triangle.triangle_bounds` against the faces near them
    (slower: where two faces meet, a piece's bound only shrinks with its size). Either way the
    refinement stops when ``upper - lower <= tol`` or at the depth limit (``tol_reached``).
 
@@ -27,7 +28,7 @@ Any face set gives a valid upper bound; a lower bound needs the nearest face of 
 measures, which the candidate sets hold by construction (see :func:`~.polygon._gather`).
 Distances are in model units. The bracket is certified: its ends are rounded outward by the
 bound of their own rounding (:func:`~.metric.bracket_rounding`, the error model of
-:mod:`workbench.algo.distance`: the backward-stable distance kernel's error, and how far the
+:mod:`workbench.algo.nearest.triangle`: the backward-stable distance kernel's error, and how far the
 measured points, built by interpolation, may lie from A), so it holds the exact value, also 0
 for a surface against any refinement of itself, slivers included.
 

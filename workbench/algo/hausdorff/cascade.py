@@ -33,8 +33,8 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from ..bvh import PARALLEL_MIN, bounding_box, nearest_one
-from ..distance import closest_point_on_triangle
+from ..nearest.bvh import PARALLEL_MIN, bounding_box, nearest_one
+from ..nearest.triangle import closest_point_on_triangle
 from .pieces import _shared_edge_plane
 
 
@@ -393,7 +393,8 @@ def cascade(vertices: np.ndarray, tri_vertices: np.ndarray, corners: np.ndarray,
             neighbours: np.ndarray, tol: float) -> Cascade:
     """Certified upper bounds of the distance to B over every triangle of A (``vertices``
     (N, 3), all used, ``tri_vertices`` (K, 3) int64, their ``corners`` (K, 3, 3)), against B's
-    tree ``bvh`` (:class:`~workbench.algo.bvh.TriangleBVH`) and face neighbours ``neighbours``
+    tree ``bvh`` (:class:`~workbench.algo.nearest.bvh.TriangleBVH`) and face neighbours
+    ``neighbours``
     (F, w), -1 padded; see the module notes. ``tol``: the bracket width sought (bounds at most
     the lower bound + tol are not tightened further)."""
     order = _morton_order(vertices)

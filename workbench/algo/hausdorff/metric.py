@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ..bvh import TriangleBVH, bounding_box, check_triangles, compacted, used_vertices
-from ..distance import construction_rounding, distance_rounding, outward
+from ..nearest.bvh import TriangleBVH, bounding_box, check_triangles, compacted, used_vertices
+from ..nearest.triangle import construction_rounding, distance_rounding, outward
 from .cascade import cascade
 from .refine import _locate_in, _refine, _refine_planes, _sample_upper, _tighten
 
@@ -195,7 +195,8 @@ def _one_sided(a: _Surface, b: _Surface, tol: float, max_depth: int, split: str,
         queries += samples
 
     # round the bracket outward by the bound of its own rounding (the error model of
-    # workbench.algo.distance): distances to B's faces, and the points they were measured at,
+    # workbench.algo.nearest.triangle): distances to B's faces, and the points they were measured
+    # at,
     # built by up to `levels` interpolations (samples, cuts or midpoints, the translation)
     estimate = lower
     top = max(float(upper.max(initial=-1.0)), pruned_upper, lower)

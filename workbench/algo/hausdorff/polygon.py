@@ -16,8 +16,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..bvh import nearest_one, within
-from ..distance import closest_point_on_triangle
+from ..nearest.bvh import nearest_one, within
+from ..nearest.triangle import closest_point_on_triangle
 from .pieces import (
     _BALL_SLACK,
     _MAX_POLY,

@@ -7,10 +7,10 @@
   queries); :func:`_refine_planes` -- plane cuts against every face near a triangle, which also
   raises the lower bound (both through :func:`~.polygon._polygon_bounds`).
 * :func:`_refine` and :func:`_locate_in` -- the ``split="midpoint"`` refinement by 4-way
-  subdivision (:func:`~workbench.algo.distance.triangle_bounds`), and the point where the
+  subdivision (:func:`~workbench.algo.nearest.triangle.triangle_bounds`), and the point where the
   lower bound it reports is attained.
 
-The numba kernels take the flat tree of :meth:`~workbench.algo.bvh.TriangleBVH.arrays`;
+The numba kernels take the flat tree of :meth:`~workbench.algo.nearest.bvh.TriangleBVH.arrays`;
 distances are in model units.
 """
 
@@ -19,8 +19,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..bvh import PARALLEL_MIN, within
-from ..distance import closest_point_on_triangle, triangle_bounds
+from ..nearest.bvh import PARALLEL_MIN, within
+from ..nearest.triangle import closest_point_on_triangle, triangle_bounds
 from .pieces import _ball_radius
 from .polygon import _polygon_bounds
 

@@ -2,7 +2,7 @@
 
 How the distance is certified rather than sampled: every original triangle T keeps a small
 *support* S(T) of current faces such that the subdivision bound of
-:func:`workbench.algo.distance.triangle_bounds` certifies ``max_{p ∈ T} d(p, S(T)) <= tol``
+:func:`workbench.algo.nearest.triangle.triangle_bounds` certifies ``max_{p ∈ T} d(p, S(T)) <= tol``
 (the distance to a triangle is convex, so its maximum over a piece of T is at a corner; pieces
 are split four ways at edge midpoints where one face does not cover them). S(T) only holds
 faces of the current mesh, so every point of T is within tol of the simplified surface. A
@@ -23,7 +23,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..distance import (
+from ..nearest.triangle import (
     closest_point_on_triangle,
     construction_rounding,
     distance_rounding,
@@ -60,7 +60,7 @@ def certification_depths(corners: np.ndarray, tol: np.ndarray, max_depth=None) -
 def certificate_rounding(vertices, triangles, tol, depths) -> np.ndarray:
     """(len(tol),) the bound (model units) of the rounding error of a certificate
     ``max_{p ∈ T} d(p, S(T)) <= tol`` for each tolerance ``tol`` (one per part), following the
-    error model of :mod:`workbench.algo.distance`: a corner distance up to tol to a face no
+    error model of :mod:`workbench.algo.nearest.triangle`: a corner distance up to tol to a face no
     longer than the bounding-box diagonal of the used ``vertices`` (N, 3, near the origin), plus
     how far a piece's corners may lie from T after ``depths.max()`` levels of midpoints and the
     translation of the model (which moves T and the faces alike: twice). The certification

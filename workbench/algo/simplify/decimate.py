@@ -119,7 +119,7 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
 
     Guarantee: every point of every input triangle is within its part's tolerance of the
     simplified surface, certified by the convexity bound of
-    :func:`~workbench.algo.distance.triangle_bounds` (recomputed with that function for the
+    :func:`~workbench.algo.nearest.triangle.triangle_bounds` (recomputed with that function for the
     returned ``bounds``), not by sampling. Computation runs in float64 relative to the centre
     of the mesh's bounding box, so far-away models keep their digits.
 

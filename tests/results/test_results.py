@@ -1,0 +1,284 @@
+"""The results store end to end: a run recorded with its provenance, queried through DuckDB,
+compared with another run (no change against itself, the slowed path flagged, only it), and
+the claims report written from it; and the ``workbench results`` command line."""
+
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from workbench.cli import main
+from workbench.experiment.context import ExperimentContext
+from workbench.experiment.registry import EXPERIMENTS, experiment, run_experiment
+from workbench.experiment.report import BEGIN, END, write_report
+from workbench.measurement.rows import Together, measure_together
+from workbench.measurement.stats import StoppingRule
+from workbench.paths import make_path
+from workbench.reliability.faults import slowed
+from workbench.results.compare import compare_runs, measurement_key, select_runs
+from workbench.results.recording import start_run
+from workbench.results.store import ResultsStore
+from workbench.scene import generators
+
+ROOT = Path(__file__).resolve().parents[2]
+NAME = "results_probe"
+PATHS = ("position", "flat", "gouraud")
+SLOWED: dict[str, float] = {}  # path name -> added share of its own draw time
+
+
+def probe(exp: ExperimentContext) -> list[dict]:
+    """Three paths on the semicylinders measured together, one of them slowed by ``SLOWED``;
+    a second table."""
+    mesh = generators.semicylinders(n=64)
+    paths = [make_path(name) for name in PATHS]
+    paths = [slowed(p, exp.gl.finish, SLOWED[p.name]) if p.name in SLOWED else p for p in paths]
+    measured = measure_together(exp.gl, mesh, [Together(p) for p in paths], size=(400, 400),
+                                repeats=9, stop=StoppingRule(0.03, min_samples=9,
+                                                             max_samples=21))
+    rows = [{**m.row, "case": name} for name, m in zip(PATHS, measured)]
+    exp.table([{"scene": mesh.name, "covered": rows[0]["covered_px"]}], "extra", "Extra")
+    return rows
+
+
+@pytest.fixture(scope="module")
+def probe_experiment():
+    experiment(NAME, "three paths for the results-store tests")(probe)
+    yield NAME
+    EXPERIMENTS.pop(NAME, None)
+
+
+def record(store_root: Path, figures: Path, slow: dict[str, float] | None = None) -> str:
+    """Run the probe experiment with ``slow`` paths slowed; its run id."""
+    SLOWED.clear()
+    SLOWED.update(slow or {})
+    try:
+        recorder = start_run(store_root, f"run {NAME}", size="tiny")
+        run_experiment(NAME, figures_root=figures, size="tiny", recorder=recorder)
+    finally:
+        SLOWED.clear()
+    return recorder.run_id
+
+
+@pytest.fixture(scope="module")
+def store(tmp_path_factory, probe_experiment) -> tuple[ResultsStore, list[str]]:
+    """A store with three runs of the probe: two plain, one with gouraud's draw tripled (on
+    this 2-core llvmpipe machine one draw varies by 10–20 % from the next, so a 20 % change is
+    found in most comparisons, not all: see benchmarks/compare_detection.py for the rates).
+
+    The fault spins for twice the time of the draw and its finish; the clock also holds what
+    the spin does not scale (the timer query and a second finish, ε), so the slowed path's
+    time ratio is ``1 + 2 d / (d + ε)`` for a draw of d: above 2 while ε < d, and above 1.5
+    while ε < 3 d. (Doubling the draw gave ``1 + d / (d + ε)``, which crossed 1.5 where ε
+    came near d: a measured 1.497.)"""
+    tmp_path = tmp_path_factory.mktemp("probe")
+    root = tmp_path / "store"
+    runs = [record(root, tmp_path / "f"), record(root, tmp_path / "f"),
+            record(root, tmp_path / "f", {"gouraud": 2.0})]
+    return ResultsStore(root), runs
+
+
+@pytest.mark.gl
+def test_a_recorded_run_has_its_provenance_and_every_table(store):
+    store, (run, *_) = store
+    (meta,) = store.query(f"SELECT * FROM runs WHERE run_id = '{run}'").to_pylist()
+    head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True,
+                          text=True).stdout.strip()
+    if head:
+        assert meta["commit"] == head and meta["dirty"] in (True, False)
+    assert meta["renderer"] and meta["cpu"] and meta["command"] == f"run {NAME}"
+    (machine,) = store.query("SELECT * FROM machines").to_pylist()  # one machine, stored once
+    assert machine["machine_id"] == meta["machine_id"] and machine["logical_cores"] > 0
+    counts = {r["table"]: r["n"] for r in store.query(
+        f"SELECT \"table\", count(*) AS n FROM rows WHERE run_id = '{run}' GROUP BY ALL"
+    ).to_pylist()}
+    assert counts == {"table": 3, "extra": 1}
+    rows = store.query(f"SELECT \"case\", wall_ms, wall_ms_lo, wall_ms_hi, wall_samples_ms, "
+                       f"repeats, gpu_ms FROM rows WHERE run_id = '{run}' AND \"table\" = "
+                       f"'table' ORDER BY row_index").to_pylist()
+    assert [r["case"] for r in rows] == list(PATHS)
+    for r in rows:
+        assert len(r["wall_samples_ms"]) == r["repeats"] >= 9
+        assert r["wall_ms_lo"] <= r["wall_ms"] <= r["wall_ms_hi"]
+
+
+@pytest.mark.gl
+def test_compare_finds_no_change_against_itself_and_flags_only_the_slowed_path(store):
+    store, (a, b, slow) = store
+    itself = compare_runs(store, a, a)
+    assert itself and all(line["ratio"] == 1.0 and not line["flagged"] for line in itself)
+    assert not any(line["errors_changed"] for line in itself)
+    # one draw here varies by 10-20 % from the next and a path's median by up to ~16 % between
+    # runs, so "only it" holds at a threshold above that noise (the default, 10 %, is for
+    # quieter machines; benchmarks/compare_detection.py measures both rates)
+    for base in (a, b):  # the slowed path is flagged against either plain run, and only it
+        lines = compare_runs(store, base, slow, threshold=0.25)
+        flagged = [line for line in lines if line["flagged"]]
+        assert [(line["measurement"].split(",")[0], line["quantity"]) for line in flagged] == [
+            ("case=gouraud", "wall_ms")], [(line["measurement"][:14], line["relative"],
+                                            line["relative_lo"], line["relative_hi"])
+                                           for line in lines]
+        assert flagged[0]["relative"] > 1.5 and flagged[0]["relative_lo"] > 1.1
+
+
+def synthetic_store(root, shifts: dict[str, float], drift: float = 1.0, seed: int = 0,
+                    cv: float = 0.05, n: int = 31) -> tuple[ResultsStore, str, str]:
+    """Two runs of six timed paths with lognormal samples (``cv``): B's path ``p`` is
+    ``shifts[p]`` times A's, and all of B ``drift`` times slower."""
+    rng = np.random.default_rng(seed)
+    store = ResultsStore(root)
+    machine = {"machine_id": "m0", "cpu": "test", "renderer": "test"}
+    store.record_machine(machine)
+    runs = []
+    for side, factor in (("a", 1.0), ("b", drift)):
+        run = f"run-{side}-{seed}"
+        store.record_run({"run_id": run, "machine_id": "m0", "commit": side * 7})
+        rows = []
+        for k in range(6):
+            shift = shifts.get(f"p{k}", 1.0) if side == "b" else 1.0
+            samples = 10.0 * (k + 1) * factor * shift * rng.lognormal(0, cv, n)
+            rows.append({"scene": "s", "path": f"p{k}", "wall_ms": float(np.median(samples)),
+                         "wall_samples_ms": samples.tolist(), "ssim": 0.9})
+        store.append_rows(run, rows, experiment="e", table="t", experiment_size="full")
+        runs.append(run)
+    return store, *runs
+
+
+def test_compare_statistics_on_known_samples(tmp_path):
+    false = flagged = 0
+    for seed in range(10):
+        store, a, b = synthetic_store(tmp_path / f"same{seed}", {}, drift=1.3, seed=seed)
+        lines = compare_runs(store, a, b)
+        false += sum(line["flagged"] for line in lines)
+        assert all(abs(line["drift"] - 1.3) < 0.05 for line in lines)  # the machine, reported
+        store, a, b = synthetic_store(tmp_path / f"slow{seed}", {"p2": 1.2}, drift=0.8,
+                                      seed=seed)
+        lines = {line["measurement"]: line for line in compare_runs(store, a, b)}
+        flagged += lines["path=p2, scene=s"]["flagged"]
+        assert sum(line["flagged"] for line in lines.values()) <= 1
+    assert false == 0 and flagged == 10
+    # without drift correction a slower machine flags everything
+    store, a, b = synthetic_store(tmp_path / "raw", {}, drift=1.3)
+    assert all(line["flagged"] for line in compare_runs(store, a, b, drift=False))
+    # the commit selects the run
+    assert select_runs(store, "aaaa") == ["run-a-0"]
+
+
+def test_measurement_keys_leave_out_who_ran_it_and_the_times():
+    row = {"experiment": "e", "table": "t", "experiment_size": "full", "scene": "s",
+           "path": "p", "renderer": "r1", "run_id": "x", "wall_ms": 1.0, "note_ms": "3"}
+    other = {**row, "renderer": "r2", "run_id": "y", "wall_ms": 2.0}
+    assert measurement_key(row) == measurement_key(other)
+    assert measurement_key(row) != measurement_key({**row, "path": "q"})
+
+
+@pytest.mark.gl
+def test_selectors_name_runs_commits_and_machines(store):
+    store, runs = store
+    assert select_runs(store, runs[0]) == [runs[0]]
+    (machine,) = store.query("SELECT machine_id FROM machines").column(0).to_pylist()
+    assert select_runs(store, machine[:6]) == sorted(runs)
+    with pytest.raises(ValueError, match="no run, commit or machine"):
+        select_runs(store, "zzzz")
+    with pytest.raises(ValueError, match="run selector"):
+        select_runs(store, "a'; DROP")
+
+
+@pytest.mark.gl
+def test_the_report_is_written_from_the_store(tmp_path):
+    store = ResultsStore(tmp_path / "store")
+    readme = tmp_path / "README.md"
+    readme.write_text(f"# x\n\n{BEGIN}\ntyped by hand\n{END}\n\ntail\n")
+    with pytest.raises(ValueError, match="holds no experiment run"):
+        write_report(ResultsStore(tmp_path / "empty"), readme, tmp_path / "doc.md")
+    assert "typed by hand" in readme.read_text()  # refused before writing anything
+    recorder = start_run(store.root, "run probe", size="tiny")  # tiny runs are left out
+    recorder.append([{"scene": "s", "wall_ms": 1.0}], experiment="render_paths",
+                    table="targets", experiment_size="tiny")
+    with pytest.raises(ValueError, match="holds no experiment run"):
+        write_report(store, readme, tmp_path / "doc.md")
+    recorder = start_run(store.root, "run render_paths --quick", size="quick")
+    recorder.append([{"scene": "s", "size": "64x64", "triangles": 8, "contour_wall_ms": 2.0,
+                      "contour_over_position_only": 1.25, "contour_over_position_only_lo": 1.2,
+                      "contour_over_position_only_hi": 1.3,
+                      "contour_msaa_over_pyrender": 0.5, "contour_msaa_over_pyrender_lo": 0.4,
+                      "contour_msaa_over_pyrender_hi": 0.6, "pyrender_ssim": 0.99}],
+                    experiment="render_paths", table="targets", experiment_size="quick")
+    write_report(store, readme, tmp_path / "docs" / "results.md")
+    text = readme.read_text()
+    assert "typed by hand" not in text and text.endswith(f"{END}\n\ntail\n")
+    assert "1.25× [1.20, 1.30] the position-only draw" in text
+    assert "not in the results store yet" in text  # the other experiments
+    doc = (tmp_path / "docs" / "results.md").read_text()
+    assert recorder.run_id in doc and "### targets" in doc and recorder.machine["cpu"] in doc
+    with pytest.raises(ValueError, match="no .* section"):
+        readme.write_text("# no markers\n")
+        write_report(store, readme, tmp_path / "docs" / "results.md")
+
+
+# ---------------------------------------------------------------- the command line
+@pytest.mark.gl
+def test_results_query_prints_writes_csv_and_refuses_bad_sql(store, tmp_path, capsys):
+    store, runs = store
+    base = ["results", "query", "--results", str(store.root)]
+    assert main([*base, "SELECT count(*) AS n FROM runs"]) == 0
+    assert capsys.readouterr().out.split()[-2:] == ["3", "|"]
+    assert main([*base, "SELECT run_id FROM runs ORDER BY run_id", "--csv",
+                 str(tmp_path / "out.csv")]) == 0
+    assert (tmp_path / "out.csv").read_text().split() == ["run_id", *sorted(runs)]
+    assert main([*base, "SELECT nonsense FROM nowhere"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("workbench: error: query refused by DuckDB") and err.count("\n") == 1
+
+
+@pytest.mark.gl
+def test_results_compare_exit_status_says_whether_anything_changed(store, capsys):
+    store, (a, b, slow) = store
+    base = ["results", "compare", "--results", str(store.root), "--threshold", "0.25"]
+    assert main([*base, a, a]) == 0
+    assert "0 flagged as changed (0.0%)" in capsys.readouterr().out
+    assert main([*base, a, slow]) == 1
+    out = capsys.readouterr().out
+    assert "gouraud" in out and "1 flagged as changed" in out
+    assert main([*base, a, "nothing-like-it"]) == 2
+
+
+@pytest.mark.gl
+def test_results_pareto_draws_a_figure_from_a_query(store, tmp_path):
+    store, _ = store
+    out = tmp_path / "p.png"
+    assert main(["results", "pareto", "--results", str(store.root), "-o", str(out),
+                 "--error", "covered_px",
+                 "SELECT path, wall_ms, covered_px FROM rows WHERE \"table\" = 'table'"]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert main(["results", "pareto", "--results", str(store.root), "-o", str(out),
+                 "SELECT path FROM rows"]) == 2
+
+
+@pytest.mark.gl
+def test_workbench_run_records_into_the_chosen_store(probe_experiment, tmp_path):
+    store_dir = tmp_path / "chosen"
+    assert main(["run", NAME, "--quick", "--figures", str(tmp_path / "fig"),
+                 "--results", str(store_dir)]) == 0
+    store = ResultsStore(store_dir)
+    assert len(store.run_ids()) == 1
+    rows = store.query("SELECT experiment, experiment_size, \"table\" FROM rows").to_pylist()
+    assert {(r["experiment"], r["experiment_size"], r["table"]) for r in rows} == {
+        (NAME, "quick", "table"), (NAME, "quick", "extra")}
+    assert not (tmp_path / "fig" / "results").exists()
+
+
+def test_a_slowed_draw_takes_its_share_longer_and_a_negative_share_is_refused():
+    class Busy:
+        def draw(self):
+            end = time.perf_counter() + 0.004
+            while time.perf_counter() < end:
+                pass
+
+    path = slowed(Busy(), lambda: None, 1.0)
+    start = time.perf_counter()
+    path.draw()
+    assert time.perf_counter() - start >= 0.008  # the 4 ms draw, then as long again
+    with pytest.raises(ValueError, match="share"):
+        slowed(Busy(), lambda: None, -0.1)

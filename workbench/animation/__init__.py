@@ -1,0 +1,8 @@
+"""Frame sequences: a time-dependent mesh drawn state by state, and the ghost2013 exploded view.
+
+==============  ==================================================================
+``frames``      the frame loop (:class:`~.frames.FrameLoop`): states drawn through
+                one prepared path
+``exploded``    the exploded-view animation of one part, frame by frame
+``decoration``  the time stamp and colour bar drawn around each frame
+==============  =================================================================="""
