@@ -34,6 +34,7 @@ import numba
 import numpy as np
 
 from ..nearest.bvh import PARALLEL_MIN, bounding_box, nearest_one
+from ..nearest.state import new_search
 from ..nearest.triangle import closest_point_on_triangle
 from .pieces import _shared_edge_plane
 
@@ -315,18 +316,17 @@ def _straddle(idx, tri, tri_vertices, face, faces, neighbours, out) -> None:
 
 
 @numba.njit(cache=True)
-def _vertex_range(begin, end, points, floor_sq, dist_sq, face, exact, neighbours, box_lo,
-                  box_hi, child, first, count, ref_tri, corners, depth):
-    """Squared distance bounds of ``points[begin:end]`` (in Morton order) to B, some measured
+def _vertex_range(begin, end, points, floor_sq, dist_sq, face, exact, neighbours, tree):
+    """Squared distance bounds of ``points[begin:end]`` (in Morton order) to B (its ``tree``, a
+    :class:`~workbench.algo.nearest.state.Tree`), some measured
     already (``exact``): every other point is bounded by its distance to the face of the point
     before it, or else to one of that face's neighbours, and measured through the tree only
     where the bound exceeds ``floor_sq`` (the largest squared distance measured so far) -- a
     point bounded below it can neither raise the lower bound nor needs more than a valid
     bound."""
-    stack = np.empty(depth + 2, np.int64)
-    stack_d = np.empty(depth + 2)
-    tmp = np.empty(3)
-    near = np.empty(3)
+    corners = tree.corners
+    search = new_search(tree.depth)
+    tmp = search.tmp
     previous = -1
     for i in range(begin, end):
         if exact[i]:
@@ -348,22 +348,19 @@ def _vertex_range(begin, end, points, floor_sq, dist_sq, face, exact, neighbours
                 dist_sq[i], face[i] = d, g
                 previous = g
                 continue
-        d, f = nearest_one(points[i], previous, np.inf, box_lo, box_hi, child, first, count,
-                           ref_tri, corners, depth, stack, stack_d, tmp, near)
+        d, f = nearest_one(points[i], previous, np.inf, tree, search)
         dist_sq[i], face[i], exact[i] = d, f, True
         floor_sq = max(floor_sq, d)  # a measured distance: the lower bound is at least it
         previous = f
 
 
 @numba.njit(cache=True, parallel=True)
-def _vertex_parallel(points, floor_sq, dist_sq, face, exact, neighbours, box_lo, box_hi, child,
-                     first, count, ref_tri, corners, depth):
+def _vertex_parallel(points, floor_sq, dist_sq, face, exact, neighbours, tree):
     n = len(points)
     per = 256
     for chunk in numba.prange((n + per - 1) // per):
         _vertex_range(chunk * per, min(n, (chunk + 1) * per), points, floor_sq, dist_sq, face,
-                      exact, neighbours, box_lo, box_hi, child, first, count, ref_tri, corners,
-                      depth)
+                      exact, neighbours, tree)
 
 
 def _vertex_distances(points: np.ndarray, bvh,
@@ -380,8 +377,7 @@ def _vertex_distances(points: np.ndarray, bvh,
     sampled = np.arange(0, n, STRIDE)
     d, f, _ = bvh.nearest(points[sampled])
     dist_sq[sampled], face[sampled], exact[sampled] = d * d, f, True
-    args = (points, float(np.max(d * d)), dist_sq, face, exact, neighbours) + \
-        tuple(bvh.arrays())
+    args = (points, float(np.max(d * d)), dist_sq, face, exact, neighbours, bvh.arrays())
     if n >= PARALLEL_MIN:
         _vertex_parallel(*args)
     else:

@@ -265,11 +265,11 @@ def _bound_triangles(v, f, corners, b, upper, lower, point_a, point_b, tol, max_
             point_a, point_b = point, near[0]
     else:
         new_lower, best_t, best_target, best_radius, refined = _refine(
-            corners, order, upper, lower, tol, max_depth, *bvh.arrays())
+            corners, order, upper, lower, tol, max_depth, bvh.arrays())
         if best_t >= 0:
             # the subdivision raised the lower bound: find the point where it is attained
             found, point = _locate_in(corners[best_t], best_radius, best_target, max_depth,
-                                      *bvh.arrays())
+                                      bvh.arrays())
             if found >= lower:
                 _, _, near = bvh.nearest(point[None])
                 point_a, point_b = point, near[0]

@@ -17,6 +17,7 @@ import numba
 import numpy as np
 
 from ..nearest.bvh import nearest_one, within
+from ..nearest.state import Search
 from ..nearest.triangle import closest_point_on_triangle
 from .pieces import (
     _BALL_SLACK,
@@ -47,21 +48,17 @@ def _gather(poly, n, bound, parent, full, corners, tree, scratch, pool, start):
     ``min(bound + ρ, d(c, B) + 2ρ)`` of c; the second radius keeps the set small for pieces
     far from B. The faces are taken from ``parent`` (the parent piece's faces, which hold the
     nearest face of every point of the parent) by exact distance, or, for a long parent list
-    and ``full``, from the tree (``tree``: box_lo, box_hi, child, first, count, ref_tri,
-    depth; ``scratch``: room for every reference).
+    and ``full``, from the tree (``tree``: a :class:`~workbench.algo.nearest.state.Tree` over
+    ``corners``; ``scratch``: room for every reference).
     """
-    box_lo, box_hi, child, first, count, ref_tri, depth = tree
     c, rho = _piece_ball(poly, n)
     tmp = np.empty(3)
     if full and (len(parent) == 0 or len(parent) > _MANY_FACES):
-        stack = np.empty(depth + 2, np.int64)
-        stack_d = np.empty(depth + 2)
-        near = np.empty(3)
-        d_sq, _ = nearest_one(c, -1, np.inf, box_lo, box_hi, child, first, count, ref_tri,
-                              corners, depth, stack, stack_d, tmp, near)
+        search = Search(np.empty(tree.depth + 2, np.int64), np.empty(tree.depth + 2), tmp,
+                        np.empty(3))
+        d_sq, _ = nearest_one(c, -1, np.inf, tree, search)
         radius = min(bound + rho, np.sqrt(d_sq) + 2.0 * rho) * (1.0 + _BALL_SLACK)
-        m = within(c, radius * radius, box_lo, box_hi, child, first, count, ref_tri, corners,
-                   depth, scratch, _HUGE_FACES)
+        m = within(c, radius * radius, tree, scratch, _HUGE_FACES)
         if m < 0:
             return pool, -1
     else:
@@ -89,8 +86,8 @@ def _gather(poly, n, bound, parent, full, corners, tree, scratch, pool, start):
 def _polygon_bounds(tri, start_upper, target, max_splits, eps, best_point, corners, tree,
                     fixed):
     """(lower, upper) of max over the points p of triangle ``tri`` (3, 3) of d(p, B), B the
-    faces ``corners`` (F, 3, 3) in the tree ``tree`` (box_lo, box_hi, child, first, count,
-    ref_tri, depth), given a valid upper bound ``start_upper``.
+    faces ``corners`` (F, 3, 3) in the tree ``tree`` (a :class:`~workbench.algo.nearest.state.Tree`
+    over them), given a valid upper bound ``start_upper``.
 
     A convex piece Q is bounded by ``min_f max_{v ∈ Q} d(v, f)`` over a set of faces f
     (distance to one face is convex, so its max over Q is at a vertex); the bound is exact when
@@ -112,7 +109,7 @@ def _polygon_bounds(tri, start_upper, target, max_splits, eps, best_point, corne
     without the nearest faces overstates distances) and must be ignored.
     """
     full = len(fixed) == 0
-    depth, ref_tri = tree[6], tree[5]
+    depth, ref_tri = tree.depth, tree.ref_tri
     size = max_splits + 4
     poly, count_v, depth_v, kind, bound, parent_start, parent_n = _piece_stack(size)
     tmp = np.empty(3)
@@ -120,9 +117,7 @@ def _polygon_bounds(tri, start_upper, target, max_splits, eps, best_point, corne
     point = np.empty(3)
     side = np.empty(_MAX_POLY)
     quick = np.empty(_MAX_POLY, np.int64)
-    stack = np.empty(depth + 2, np.int64)
-    stack_d = np.empty(depth + 2)
-    near = np.empty(3)
+    search = Search(np.empty(depth + 2, np.int64), np.empty(depth + 2), tmp, np.empty(3))
     scratch = np.empty(len(ref_tri) if full else len(fixed), np.int64)
     dist = np.empty((_MAX_POLY, 64))
     pool = np.empty(max(1024, 4 * len(fixed)), np.int64)
@@ -143,8 +138,7 @@ def _polygon_bounds(tri, start_upper, target, max_splits, eps, best_point, corne
         piece_lower = 0.0
         if full:
             best_max, piece_lower, lower_sq, hint = _vertex_bound(
-                poly[top], n, best_max, lower_sq, hint, best_point, corners, tree, stack,
-                stack_d, tmp, near, quick)
+                poly[top], n, best_max, lower_sq, hint, best_point, corners, tree, search, quick)
             if _settled(best_max, piece_lower, target_sq, eps, depth_v[top], max_splits, n):
                 upper_sq = max(upper_sq, best_max)
                 continue
@@ -227,23 +221,21 @@ def _settled(best_max, piece_lower, target_sq, eps, level, max_splits, n):
 
 
 @numba.njit(cache=True, inline="always")
-def _vertex_bound(piece, n, best_max, lower_sq, hint, best_point, corners, tree, stack, stack_d,
-                  tmp, near, quick):
+def _vertex_bound(piece, n, best_max, lower_sq, hint, best_point, corners, tree, search, quick):
     """The nearest faces of a piece's n vertices (from the tree): exact distances, and a bound
     that often settles the piece without gathering the faces near it.
 
     Returns (``best_max`` lowered to the least over those faces of the largest squared vertex
     distance, the piece's largest squared vertex distance, ``lower_sq`` raised to it (the
     vertex written to ``best_point``), the last nearest face, where the next search starts).
-    ``stack``/``stack_d``/``tmp``/``near`` are the tree search's scratch, ``quick`` room for
-    n faces.
+    ``search`` (a :class:`~workbench.algo.nearest.state.Search`) is the tree search's scratch,
+    ``quick`` room for n faces.
     """
-    box_lo, box_hi, child, first, count, ref_tri, depth = tree
+    tmp = search.tmp
     piece_lower = 0.0
     n_quick = 0
     for i in range(n):
-        d, f = nearest_one(piece[i], hint, np.inf, box_lo, box_hi, child, first, count, ref_tri,
-                           corners, depth, stack, stack_d, tmp, near)
+        d, f = nearest_one(piece[i], hint, np.inf, tree, search)
         hint = f
         piece_lower = max(piece_lower, d)
         if d > lower_sq:

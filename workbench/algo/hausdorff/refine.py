@@ -10,8 +10,8 @@
   subdivision (:func:`~workbench.algo.nearest.triangle.triangle_bounds`), and the point where the
   lower bound it reports is attained.
 
-The numba kernels take the flat tree of :meth:`~workbench.algo.nearest.bvh.TriangleBVH.arrays`;
-distances are in model units.
+The numba kernels take the flat tree of :meth:`~workbench.algo.nearest.bvh.TriangleBVH.arrays`
+(a :class:`~workbench.algo.nearest.state.Tree`, ``tree``); distances are in model units.
 """
 
 from __future__ import annotations
@@ -67,12 +67,12 @@ def _sample_upper(tri, candidates, faces, out):
 
 
 @numba.njit(cache=True)
-def _refine(tri, order, upper, lower, tol, max_depth, box_lo, box_hi, child, first, count,
-            ref_tri, corners, depth):
+def _refine(tri, order, upper, lower, tol, max_depth, tree):
     """Bound the triangles ``order`` (largest upper bound first) by subdivision against the
     faces near them; updates ``upper`` in place and returns (lower, triangle that set it, its
     subdivision target, its candidate radius, triangles refined)."""
-    buffer = np.empty(len(ref_tri), np.int64)
+    corners = tree.corners
+    buffer = np.empty(len(tree.ref_tri), np.int64)
     best_t, best_target, best_radius = -1, 0.0, 0.0
     refined = 0
     for t in order:
@@ -80,8 +80,7 @@ def _refine(tri, order, upper, lower, tol, max_depth, box_lo, box_hi, child, fir
         if upper[t] <= target:
             continue
         c, radius = _ball_radius(tri[t], upper[t])
-        n = within(c, radius * radius, box_lo, box_hi, child, first, count, ref_tri, corners,
-                   depth, buffer)
+        n = within(c, radius * radius, tree, buffer)
         if n == 0:  # cannot happen when upper[t] is a true bound; keep it as it is
             continue
         lo, up = triangle_bounds(tri[t], corners[buffer[:n]], target, max_depth)
@@ -94,11 +93,11 @@ def _refine(tri, order, upper, lower, tol, max_depth, box_lo, box_hi, child, fir
 
 @numba.njit(cache=True)
 def _tighten_range(begin, end, tri, order, sample_faces, neighbours, upper, target, max_splits,
-                   eps, box_lo, box_hi, child, first, count, ref_tri, corners, depth):
+                   eps, tree):
+    corners = tree.corners
     width = sample_faces.shape[1] * (1 + neighbours.shape[1])
     candidates = np.empty(width, np.int64)
     point = np.empty(3)
-    tree = (box_lo, box_hi, child, first, count, ref_tri, depth)
     for k in range(begin, end):
         t = order[k]
         n = 0
@@ -123,21 +122,19 @@ def _tighten_range(begin, end, tri, order, sample_faces, neighbours, upper, targ
 
 @numba.njit(cache=True, parallel=True)
 def _tighten_parallel(tri, order, sample_faces, neighbours, upper, target, max_splits, eps,
-                      box_lo, box_hi, child, first, count, ref_tri, corners, depth):
+                      tree):
     n = len(order)
     for chunk in numba.prange((n + 63) // 64):
         _tighten_range(chunk * 64, min(n, (chunk + 1) * 64), tri, order, sample_faces,
-                       neighbours, upper, target, max_splits, eps, box_lo, box_hi, child, first,
-                       count, ref_tri, corners, depth)
+                       neighbours, upper, target, max_splits, eps, tree)
 
 
-def _tighten(tri, order, sample_faces, neighbours, upper, target, max_splits, eps, bvh_arrays):
+def _tighten(tri, order, sample_faces, neighbours, upper, target, max_splits, eps, tree):
     """Upper bounds of the triangles ``order`` by plane cuts against the nearest faces of their
     samples and those faces' neighbours only (no tree queries): cheap, valid, and exact
     wherever those faces cover the triangle, which leaves few triangles for the full
     refinement."""
-    args = (tri, order, sample_faces, neighbours, upper, target, max_splits, eps) + \
-        tuple(bvh_arrays)
+    args = (tri, order, sample_faces, neighbours, upper, target, max_splits, eps, tree)
     if len(order) >= PARALLEL_MIN // 16:
         _tighten_parallel(*args)
     else:
@@ -145,12 +142,12 @@ def _tighten(tri, order, sample_faces, neighbours, upper, target, max_splits, ep
 
 
 @numba.njit(cache=True)
-def _refine_range(begin, end, tri, order, upper, target, max_splits, eps, box_lo, box_hi, child,
-                  first, count, ref_tri, corners, depth, out_lower, out_point):
+def _refine_range(begin, end, tri, order, upper, target, max_splits, eps, tree, out_lower,
+                  out_point):
     """Bound the triangles ``order[begin:end]`` by plane cuts against every face near them
     (:func:`_polygon_bounds`), those whose upper bound exceeds ``target``: updates ``upper``,
     writes each one's lower bound and the point attaining it (-1 where skipped)."""
-    tree = (box_lo, box_hi, child, first, count, ref_tri, depth)
+    corners = tree.corners
     none = np.empty(0, np.int64)
     for k in range(begin, end):
         t = order[k]
@@ -164,16 +161,14 @@ def _refine_range(begin, end, tri, order, upper, target, max_splits, eps, box_lo
 
 
 @numba.njit(cache=True, parallel=True)
-def _refine_parallel(tri, order, upper, target, max_splits, eps, box_lo, box_hi, child, first,
-                     count, ref_tri, corners, depth, out_lower, out_point):
+def _refine_parallel(tri, order, upper, target, max_splits, eps, tree, out_lower, out_point):
     n = len(order)
     for chunk in numba.prange((n + 7) // 8):
         _refine_range(chunk * 8, min(n, (chunk + 1) * 8), tri, order, upper, target, max_splits,
-                      eps, box_lo, box_hi, child, first, count, ref_tri, corners, depth,
-                      out_lower, out_point)
+                      eps, tree, out_lower, out_point)
 
 
-def _refine_planes(tri, order, upper, lower, tol, max_splits, eps, bvh_arrays):
+def _refine_planes(tri, order, upper, lower, tol, max_splits, eps, tree):
     """Bound the triangles ``order`` (largest upper bound first) by plane cuts against every
     face near them; updates ``upper``; returns (lower, the point attaining it or None, how
     many triangles were refined). The largest few go one by one, each raising the target for
@@ -183,16 +178,15 @@ def _refine_planes(tri, order, upper, lower, tol, max_splits, eps, bvh_arrays):
     point = None
     head = min(len(order), _SERIAL_HEAD)
     for k in range(head):
-        _refine_range(k, k + 1, tri, order, upper, lower + tol, max_splits, eps,
-                      *bvh_arrays, out_lower, out_point)
+        _refine_range(k, k + 1, tri, order, upper, lower + tol, max_splits, eps, tree,
+                      out_lower, out_point)
         if out_lower[k] > lower:
             lower, point = float(out_lower[k]), out_point[k]
     if len(order) > head:
         rest = order[head:]
         tail_lower = np.full(len(rest), -1.0)
         tail_point = np.zeros((len(rest), 3))
-        args = (tri, rest, upper, lower + tol, max_splits, eps) + tuple(bvh_arrays) + \
-            (tail_lower, tail_point)
+        args = (tri, rest, upper, lower + tol, max_splits, eps, tree, tail_lower, tail_point)
         if len(rest) >= 16:
             _refine_parallel(*args)
         else:
@@ -205,17 +199,15 @@ def _refine_planes(tri, order, upper, lower, tol, max_splits, eps, bvh_arrays):
 
 
 @numba.njit(cache=True)
-def _locate_in(t, radius, target, max_depth, box_lo, box_hi, child, first, count, ref_tri,
-               corners, depth):
+def _locate_in(t, radius, target, max_depth, tree):
     """A point of triangle t whose exact distance is at least the lower bound that
     ``triangle_bounds(t, faces, target, max_depth)`` reports, found by descending into the
     subdivision piece with the largest lower bound (a piece bounded on its own is subdivided at
     least as far as inside the whole, so its lower bound is never smaller)."""
     c, _ = _ball_radius(t, 0.0)
-    buffer = np.empty(len(ref_tri), np.int64)
-    n = within(c, radius * radius, box_lo, box_hi, child, first, count, ref_tri, corners, depth,
-               buffer)
-    faces = corners[buffer[:n]]
+    buffer = np.empty(len(tree.ref_tri), np.int64)
+    n = within(c, radius * radius, tree, buffer)
+    faces = tree.corners[buffer[:n]]
     piece = t.copy()
     tmp = np.empty(3)
     best = -1.0

@@ -7,6 +7,7 @@
 ``hierarchy``  crash2000's per-part hierarchies (AABB or OBB) in one forest of arrays
 ``parts``      per-node distance to the other parts, part connectivity, flange
                distances
+``state``      the trees and search scratch as the kernels take them (NamedTuples)
 =============  ====================================================================
 
 Every distance here is within the kernel's stated error of the exact value; the Hausdorff

@@ -66,6 +66,7 @@ import numpy as np
 
 from .bvh import TriangleBVH
 from .hierarchy import squared_bound
+from .state import Batch, Buckets, Found, Groups, GroupScratch, WideTree
 from .triangle import closest_point_on_triangle
 
 __all__ = ["GROUP", "LEAF_SIZE", "BatchedTriangleTree"]
@@ -188,11 +189,13 @@ class BatchedTriangleTree:
         d2 = np.full(len(p), np.inf)
         tri = np.full(len(p), -1, np.int64)
         stats = np.zeros((len(starts) - 1, 3), np.int64)
-        tree = (self.box, self.child, self.part, self.leaf_first, self.leaf_count,
-                self.leaf_part, self.ref_tri, self.ref_part, self.ref_box, self.ref_corners)
+        tree = WideTree(self.box, self.child, self.part, self.leaf_first, self.leaf_count,
+                        self.leaf_part, self.ref_tri, self.ref_part, self.ref_box,
+                        self.ref_corners, int(self.depth))
+        buckets = Buckets(vals, starts, int(index_bits), int(bits), int(below))
         with numba.parallel_chunksize(1):  # buckets differ in cost: hand them out one by one
-            _search(vals, starts, index_bits, bits, below, int(group), p, ptr, parts, best0,
-                    tree, self.depth, d2, tri, stats)
+            _search(buckets, Batch(p, ptr, parts, best0, int(group)), tree, Found(d2, tri),
+                    stats)
         total = stats.sum(axis=0)
         return d2, tri, {"box_tests": int(total[0]), "triangle_tests": int(total[1]),
                          "groups": int(total[2])}
@@ -407,12 +410,19 @@ def _is_in(value, values, s0, s1):
 
 
 @numba.njit(cache=True)
-def _search_groups(ga, gb, spts, order, g_start, s0, s1, set_parts, best0, tree, out_d2,
-                   out_tri, stats, stack, cand, cbox, g, tmp):
-    """Groups ga .. gb - 1 (see the module notes). Returns gb, or the group at which ``cand``
-    ran out of room (that group is to be searched again with more)."""
+def _search_groups(ga, gb, groups, s0, s1, set_parts, best0, tree, found, stats, scratch):
+    """Groups ga .. gb - 1 of ``groups`` (:class:`~workbench.algo.nearest.state.Groups`) in the
+    :class:`~workbench.algo.nearest.state.WideTree` ``tree``, ignoring the parts
+    ``set_parts[s0:s1]``, into ``found`` (see the module notes; ``scratch`` a
+    :class:`~workbench.algo.nearest.state.GroupScratch`). Returns gb, or the group at which
+    ``scratch.cand`` ran out of room (that group is to be searched again with more)."""
     box, child, part, leaf_first, leaf_count, leaf_part, ref_tri, ref_part, ref_box, \
-        corners = tree
+        corners = tree.box, tree.child, tree.part, tree.leaf_first, tree.leaf_count, \
+        tree.leaf_part, tree.ref_tri, tree.ref_part, tree.ref_box, tree.ref_corners
+    spts, order, g_start = groups.spts, groups.order, groups.g_start
+    out_d2, out_tri = found.d2, found.tri
+    stack, cand, cbox, g, tmp = scratch.stack, scratch.cand, scratch.cbox, scratch.g, \
+        scratch.tmp
     bound = best0 * _SLACK  # a box is pruned when its squared distance is >= this
     for grp in range(ga, gb):
         b0, b1 = g_start[grp], g_start[grp + 1]
@@ -490,10 +500,13 @@ def _points_box(spts, b0, b1, g):
 
 
 @numba.njit(cache=True)
-def _search_bucket(vals, b0, b1, index_bits, bits, below, group, points, set_ptr, set_parts,
-                   best0, tree, depth, out_d2, out_tri):
-    """One bucket's points: sorted along the curve (radix, _RADIX bits a pass, in cache),
+def _search_bucket(buckets, b, batch, tree, found):
+    """Bucket b's points: sorted along the curve (radix, _RADIX bits a pass, in cache),
     grouped, searched. Returns (box tests, triangle tests, groups)."""
+    vals, index_bits, bits, below = buckets.vals, buckets.index_bits, buckets.bits, \
+        buckets.below
+    b0, b1 = buckets.starts[b], buckets.starts[b + 1]
+    points, set_ptr, set_parts, best0 = batch.points, batch.set_ptr, batch.set_parts, batch.best0
     m = b1 - b0
     v = vals[b0:b1].copy()
     v2 = np.empty(m, np.int64)
@@ -520,12 +533,13 @@ def _search_bucket(vals, b0, b1, index_bits, bits, below, group, points, set_ptr
         for a in range(3):
             spts[j, a] = points[i, a]
     g_start = np.empty(m + 1, np.int64)
-    n_groups = _groups(keys, group, bits, g_start)
+    n_groups = _groups(keys, batch.group, bits, g_start)
+    groups = Groups(spts, order, g_start)
     s = keys[0] >> (3 * bits)
     stats = np.zeros((n_groups, 2), np.int64)
     # the candidate arrays are never reassigned inside the search loops: numba would count
     # references at every step there (measured: twice the time)
-    stack = np.empty(3 * depth + 8, np.int64)
+    stack = np.empty(3 * tree.depth + 8, np.int64)
     g = np.empty(6)
     tmp = np.empty(3)
     room = 512
@@ -533,20 +547,19 @@ def _search_bucket(vals, b0, b1, index_bits, bits, below, group, points, set_ptr
     while grp < n_groups:
         cand = np.empty(room, np.int64)
         cbox = np.empty((room, 6))
-        grp = _search_groups(grp, n_groups, spts, order, g_start, set_ptr[s], set_ptr[s + 1],
-                             set_parts, best0, tree, out_d2, out_tri, stats, stack, cand, cbox,
-                             g, tmp)
+        grp = _search_groups(grp, n_groups, groups, set_ptr[s], set_ptr[s + 1], set_parts,
+                             best0, tree, found, stats, GroupScratch(stack, cand, cbox, g, tmp))
         room *= 4
     return stats[:, 0].sum(), stats[:, 1].sum(), n_groups
 
 
 @numba.njit(cache=True, parallel=True)
-def _search(vals, starts, index_bits, bits, below, group, points, set_ptr, set_parts, best0,
-            tree, depth, out_d2, out_tri, stats):
-    for b in numba.prange(len(starts) - 1):
-        n_box, n_tri, n_groups = _search_bucket(vals, starts[b], starts[b + 1], index_bits,
-                                                bits, below, group, points, set_ptr,
-                                                set_parts, best0, tree, depth, out_d2, out_tri)
+def _search(buckets, batch, tree, found, stats):
+    """Every bucket of ``buckets`` (:class:`~workbench.algo.nearest.state.Buckets`) in parallel:
+    the query ``batch`` in ``tree`` into ``found``; per bucket (box tests, triangle tests,
+    groups) into ``stats``."""
+    for b in numba.prange(len(buckets.starts) - 1):
+        n_box, n_tri, n_groups = _search_bucket(buckets, b, batch, tree, found)
         stats[b, 0] = n_box
         stats[b, 1] = n_tri
         stats[b, 2] = n_groups

@@ -39,6 +39,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from .state import Tree, new_search
 from .triangle import closest_point_on_triangle
 
 __all__ = ["TriangleBVH", "bounding_box", "check_triangles", "compacted", "corner_boxes",
@@ -247,11 +248,11 @@ class TriangleBVH:
     def n_nodes(self) -> int:
         return len(self.child)
 
-    def arrays(self) -> tuple:
-        """The flat tree for numba code:
+    def arrays(self) -> Tree:
+        """The flat tree for numba code, a :class:`~workbench.algo.nearest.state.Tree`
         (box_lo, box_hi, child, first, count, ref_tri, corners, depth)."""
-        return (self.box_lo, self.box_hi, self.child, self.first, self.count, self.ref_tri,
-                self.corners, self.depth)
+        return Tree(self.box_lo, self.box_hi, self.child, self.first, self.count, self.ref_tri,
+                    self.corners, int(self.depth))
 
     # ----------------------------------------------------------------- queries
     def nearest(self, points, hint=None, max_distance: float = np.inf):
@@ -285,7 +286,7 @@ class TriangleBVH:
         tri = np.empty(len(p), np.int64)
         closest = np.empty((len(p), 3))
         cap = float(max_distance) ** 2 if np.isfinite(max_distance) else np.inf
-        _nearest_many(np.ascontiguousarray(p), hint, cap, *self.arrays(), d2, tri, closest)
+        _nearest_many(np.ascontiguousarray(p), hint, cap, self.arrays(), d2, tri, closest)
         found = tri >= 0
         dist = np.where(found, np.sqrt(d2), np.inf)
         closest[~found] = np.nan
@@ -302,7 +303,7 @@ class TriangleBVH:
         if not (np.isfinite(radius) and radius >= 0):
             raise ValueError(f"radius must be finite and >= 0, got {radius!r}")
         out = np.empty(self.n_references, np.int64)
-        n = within(p, float(radius) ** 2, *self.arrays(), out)
+        n = within(p, float(radius) ** 2, self.arrays(), out)
         return out[:n].copy()
 
 
@@ -321,15 +322,21 @@ def _box_distance_sq(p, lo, hi):
 
 
 @numba.njit(cache=True)
-def nearest_one(p, start, bound_sq, box_lo, box_hi, child, first, count, ref_tri, corners, depth,
-                stack, stack_d, tmp, best_point):
-    """Squared distance and index of the triangle nearest to p, closest point into
-    ``best_point``.
+def nearest_one(p, start, bound_sq, tree, search):
+    """Squared distance and index of the triangle of ``tree`` (a
+    :class:`~workbench.algo.nearest.state.Tree`) nearest to p, closest point into
+    ``search.best_point``.
 
     Triangle ``start`` (>= 0) is tried first; only triangles strictly nearer than ``bound_sq``
-    are returned (index -1 when none is). ``stack``/``stack_d`` are scratch arrays of
-    ``depth + 2`` entries, ``tmp`` scratch (3,).
+    are returned (index -1 when none is). ``search`` (a
+    :class:`~workbench.algo.nearest.state.Search`) holds the scratch: ``stack``/``stack_d`` of
+    ``depth + 2`` entries, ``tmp`` (3,).
     """
+    box_lo, box_hi, child, first, count = tree.box_lo, tree.box_hi, tree.child, tree.first, \
+        tree.count
+    ref_tri, corners = tree.ref_tri, tree.corners
+    stack, stack_d, tmp, best_point = search.stack, search.stack_d, search.tmp, \
+        search.best_point
     best = bound_sq
     best_tri = -1
     if start >= 0:
@@ -379,19 +386,15 @@ def nearest_one(p, start, bound_sq, box_lo, box_hi, child, first, count, ref_tri
 
 
 @numba.njit(cache=True)
-def _nearest_range(begin, end, points, hint, bound_sq, box_lo, box_hi, child, first, count,
-                   ref_tri, corners, depth, out_d2, out_tri, out_point):
-    stack = np.empty(depth + 2, np.int64)
-    stack_d = np.empty(depth + 2)
-    tmp = np.empty(3)
-    best_point = np.full(3, np.nan)
+def _nearest_range(begin, end, points, hint, bound_sq, tree, out_d2, out_tri, out_point):
+    search = new_search(tree.depth)
+    best_point = search.best_point
     previous = -1
     for i in range(begin, end):
         # without a hint, start from the previous point's triangle: neighbouring queries are
         # usually near each other, and a near start prunes from the first box on
         start = hint[i] if hint[i] >= 0 else previous
-        d, k = nearest_one(points[i], start, bound_sq, box_lo, box_hi, child, first, count,
-                           ref_tri, corners, depth, stack, stack_d, tmp, best_point)
+        d, k = nearest_one(points[i], start, bound_sq, tree, search)
         out_d2[i] = d
         out_tri[i] = k
         out_point[i] = best_point
@@ -400,13 +403,11 @@ def _nearest_range(begin, end, points, hint, bound_sq, box_lo, box_hi, child, fi
 
 
 @numba.njit(cache=True, parallel=True)
-def _nearest_parallel(points, hint, bound_sq, box_lo, box_hi, child, first, count, ref_tri,
-                      corners, depth, out_d2, out_tri, out_point):
+def _nearest_parallel(points, hint, bound_sq, tree, out_d2, out_tri, out_point):
     n = len(points)
     for chunk in numba.prange((n + _CHUNK - 1) // _CHUNK):
         _nearest_range(chunk * _CHUNK, min(n, (chunk + 1) * _CHUNK), points, hint, bound_sq,
-                       box_lo, box_hi, child, first, count, ref_tri, corners, depth, out_d2,
-                       out_tri, out_point)
+                       tree, out_d2, out_tri, out_point)
 
 
 def _nearest_many(points, *args):
@@ -418,12 +419,14 @@ def _nearest_many(points, *args):
 
 
 @numba.njit(cache=True)
-def within(p, radius_sq, box_lo, box_hi, child, first, count, ref_tri, corners, depth, out,
-           limit=-1):
-    """Sorted indices of the triangles at squared distance <= ``radius_sq`` from p, written to
-    ``out`` (room for every reference); returns how many, or -1 as soon as more than ``limit``
-    (when >= 0) references are found."""
-    stack = np.empty(depth + 2, np.int64)
+def within(p, radius_sq, tree, out, limit=-1):
+    """Sorted indices of the triangles of ``tree`` (a :class:`~workbench.algo.nearest.state.Tree`)
+    at squared distance <= ``radius_sq`` from p, written to ``out`` (room for every reference);
+    returns how many, or -1 as soon as more than ``limit`` (when >= 0) references are found."""
+    box_lo, box_hi, child, first, count = tree.box_lo, tree.box_hi, tree.child, tree.first, \
+        tree.count
+    ref_tri, corners = tree.ref_tri, tree.corners
+    stack = np.empty(tree.depth + 2, np.int64)
     tmp = np.empty(3)
     n = 0
     top = 0

@@ -46,8 +46,9 @@ digits; queries take and return the mesh's own coordinates.
 
 The package: :mod:`.element_hierarchy` the class and its queries' result, :mod:`.trees` the
 median-split trees and the forest layout, :mod:`.volumes` the slabs and the AABB/OBB boxes,
-:mod:`.queries` the numba searches, :mod:`.inputs` the checks and small conversions shared
-with :mod:`workbench.algo.nearest.parts`.
+:mod:`.queries` the numba searches, :mod:`.state` the forest and its elements as those
+searches take them (NamedTuples), :mod:`.inputs` the checks and small conversions shared with
+:mod:`workbench.algo.nearest.parts`.
 
 Why a second hierarchy beside :class:`~workbench.algo.nearest.bvh.TriangleBVH`: this one is the
 subject

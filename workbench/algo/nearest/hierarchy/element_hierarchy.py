@@ -14,6 +14,7 @@ import numpy as np
 
 from .inputs import check_elements, check_finite, distinct, local_origin, squared_bound, used_nodes
 from .queries import _cut, _nearest_many, _per_part_many
+from .state import Elements, Exclusion, Forest
 from .trees import build_forest
 from .volumes import _slabs, bounding_volumes
 
@@ -146,6 +147,15 @@ class ElementHierarchy:
         self.max_leaf = int((forest.end[is_leaf] - forest.start[is_leaf]).max())
         self.depth = forest.depth
 
+    def _forest(self) -> Forest:
+        """The forest as the kernels take it."""
+        return Forest(self.bv, self.kind == "obb", self.left, self.right, self.start, self.end,
+                      self.node_part, int(self.root), int(self.depth), int(self.max_leaf))
+
+    def _elements(self) -> Elements:
+        """The elements as the nearest-element kernels take them."""
+        return Elements(self.corners, self.n_tri, self.slab)
+
     # ----------------------------------------------------------------- sizes and boxes
     @property
     def n_parts(self) -> int:
@@ -208,10 +218,8 @@ class ElementHierarchy:
         d2 = np.empty(n)
         elem = np.empty(n, np.int64)
         counters = np.zeros((n, 4), np.int64)
-        _nearest_many(np.ascontiguousarray(local), act, ptr, own, best0, self.bv,
-                      self.kind == "obb", self.left, self.right, self.start, self.end,
-                      self.node_part, self.root, self.corners, self.n_tri, self.slab,
-                      bool(plane_test), self.depth, self.max_leaf, d2, elem, counters)
+        _nearest_many(np.ascontiguousarray(local), act, Exclusion(ptr, own), best0,
+                      self._forest(), self._elements(), bool(plane_test), d2, elem, counters)
         found = elem >= 0
         distance = np.where(found, np.sqrt(np.where(found, d2, 0.0)), np.inf)
         element = np.where(found, self.element_order[np.maximum(elem, 0)], -1)
@@ -268,9 +276,7 @@ class ElementHierarchy:
         ptr, own = self._exclusion(exclude, n)
         local = np.ascontiguousarray(np.where(act[:, None], p - self.origin, 0.0))
         best0 = float(np.nextafter(squared_bound(cutoff), np.inf))
-        args = (local, act, ptr, own, best0, self.bv, self.kind == "obb", self.left,
-                self.right, self.start, self.end, self.node_part, self.root, self.corners,
-                self.n_tri, self.slab, self.depth, self.max_leaf)
+        args = (local, act, Exclusion(ptr, own), best0, self._forest(), self._elements())
         counts = np.zeros(n, np.int64)
         dummy_p = np.zeros(0, np.int64)
         dummy_d = np.zeros(0)
@@ -308,9 +314,7 @@ class ElementHierarchy:
         ql = q - self.origin
         tol = 1e-12 * (float(np.abs(q).max()) + float(np.abs(self.origin).max()) + self.scale)
         out = np.empty(self.n_elements, np.int64)
-        k = _cut(ql, unit, tol, q, nrm, self.bv, self.kind == "obb", self.left, self.right,
-                 self.start, self.end, self.root, self.depth, self.element_nodes, self._coords,
-                 out)
+        k = _cut(ql, unit, tol, q, nrm, self._forest(), self.element_nodes, self._coords, out)
         return np.sort(self.element_order[out[:k]])
 
 

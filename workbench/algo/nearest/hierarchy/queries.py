@@ -3,9 +3,9 @@ per point (crash2000 §4.1), each part's nearest element, and the elements a pla
 (§4.2).
 
 The kernels take the flat forest of :class:`~workbench.algo.nearest.hierarchy.ElementHierarchy`
-(packed bounding volumes, children, element ranges, each node's part) and count the tests of
-crash2000's Table 2. Distances are squared, exact float64, in the hierarchy's local
-coordinates.
+(packed bounding volumes, children, element ranges, each node's part) and its elements as the
+NamedTuples of :mod:`.state`, and count the tests of crash2000's Table 2. Distances are
+squared, exact float64, in the hierarchy's local coordinates.
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ import numba
 import numpy as np
 
 from ..triangle import closest_point_on_triangle
+from .state import LeafSearch
 
 _CHUNK = 64  # points per parallel work item
 # a box or slab is pruned only when its squared distance exceeds the bound by this share
@@ -69,13 +70,18 @@ def _is_excluded(node, node_part, own, o0, o1):
 
 
 @numba.njit(cache=True)
-def _nearest_one(p, best, root, own, o0, o1, bv, obb, left, right, start, end, node_part,
-                 corners, n_tri, slab, plane_test, stack, stack_d, tmp, leaf_g, leaf_j, counts):
+def _nearest_one(p, best, root, own, o0, o1, forest, elements, plane_test, search, counts):
     """Squared distance and tree-order index of the nearest element to p strictly nearer than
-    ``best`` (-1 when none), searching from ``root`` and skipping the part trees whose index is
-    in own[o0:o1]. Adds to counts: bv tests, element tests, plane skips, leaf elements.
-    ``stack``/``stack_d`` scratch of depth + 2 entries, ``tmp`` (3,), ``leaf_g``/``leaf_j``
-    scratch of the largest leaf's size."""
+    ``best`` (-1 when none), searching ``forest`` (a :class:`~.state.Forest` over ``elements``,
+    an :class:`~.state.Elements`) from ``root`` and skipping the part trees whose index is in
+    own[o0:o1]. Adds to counts: bv tests, element tests, plane skips, leaf elements.
+    ``search`` (a :class:`~.state.LeafSearch`): ``stack``/``stack_d`` scratch of depth + 2
+    entries, ``tmp`` (3,), ``leaf_g``/``leaf_j`` scratch of the largest leaf's size."""
+    bv, obb, left, right, start, end, node_part = forest.bv, forest.obb, forest.left, \
+        forest.right, forest.start, forest.end, forest.node_part
+    corners, n_tri, slab = elements.corners, elements.n_tri, elements.slab
+    stack, stack_d, tmp, leaf_g, leaf_j = search.stack, search.stack_d, search.tmp, \
+        search.leaf_g, search.leaf_j
     best_e = -1
     p0, p1, p2 = p[0], p[1], p[2]
     if node_part[root] >= 0 and _is_excluded(root, node_part, own, o0, o1):
@@ -163,47 +169,48 @@ def _nearest_one(p, best, root, own, o0, o1, bv, obb, left, right, start, end, n
 
 
 @numba.njit(cache=True, parallel=True)
-def _nearest_many(points, active, ptr, own, best0, bv, obb, left, right, start, end, node_part,
-                  root, corners, n_tri, slab, plane_test, depth, max_leaf, out_d2, out_elem,
-                  counts):
+def _nearest_many(points, active, exclusion, best0, forest, elements, plane_test, out_d2,
+                  out_elem, counts):
+    """For each active point, the nearest element of ``elements`` in ``forest`` strictly
+    nearer than ``best0`` and not of a part ``exclusion`` (an :class:`~.state.Exclusion`)
+    lists for it: squared distance into ``out_d2``, tree-order index into ``out_elem`` (inf,
+    -1 where none or inactive), its tests into ``counts[i]``."""
+    ptr, own = exclusion.ptr, exclusion.own
+    root, depth, max_leaf = forest.root, forest.depth, forest.max_leaf
     n = len(points)
     n_chunks = (n + _CHUNK - 1) // _CHUNK
     for chunk in numba.prange(n_chunks):
-        stack = np.empty(2 * depth + 4, np.int64)
-        stack_d = np.empty(2 * depth + 4)
-        tmp = np.empty(3)
-        leaf_g = np.empty(max_leaf)
-        leaf_j = np.empty(max_leaf, np.int64)
+        search = LeafSearch(np.empty(2 * depth + 4, np.int64), np.empty(2 * depth + 4),
+                            np.empty(3), np.empty(max_leaf), np.empty(max_leaf, np.int64))
         for i in range(chunk * _CHUNK, min(n, (chunk + 1) * _CHUNK)):
             if not active[i]:
                 out_d2[i] = np.inf
                 out_elem[i] = -1
                 continue
-            d, e = _nearest_one(points[i], best0, root, own, ptr[i], ptr[i + 1], bv, obb, left,
-                                right, start, end, node_part, corners, n_tri, slab, plane_test,
-                                stack, stack_d, tmp, leaf_g, leaf_j, counts[i])
+            d, e = _nearest_one(points[i], best0, root, own, ptr[i], ptr[i + 1], forest,
+                                elements, plane_test, search, counts[i])
             out_d2[i] = d
             out_elem[i] = e
 
 
 @numba.njit(cache=True, parallel=True)
-def _per_part_many(points, active, ptr, own, best0, bv, obb, left, right, start, end,
-                   node_part, root, corners, n_tri, slab, depth, max_leaf, offsets, counts,
+def _per_part_many(points, active, exclusion, best0, forest, elements, offsets, counts,
                    out_part, out_d2, fill):
-    """For each point, walk the top level to every part root within ``best0`` (not excluded)
-    and search that part for its nearest element. First pass (fill False) counts the parts
-    found per point into ``counts``; the second writes (part index, squared distance) at
-    ``offsets``."""
+    """For each point, walk the top level of ``forest`` to every part root within ``best0``
+    (not excluded by ``exclusion``) and search that part for its nearest element. First pass
+    (fill False) counts the parts found per point into ``counts``; the second writes (part
+    index, squared distance) at ``offsets``."""
+    ptr, own = exclusion.ptr, exclusion.own
+    bv, obb, left, right, node_part = forest.bv, forest.obb, forest.left, forest.right, \
+        forest.node_part
+    root, depth, max_leaf = forest.root, forest.depth, forest.max_leaf
     n = len(points)
     n_chunks = (n + _CHUNK - 1) // _CHUNK
     for chunk in numba.prange(n_chunks):
-        stack = np.empty(2 * depth + 4, np.int64)
+        search = LeafSearch(np.empty(2 * depth + 4, np.int64), np.empty(2 * depth + 4),
+                            np.empty(3), np.empty(max_leaf), np.empty(max_leaf, np.int64))
         stack2 = np.empty(2 * depth + 4, np.int64)
-        stack_d = np.empty(2 * depth + 4)
-        tmp = np.empty(3)
         scratch = np.zeros(4, np.int64)
-        leaf_g = np.empty(max_leaf)
-        leaf_j = np.empty(max_leaf, np.int64)
         for i in range(chunk * _CHUNK, min(n, (chunk + 1) * _CHUNK)):
             k = 0
             if active[i]:
@@ -216,9 +223,8 @@ def _per_part_many(points, active, ptr, own, best0, bv, obb, left, right, start,
                     if node_part[node] >= 0:
                         if _is_excluded(node, node_part, own, ptr[i], ptr[i + 1]):
                             continue
-                        d, e = _nearest_one(p, best0, node, own, 0, 0, bv, obb, left, right,
-                                            start, end, node_part, corners, n_tri, slab, True,
-                                            stack, stack_d, tmp, leaf_g, leaf_j, scratch)
+                        d, e = _nearest_one(p, best0, node, own, 0, 0, forest, elements, True,
+                                            search, scratch)
                         if e >= 0:
                             if fill:
                                 out_part[offsets[i] + k] = node_part[node]
@@ -235,12 +241,13 @@ def _per_part_many(points, active, ptr, own, best0, bv, obb, left, right, start,
 
 
 @numba.njit(cache=True)
-def _cut(ql, unit, tol, q, nrm, bv, obb, left, right, start, end, root, depth, element_nodes,
-         coords, out):
-    """Tree-order indices of the elements cut by the plane (see cut_by_plane) into ``out``;
-    returns how many."""
-    stack = np.empty(2 * depth + 4, np.int64)
-    stack[0] = root
+def _cut(ql, unit, tol, q, nrm, forest, element_nodes, coords, out):
+    """Tree-order indices of the elements of ``forest`` (a :class:`~.state.Forest`) cut by the
+    plane (see cut_by_plane) into ``out``; returns how many."""
+    bv, obb, left, right, start, end = forest.bv, forest.obb, forest.left, forest.right, \
+        forest.start, forest.end
+    stack = np.empty(2 * forest.depth + 4, np.int64)
+    stack[0] = forest.root
     top = 1
     k = 0
     while top > 0:
