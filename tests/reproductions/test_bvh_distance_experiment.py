@@ -2,28 +2,12 @@
 what its tables show in its quick form (slow)."""
 
 import pytest
-from device_column import own_columns
+from declared import assert_declared_tables
 
 from workbench.algo.nearest.triangle import DISTANCE_ERROR, UNIT_ROUNDOFF
 from workbench.output.tables import read_table
 
 NAME = "table_bvh_distance"
-# every table the quick run writes (with the car deck), with its columns
-TABLES = {
-    "table": ["scene", "nodes", "elements", "parts", "kind", "elements_per_leaf", "n_bvs",
-              "point_bv_tests", "point_element_tests", "plane_skips", "plane_skip_pct",
-              "build_s", "query_s", "queries_per_s", "nodes_within", "checked_nodes",
-              "checked_within", "max_abs_error_mm", "max_rel_error", "same_nodes_within",
-              "max_change_translated_1e6_mm"],
-    "references": ["scene", "tool", "queries", "build_s", "query_s", "queries_per_s",
-                   "speed_vs_ours", "max_abs_error_mm", "nodes_off", "nodes_flagged",
-                   "constraints", "cutoff_disagreements"],
-    "connectivity": ["part_a", "part_b", "min_distance_mm", "nodes_within"],
-    "flange": ["scene", "view", "wall_ms", "gpu_ms", "derive_ms", "covered_px", "renderer"],
-    "forcetube": ["case", "max_rel_error_vs_closed_form", "planes", "max_compression_kN",
-                  "max_tension_kN", "elements_cut", "equal_forces", "hierarchy_s",
-                  "brute_force_s"],
-}
 FIGURES = ("fig9_distance.png", "fig9_flanges.png", "connectivity.png")
 
 
@@ -94,12 +78,9 @@ def check_force_tubes_and_flanges(out_dir) -> None:
 
 
 # ------------------------------------------------------------------------------- tiny size
-def test_tiny_run_writes_every_table_with_its_columns(tiny, car_deck):
+def test_tiny_run_writes_every_table_with_its_declared_columns(tiny, car_deck):
     _, out_dir = tiny
-    for name, columns in TABLES.items():
-        assert (out_dir / f"{name}.md").is_file()
-        with open(out_dir / f"{name}.csv", encoding="utf-8") as fh:
-            assert own_columns(fh.readline().rstrip("\r\n").split(",")) == columns, name
+    assert_declared_tables(NAME, out_dir)
     assert (out_dir / "force_tubes.png").stat().st_size > 0
 
 

@@ -2,45 +2,11 @@
 (every table, row kind and column, on small stamped panels) and at the quick size (the car
 meshes too; marked slow)."""
 
-import csv
-
 import pytest
-from device_column import own_columns
+from declared import assert_declared_tables
 
 from workbench.algo.fepatch.pipeline import PARAMETER_SETS
 from workbench.output.tables import read_table
-
-ERRORS = ["d_mm", "hausdorff_mm", "hausdorff_lower_mm", "hausdorff_pct_diag", "hausdorff_s",
-          "within_d"]
-WIRE = ["wire_pixels", "overdraw_wire_pixels", "wire_recall_1px", "wire_precision_1px",
-        "wire_iou_1px", "wire_exact_overlap"]
-TABLES = {
-    "params": ["set", "alpha_g1_deg", "d_mm", "l_outer_mm", "l_inner_mm"],
-    "preprocessing": [
-        "scene", "set", "rules", "elements", "patches", "subpatches", "g0_edges", "g1_edges",
-        "closing_edges", "line_nodes", "line_nodes_kept", "fallback_subpatches",
-        "original_triangles", "simplified_triangles", "atlas", "rgba_texels_per_element",
-        "wire_encoding", "narrow_elements", "fit_share", "split_subpatches", "kept_subpatches",
-        "certified_bound_mm", "features, subpatches, lines s", "retriangulation s",
-        "textures s", "certification s", "total s"],
-    "table": [
-        "renderer", "scene", "size", "case", "set", "rules", "triangles", "line_edges", "gpu_ms",
-        "gpu_ms_min", "gpu_ms_max", "wall_ms", "wall_ms_min", "wall_ms_max", "readback_ms",
-        "repeats", "wall_ms_lo", "wall_ms_hi", "speed_vs_overdraw", "gpu_speed_vs_overdraw",
-        "rgba_texels_per_element",
-        "texture_mb", "narrow_elements", "ssim", "reference", *WIRE, *ERRORS],
-    "table3": ["renderer", "scene", "size", "case", "rules", "triangles", "line_edges",
-               "gpu_ms", "wall_ms", "speed_vs_overdraw", "rgba_texels_per_element",
-               "hausdorff_mm", "d_mm", "wire_precision_1px", "wire_recall_1px",
-               "wire_iou_1px", "ssim"],
-    "sweep": [
-        "scene", "case", "alpha_g1_deg", "d_mm", "l_outer_mm", "l_inner_mm", "fit_share",
-        "certify", "wire_encoding", "texels_per_edge", "scale_by", "scale_quantile",
-        "atlas_turns", "border", "normal_reduction", "min_width", "triangles", "line_edges",
-        "narrow_elements", "preprocessing_s", "wall_ms", "speed_vs_overdraw",
-        "rgba_texels_per_element", *WIRE, *ERRORS[1:]],
-    "closeup": ["scene", "view", "case", "rules", "wire_encoding", *WIRE, "ssim"],
-}
 
 
 @pytest.fixture(scope="module")
@@ -59,16 +25,9 @@ def result(request):
     return request.getfixturevalue(request.param)
 
 
-def _columns(path):
-    with open(path, encoding="utf-8", newline="") as handle:
-        return next(csv.reader(handle))
-
-
-def test_tiny_writes_every_table_with_its_columns(tiny):
+def test_tiny_writes_every_table_with_its_declared_columns(tiny):
     _, out_dir = tiny
-    for name, columns in TABLES.items():
-        assert (out_dir / f"{name}.md").is_file()
-        assert own_columns(_columns(out_dir / f"{name}.csv")) == columns, name
+    assert_declared_tables("table_fe_texture_wireframe", out_dir)
     rows = read_table(out_dir / "table.csv")
     assert {r["case"] for r in rows} >= {"original, shaded", "original + line overdraw",
                                          "original + wire texture"}

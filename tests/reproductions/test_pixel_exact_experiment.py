@@ -2,35 +2,11 @@
 the tiny size, and what its tables show in its quick form (slow)."""
 
 import pytest
-from device_column import own_columns
+from declared import assert_declared_tables
 
 from workbench.output.tables import read_table
 
 NAME = "fig_pixel_exact"
-ERRORS = ["max_diff_255", "mean_diff_255", "share_over_1", "share_over_1_off_edges",
-          "max_diff_255_off_edges", "uncovered"]
-# every table the quick run writes, with its columns
-TABLES = {
-    "table": ["target_polygons", "cells", "tets", "polygons", "quads", "slice_ms", "path",
-              "edge_overdraw", "element_store", "gpu_ms", "gpu_ms_min", "gpu_ms_max", "wall_ms",
-              "wall_ms_min", "wall_ms_max", "readback_ms", "repeats", "wall_ms_lo",
-              "wall_ms_hi", "prepare_ms",
-              "bytes_uploaded", *ERRORS, "crack_pixels", "renderer", "size",
-              "wall_vs_per_vertex"],
-    "slicing": ["tets", "build_s", "sort_s", "frames", "polygons_median", "polygons_max",
-                "incremental_ms_median", "incremental_ms_max", "first_frame_ms",
-                "shared_facets_s", "with_outer_ms_median", "brute_force_ms_median", "speedup",
-                "last_slice_area_error"],
-    "sweep": ["sweep", "cells", "threshold_mm2", "threshold_vs_mean_area", "polygons", "path",
-              "wall_ms", "gpu_ms", *ERRORS, "crack_pixels", "crack_pixels_skirts", "renderer",
-              "fit_U_err_max"],
-    "interleaved": ["target_polygons", "polygons", "size", "renderer", "per_pixel_ms",
-                    "per_vertex_ms", "per_pixel_over_per_vertex", "per_pixel_over_per_vertex_lo",
-                    "per_pixel_over_per_vertex_hi", "per_pixel_over_per_vertex_pairs"],
-    "stability": ["case", "offset_mm", "polygons", *ERRORS, "f32_global_U_err_rel",
-                  "f32_local_U_err_rel", "nan_pixels", "renderer", "t_us", "zero_area_polygons",
-                  "nan_corners", "area_error", "zero_U_pixels"],
-}
 FIGURES = ("fig3_bar", "fig5_slice", "fig5_crop", "fig5_colorbar", "fig4_cracks", "fig8_height",
            "sweep")
 
@@ -46,8 +22,7 @@ def result(experiment_run):
 
 
 def check_tables_and_figures(out_dir, min_png_bytes: int) -> None:
-    for name in TABLES:
-        assert (out_dir / f"{name}.csv").is_file() and (out_dir / f"{name}.md").is_file()
+    assert_declared_tables(NAME, out_dir)
     for name in FIGURES:
         assert (out_dir / f"{name}.png").stat().st_size > min_png_bytes
 
@@ -104,11 +79,8 @@ def check_slicing_and_stability(out_dir) -> None:
 
 
 # ------------------------------------------------------------------------------- tiny size
-def test_tiny_run_writes_every_table_with_its_columns(tiny):
+def test_tiny_run_writes_every_table_with_its_declared_columns(tiny):
     _, out_dir = tiny
-    for name, columns in TABLES.items():
-        with open(out_dir / f"{name}.csv", encoding="utf-8") as fh:
-            assert own_columns(fh.readline().rstrip("\r\n").split(",")) == columns, name
     check_tables_and_figures(out_dir, min_png_bytes=10_000)
     sweep = read_table(out_dir / "sweep.csv")
     assert {(r["sweep"], r["path"]) for r in sweep} == {

@@ -6,7 +6,7 @@ at the quick sizes is tested on the quick run alone.
 """
 
 import pytest
-from device_column import own_columns
+from declared import assert_declared_tables
 
 import workbench.data
 from workbench.experiment.registry import discover, run_experiment
@@ -98,40 +98,15 @@ def test_tables_and_figures_are_written(result):
         assert (out_dir / name).stat().st_size > 1000
 
 
-# the tables of a quick run and their columns
-COLUMNS = {
-    "table": ["renderer", "scene", "case", "path", "style", "size", "samples", "triangles",
-              "vertices", "bytes_uploaded", "bytes_per_step", "gpu_ms", "gpu_ms_min",
-              "gpu_ms_max", "wall_ms", "wall_ms_min", "wall_ms_max", "readback_ms", "repeats",
-              "wall_ms_lo", "wall_ms_hi", "mtri_per_s", "set_step_ms", "derive_ms",
-              "derive_bytes", "skipped_ms", "skipped_bytes", "reference", "max_diff_255",
-              "share_differing", "psnr_db", "ssim", "wall_over_ours", "peer_version",
-              "lighting"],
-    "targets": ["renderer", "scene", "size", "triangles", "contour_wall_ms",
-                "position_only_wall_ms", "contour_msaa_incl_readback_ms",
-                "pyrender_incl_readback_ms", "pyvista_incl_readback_ms",
-                "contour_over_position_only",
-                "contour_over_position_only_lo", "contour_over_position_only_hi",
-                "contour_over_position_only_pairs", "contour_msaa_over_pyrender",
-                "contour_msaa_over_pyrender_lo", "contour_msaa_over_pyrender_hi",
-                "contour_msaa_over_pyrender_pairs", "contour_msaa_over_pyvista",
-                "contour_msaa_over_pyvista_lo", "contour_msaa_over_pyvista_hi",
-                "contour_msaa_over_pyvista_pairs", "gouraud_msaa_over_pyvista",
-                "gouraud_msaa_over_pyvista_lo", "gouraud_msaa_over_pyvista_hi",
-                "gouraud_msaa_over_pyvista_pairs", "pyrender_ssim", "pyvista_ssim", "nodes",
-                "crease_vertices_added", "bytes_per_step", "bytes_at_prepare"],
-}
 CASES = {"position", "flat", "gouraud", "gouraud + wire", "pixel smooth", "vertex smooth",
          "pixel bands", "vertex bands", "pixel bands + wire", "pixel transfer (hide low 30 %)",
          "pixel bands + clip", "element flat", "pixel bands, deformation x3",
          "gouraud, 4x MSAA", "pixel bands, 4x MSAA", "pyrender (EGL)", "pyvista/VTK (EGL)"}
 
 
-def test_every_table_with_every_column_and_kind_of_row(result):
+def test_every_table_with_every_declared_column_and_kind_of_row(result):
     _, rows, out_dir = result
-    assert sorted(p.stem for p in out_dir.glob("*.csv")) == sorted(COLUMNS)
-    for name, columns in COLUMNS.items():
-        assert own_columns(read_table(out_dir / f"{name}.csv")[0]) == columns, name
+    assert_declared_tables("render_paths", out_dir)
     assert {r["case"] for r in rows} == CASES
 
 

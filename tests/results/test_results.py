@@ -212,6 +212,8 @@ def test_the_report_is_written_from_the_store(tmp_path):
     assert "not in the results store yet" in text  # the other experiments
     doc = (tmp_path / "docs" / "results.md").read_text()
     assert recorder.run_id in doc and "### targets" in doc and recorder.machine["cpu"] in doc
+    # the stored table's legend comes from the experiment's declaration
+    assert "- `contour_wall_ms` (ms): wall time of the per-pixel band draw" in doc
     with pytest.raises(ValueError, match="no .* section"):
         readme.write_text("# no markers\n")
         write_report(store, readme, tmp_path / "docs" / "results.md")

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 from ..data import shared_file
 from ..measurement.stats import StoppingRule
 from ..measurement.timing import empty_gpu_note
-from ..output.tables import write_table
+from ..output.tables import table_columns, write_table
 
 if TYPE_CHECKING:
     import moderngl
@@ -34,6 +34,7 @@ if TYPE_CHECKING:
     from ..paths.backends import Backend
     from ..paths.base import RenderPath
     from ..scene.protocol import Scene
+    from .declare import Declaration
 
 T = TypeVar("T")
 
@@ -64,12 +65,14 @@ class Case:
 class ExperimentContext:
     """The context of one experiment run: ``name``, ``out_dir`` (the run's own folder, swapped
     into place whole when the run ends), ``size`` (one of :data:`SIZES`) and ``progress`` (a
-    callback taking one line, or None)."""
+    callback taking one line, or None); ``declared``, the experiment's declaration, against
+    which every table is checked before it is written (None: unchecked)."""
 
     name: str
     out_dir: Path
     size: str = "full"
     progress: Callable[[str], None] | None = None
+    declared: Declaration | None = None
     skipped: list[str] = field(default_factory=list)
     tables: list[tuple[str, list[dict[str, Any]]]] = field(default_factory=list)
     gl_renderer: str | None = None  # the renderer of the run's GL context, once made
@@ -138,12 +141,25 @@ class ExperimentContext:
     def table(self, rows: Sequence[dict[str, Any]], name: str, title: str,
               columns: Sequence[str] | None = None) -> None:
         """Write ``rows`` as ``<name>.csv`` and ``<name>.md`` (titled, with a note where its
-        GPU times are empty on a software renderer) into the run's folder, and keep them in
-        :attr:`tables` for the results store."""
+        GPU times are empty on a software renderer, and the declared legend under it) into the
+        run's folder, and keep them in :attr:`tables` for the results store. Refuses
+        (:class:`~workbench.experiment.declare.DeclarationError`) a table or a column the
+        experiment did not declare, and a declared column its rows leave out."""
         rows = self.with_device(rows)
         write_table(rows, self.out_dir, name, columns=columns, title=title,
-                    notes=empty_gpu_note(rows, self.gl_renderer))
+                    notes=empty_gpu_note(rows, self.gl_renderer),
+                    legend=self.legend(name, rows, columns))
         self.tables.append((name, rows))
+
+    def legend(self, name: str, rows: Sequence[dict[str, Any]],
+               columns: Sequence[str] | None = None) -> list[tuple[str, str, str]]:
+        """The legend of table ``name`` written from ``rows`` (``columns``: the columns
+        written, default all), after checking ``rows`` against the declaration; none for an
+        undeclared experiment."""
+        if self.declared is None:
+            return []
+        table = self.declared.check(self.name, name, rows, columns)
+        return table.legend(table_columns(rows) if columns is None else columns)
 
     def with_device(self, rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
         """``rows`` with an ``egl_device`` column (the run's EGL device identity, e.g.

@@ -1,11 +1,14 @@
 """The experiment registry behind ``workbench reproduce``.
 
 An experiment script in the package ``workbench.reproductions`` (one module per paper table
-or figure) registers a function with :func:`experiment`; the function
+or figure) registers a function with :func:`experiment`, with the
+:class:`~workbench.experiment.declare.Declaration` of its tables and claims; the function
 ``run(exp)`` receives an :class:`~workbench.experiment.context.ExperimentContext` (size,
 output folder, progress, GL context, measurement defaults, the shared-data guard), writes its
 figures and further tables into the context's folder and returns its rows.
-:func:`run_experiment` then writes ``table.csv``/``table.md`` from those rows.
+:func:`run_experiment` then writes ``table.csv``/``table.md`` from those rows. Every table a
+declared experiment writes is checked against its declaration first, and its Markdown carries
+the declared legend.
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from ..output.tables import current_umask, write_table
 from ..output.targets import output_folder
 from ..results.store import process_alive
 from .context import SIZES, ExperimentContext
+from .declare import Declaration
 
 if TYPE_CHECKING:
     from ..results.recording import Recorder
@@ -40,25 +44,34 @@ _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 @dataclass(frozen=True)
 class Experiment:
-    """A registered experiment: its name (also its figures folder), a one-line description and
-    the function ``run(exp: ExperimentContext) -> list[dict]``."""
+    """A registered experiment: its name (also its figures folder), a one-line description,
+    the function ``run(exp: ExperimentContext) -> list[dict]`` and the declaration of its
+    tables and claims (None: its tables are written unchecked, without legends)."""
 
     name: str
     description: str
     function: RunFunction
+    declared: Declaration | None = None
 
 
 EXPERIMENTS: dict[str, Experiment] = {}
 _discovered = False
 
 
-def experiment(name: str, description: str) -> Callable[[RunFunction], RunFunction]:
+def experiment(name: str, description: str,
+               declared: Declaration | None = None) -> Callable[[RunFunction], RunFunction]:
     """Decorator registering ``run`` under ``name`` (letters, digits, ``_ . -``; it names the
-    folder ``figures/<name>/``). Refuses a name already taken by a different function; a module
-    imported again replaces its own entry. Returns the function unchanged."""
+    folder ``figures/<name>/``) with ``declared``, the declaration of its tables and claims
+    (every experiment of ``workbench.reproductions`` has one). Refuses a name already taken by
+    a different function, and a ``declared`` that is not a
+    :class:`~workbench.experiment.declare.Declaration`; a module imported again replaces its
+    own entry. Returns the function unchanged."""
     if not isinstance(name, str) or not _NAME.match(name):
         raise ValueError(f"experiment name must be letters, digits, '_', '.' or '-' (not leading), "
                          f"got {name!r}")
+    if declared is not None and not isinstance(declared, Declaration):
+        raise TypeError(f"experiment {name!r}: declared must be a Declaration, "
+                        f"got {type(declared).__name__}")
 
     def register(function: RunFunction) -> RunFunction:
         if not callable(function):
@@ -68,7 +81,7 @@ def experiment(name: str, description: str) -> Callable[[RunFunction], RunFuncti
                 function.__module__, function.__qualname__):
             raise ValueError(f"experiment {name!r} is already registered by "
                              f"{old.function.__module__}.{old.function.__qualname__}")
-        EXPERIMENTS[name] = Experiment(name, str(description), function)
+        EXPERIMENTS[name] = Experiment(name, str(description), function, declared)
         return function
 
     return register
@@ -123,7 +136,9 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     folder set aside, temporary files) is cleaned up first. Returns ``(rows, out_dir)``.
     Unknown names raise KeyError listing the known ones; rows that are not dicts raise TypeError.
     An output folder that is a symbolic link (wherever it points) or not a folder is refused
-    (ValueError) before the experiment runs, and again just before the swap.
+    (ValueError) before the experiment runs, and again just before the swap. A declared
+    experiment's table whose columns differ from its declaration is refused
+    (:class:`~workbench.experiment.declare.DeclarationError`) before it is written.
     """
     exp = get_experiment(name)
     size = size if size is not None else ("quick" if quick else "full")
@@ -137,7 +152,7 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     staging = Path(tempfile.mkdtemp(dir=root, prefix=f".{exp.name}.",
                                     suffix=f".{os.getpid()}.partial"))
     os.chmod(staging, 0o777 & ~current_umask())  # mkdtemp makes 0700; the output folder is public
-    context = ExperimentContext(exp.name, staging, size, progress)
+    context = ExperimentContext(exp.name, staging, size, progress, declared=exp.declared)
     try:
         try:
             rows = exp.function(context)
@@ -151,7 +166,8 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
             raise TypeError(f"experiment {name!r} returned rows that are not dicts: {bad[:3]}")
         rows = context.with_device(rows)
         write_table(rows, staging, "table", title=f"{exp.name}: {exp.description}",
-                    notes=empty_gpu_note(rows, context.gl_renderer))
+                    notes=empty_gpu_note(rows, context.gl_renderer),
+                    legend=context.legend("table", rows))
         _swap_in(staging, out_dir)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)

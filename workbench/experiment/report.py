@@ -1,31 +1,34 @@
 """The measured claims of the README and ``docs/results.md``, written from the results store.
 
 Nothing in them is typed: each experiment's latest stored run (full size where there is one,
-else quick) gives its claims (:data:`CLAIMS`, one function per experiment reading that run's
-tables) and its tables; each names the run, the machine and renderer it ran on, its size, the
-commit and the load on the machine when it started. A ratio measured interleaved is given with
-its 95 % interval (``1.13× [1.07, 1.22]``); a ratio of two separate measurements says so.
+else quick) gives its claims (the :class:`~workbench.experiment.declare.Claim` s its
+declaration holds, each reading only the declared columns it names from that run's tables,
+:class:`ClaimRow`) and its tables; each names the run, the machine and renderer it ran on, its
+size, the commit and the load on the machine when it started. A ratio measured interleaved is
+given with its 95 % interval (``1.13× [1.07, 1.22]``); a ratio of two separate measurements
+says so. The README lists the experiments with claims ordered by paper.
 
 :func:`write_report` rewrites the part of the README between ``<!-- results:begin -->`` and
-``<!-- results:end -->`` and the whole of ``docs/results.md``, each atomically.
+``<!-- results:end -->`` and the whole of ``docs/results.md`` (every stored table with its
+declared legend), each atomically.
 """
 
 from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..output.tables import atomic_write_text, format_number, markdown_table
+from ..output.tables import atomic_write_text, format_number, markdown_table, table_columns
 
 if TYPE_CHECKING:
     from ..results.store import ResultsStore
+    from .declare import Claim, Declaration
 
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
-Tables = Callable[[str], list[dict[str, Any]]]
 
 
 @dataclass(frozen=True)
@@ -59,8 +62,8 @@ class Source:
 
 
 def latest_sources(store: ResultsStore) -> dict[str, Source]:
-    """Per experiment, its latest stored run at full size, else at quick size (tiny runs and
-    sweeps are not reported)."""
+    """Per experiment, its latest stored run at full size, else at quick size (tiny runs,
+    sweeps and benchmarks are not reported)."""
     if not {"experiment", "experiment_size"} <= set(
             store.query("SELECT * FROM rows LIMIT 0").column_names):
         return {}  # nothing an experiment wrote
@@ -72,6 +75,7 @@ def latest_sources(store: ResultsStore) -> dict[str, Source]:
         "any_value(u.load_1m) AS load_1m "
         "FROM rows r JOIN runs u USING (run_id) LEFT JOIN machines m USING (machine_id) "
         "WHERE r.experiment_size IN ('full', 'quick') AND r.experiment NOT LIKE 'sweep:%' "
+        "AND r.experiment NOT LIKE 'bench:%' "
         "GROUP BY ALL").to_pylist()
     best: dict[str, Source] = {}
     for row in found:
@@ -125,18 +129,6 @@ def interval(row: dict[str, Any], name: str) -> str:
             f"{num(row.get(f'{name}_hi'))}]")
 
 
-# ---------------------------------------------------------------- the claims
-def render_paths_claims(tables: Tables) -> list[str]:
-    out = []
-    for r in tables("targets"):
-        out.append(f"{r['scene']} at {r['size']} ({r['triangles']:,} triangles): per-pixel "
-                   f"bands {num(r['contour_wall_ms'])} ms, "
-                   f"{interval(r, 'contour_over_position_only')} the position-only draw; with "
-                   f"4× MSAA and read-back {interval(r, 'contour_msaa_over_pyrender')} "
-                   f"pyrender's time (SSIM {num(r['pyrender_ssim'])} against it)")
-    return out + ["ratios interleaved"] if out else out
-
-
 def span(values: list[float], digits: int = 3) -> str:
     """``a`` or ``a–b``: the range of ``values`` (None left out); "n/a" for none."""
     values = sorted(v for v in values if v is not None)
@@ -146,140 +138,64 @@ def span(values: list[float], digits: int = 3) -> str:
     return lo if lo == hi else f"{lo}–{hi}"
 
 
-def software_raster_claims(tables: Tables) -> list[str]:
-    out = []
-    for r in tables("interleaved"):
-        out.append(f"{r['scene']} at {r['size']}: {r['case']} {num(r['software_ms'])} ms, "
-                   f"{interval(r, 'speed_vs_llvmpipe')} as fast as {r['against']} "
-                   f"({num(r['llvmpipe_ms'])} ms)")
-    gl_rule = [r for r in tables("table") if r.get("case") == "software bands, GL rule"]
-    out += [f"{r['scene']}: with llvmpipe's pixel rule {num(r['differing_pct'])} % of the "
-            f"pixels differ from the GL image" for r in gl_rule]
-    return out + ["speeds interleaved"] if out else out
+# ---------------------------------------------------------------- the claims
+class ClaimRow(dict):
+    """A stored row as a claim sees it: the columns the claim declares it reads (those the
+    run stored); reading any other column raises KeyError naming it, so a claim cannot use a
+    column it does not declare."""
+
+    def __init__(self, row: dict[str, Any], reads: Sequence[str], quantity: str) -> None:
+        super().__init__({c: row[c] for c in reads if c in row})
+        self._reads, self._quantity = frozenset(reads), quantity
+
+    def _refuse(self, key: str) -> KeyError:
+        return KeyError(f"claim {self._quantity!r} reads column {key!r} without declaring it")
+
+    def __missing__(self, key: str) -> Any:
+        if key not in self._reads:
+            raise self._refuse(key)
+        raise KeyError(key)
+
+    def get(self, key: str, default: Any = None) -> Any:
+        """The column ``key`` (``default`` where the run did not store it); KeyError for a
+        column the claim does not declare."""
+        if key not in self._reads:
+            raise self._refuse(key)
+        return super().get(key, default)
 
 
-def bvh_claims(tables: Tables) -> list[str]:
-    rows = [r for r in tables("table") if r.get("queries_per_s")
-            and not str(r["scene"]).startswith("paper")]
-    if not rows:
-        return []
-    scene = rows[-1]["scene"]  # the largest of our scenes comes last
-    ours = [r for r in rows if r["scene"] == scene]
-    errors = [r["max_abs_error_mm"] for r in ours if r.get("max_abs_error_mm") is not None]
-    out = [f"{scene} ({ours[0]['nodes']:,} nodes): "
-           f"{span([r['queries_per_s'] / 1e6 for r in ours])} M queries/s, largest error "
-           f"against exact rational arithmetic {num(max(errors) if errors else None)} mm"]
-    for r in tables("references"):
-        if r["scene"] == scene and r["tool"] in ("libigl", "open3d") and r.get("queries_per_s"):
-            out.append(f"{r['tool']} {num(r['queries_per_s'] / 1e6)} M queries/s "
-                       f"({num(r['speed_vs_ours'])}× ours), largest error "
-                       f"{num(r['max_abs_error_mm'])} mm, {r['nodes_flagged']} nodes flagged")
-    return out + ["separate measurements"]
+def declared_claims() -> dict[str, tuple[str, tuple[Claim, ...]]]:
+    """Experiment → (paper, claims) of every registered experiment whose declaration holds
+    claims, ordered by paper."""
+    from .registry import EXPERIMENTS, discover
 
-
-def fe_texture_claims(tables: Tables) -> list[str]:
-    rows = [r for r in tables("table3") if r.get("speed_vs_overdraw") is not None]
-    wanted = [r for r in rows if "simplified A" in r["case"] and "wire" in r["case"]]
-    return [f"{r['scene']}: {r['case']} {r['triangles']:,} triangles, {num(r['wall_ms'])} ms, "
-            f"{num(r['speed_vs_overdraw'])}× the original with line overdraw (separate "
-            f"measurements), wire IoU {num(r.get('wire_iou_1px'))}, certified distance "
-            f"{num(r.get('hausdorff_mm'))} mm" for r in wanted[:2]]
-
-
-def pixel_exact_claims(tables: Tables) -> list[str]:
-    rows = [r for r in tables("table") if r.get("wall_vs_per_vertex") is not None]
-    if not rows:
-        return []
-    top = max(r["polygons"] for r in rows)
-    rows = [r for r in rows if r["polygons"] == top]
-    plain = {r["path"]: r for r in rows
-             if r["edge_overdraw"] == "none" and r["element_store"] == "buffer"}
-    if not {"per_pixel", "per_vertex"} <= set(plain):
-        return []
-    pixel, vertex = plain["per_pixel"], plain["per_vertex"]
-    out = [f"{top:,} polygons, no edge overdraw: per pixel {num(100 * pixel['share_over_1'])} "
-           f"% of the covered pixels more than 1/255 off the exact image, per vertex "
-           f"{num(100 * vertex['share_over_1'])} %; skirts leave "
-           f"{span([r['crack_pixels'] for r in rows if r['edge_overdraw'] == 'skirts'])} crack "
-           f"pixels"]
-    out += [f"{r['polygons']:,} polygons at {r['size']}: per pixel "
-            f"{interval(r, 'per_pixel_over_per_vertex')} per vertex's time "
-            f"({num(r['per_pixel_ms'])} against {num(r['per_vertex_ms'])} ms), interleaved"
-            for r in tables("interleaved")]
-    return out
-
-
-def exploded_claims(tables: Tables) -> list[str]:
-    out = []
-    rows = tables("table")
-    for scene in dict.fromkeys(r["scene"] for r in rows):
-        mine = [r for r in rows if r["scene"] == scene]
-        # "not within N" where the part was not revealed: the store keeps the column as text
-        frames = [int(r["frames_to_reveal"]) for r in mine
-                  if str(r["frames_to_reveal"]).isdigit()]
-        out.append(f"{scene}: part {mine[0]['focus_part']} revealed in {len(frames)} of "
-                   f"{len(mine)} views (up to {num(max(r['sweep_deg'] for r in mine))}° from "
-                   f"the split plane), within {max(frames) if frames else 'n/a'} frames; the "
-                   f"in-frame count costs {span([r['occlusion_over_draw'] for r in mine])}× the "
-                   f"draw, a separate pass {span([r['separate_over_draw'] for r in mine])}× "
-                   f"(separate measurements)")
-    return out
-
-
-def quad_strips_claims(tables: Tables) -> list[str]:
-    rows = [r for r in tables("table") if r.get("quad_verts_pct") is not None]
-    if not rows:
-        return []
-    panels = [r for r in rows if str(r["scene"]).startswith("panels")]
-    picked = [max(panels, key=lambda r: r["quads"])] if panels else []
-    picked += [r for r in rows if r["scene"] == "car"][:1]  # the largest panels and the car
-    return [f"{r['scene']} ({r['quads']:,} quads): quad strips send "
-            f"{num(r['quad_verts_pct'])} % of 4n vertices, triangle strips "
-            f"{num(r['tri_verts_pct'])} %" for r in picked]
-
-
-def simplify_claims(tables: Tables) -> list[str]:
-    seen, out = set(), []
-    for r in tables("table"):
-        if r.get("method") == "ours (Hausdorff-bounded)" and r["scene"] not in seen:
-            seen.add(r["scene"])
-            out.append(f"{r['scene']} at {num(r['tol_pct'])} %: {r['input_triangles']:,} → "
-                       f"{r['triangles']:,} triangles, certified one-sided distance "
-                       f"{num(r.get('hausdorff_mm'))} mm in {num(r['seconds'])} s")
-    for r in tables("hausdorff_peer"):
-        if r.get("ours_s") is None or r.get("peer_s") is None:
-            continue
-        out.append(f"{r['model']} → {r['triangles']:,} triangles, certified bracket at "
-                   f"{num(r['tol_share_of_diagonal'])} of the diagonal: ours {num(r['ours_s'])} s, "
-                   f"cascading-upper-bounds {num(r['peer_s'])} s (its time "
-                   f"{num(r['time_ratio'])}× [{num(r['time_ratio_min'])}, "
-                   f"{num(r['time_ratio_max'])}] ours, interleaved), brackets "
-                   f"{'overlap' if r.get('overlap') else 'DISJOINT'}")
-    return out
-
-
-CLAIMS: dict[str, tuple[str, Callable[[Tables], list[str]]]] = {
-    "render_paths": ("es2008", render_paths_claims),
-    "table_software_raster": ("es2008 Tables 2–3", software_raster_claims),
-    "table_bvh_distance": ("crash2000 §4, Table 2", bvh_claims),
-    "simplify_tradeoff": ("crash2000 §3.2", simplify_claims),
-    "table_quad_strips": ("crash2000 Table 1", quad_strips_claims),
-    "table_fe_texture_wireframe": ("fe2003 Tables 1–3", fe_texture_claims),
-    "fig_pixel_exact": ("st2005", pixel_exact_claims),
-    "fig_exploded": ("ghost2013", exploded_claims),
-}
+    discover()
+    found = {name: (exp.declared.paper, exp.declared.claims) for name, exp in EXPERIMENTS.items()
+             if exp.declared is not None and exp.declared.claims}
+    return dict(sorted(found.items(), key=lambda item: (item[1][0], item[0])))
 
 
 def claims_of(store: ResultsStore, source: Source) -> list[str]:
-    """The claims of ``source``'s experiment (none for an experiment without a claim
-    function; a claim that its stored tables cannot give is named as missing)."""
-    entry = CLAIMS.get(source.experiment)
+    """The claims of ``source``'s experiment, from its declaration (none for an experiment
+    that declares none), each reading the declared columns of its stored tables; a claim
+    that the run's stored tables cannot give is named as missing."""
+    entry = declared_claims().get(source.experiment)
     if entry is None:
         return []
-    try:
-        return entry[1](lambda table: stored_table(store, source, table))
-    except (KeyError, TypeError) as exc:
-        return [f"(not in this run's tables: {exc})"]
+    out = []
+    for claim in entry[1]:
+        def tables(table: str, claim: Claim = claim) -> list[ClaimRow]:
+            reads = claim.reads.get(table)
+            if reads is None:
+                raise KeyError(f"claim {claim.quantity!r} reads table {table!r} without "
+                               f"declaring it")
+            return [ClaimRow(r, reads, claim.quantity)
+                    for r in stored_table(store, source, table)]
+        try:
+            out += claim.state(tables)
+        except (KeyError, TypeError) as exc:
+            out.append(f"(not in this run's tables: {exc})")
+    return out
 
 
 # ---------------------------------------------------------------- the two documents
@@ -287,7 +203,7 @@ def readme_section(store: ResultsStore) -> str:
     """The README's table of measured claims, one row per experiment."""
     sources = latest_sources(store)
     rows = []
-    for experiment, (paper, _) in CLAIMS.items():
+    for experiment, (paper, _) in declared_claims().items():
         source = sources.get(experiment)
         if source is None:
             rows.append({"paper": paper, "experiment": f"`{experiment}`",
@@ -324,8 +240,20 @@ def results_document(store: ResultsStore) -> str:
                   ""]
         parts += [f"- {claim}" for claim in claims_of(store, source)] + [""]
         for table in stored_table_names(store, source):
-            parts += [f"### {table}", "", markdown_table(stored_table(store, source, table))]
+            rows = stored_table(store, source, table)
+            parts += [f"### {table}", "", markdown_table(rows, legend=stored_legend(
+                known.declared if known else None, table, rows))]
     return "\n".join(parts)
+
+
+def stored_legend(declared: Declaration | None, table: str,
+                  rows: list[dict[str, Any]]) -> list[tuple[str, str, str]]:
+    """The legend of the stored ``table``'s columns from the experiment's declaration (none
+    where it declares no such table: a run stored before the declaration changed keeps its
+    columns, only their legends go)."""
+    if declared is None or table not in {t.name for t in declared.tables}:
+        return []
+    return declared.table(table).legend(table_columns(rows))
 
 
 def replace_section(text: str, section: str, name: str = "README") -> str:

@@ -150,9 +150,11 @@ def _is_number(value) -> bool:
 
 
 def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[str] | None = None,
-                   title: str | None = None, notes: Sequence[str] = ()) -> str:
+                   title: str | None = None, notes: Sequence[str] = (),
+                   legend: Sequence[tuple[str, str, str]] = ()) -> str:
     """An aligned Markdown pipe table (numeric columns right-aligned), with an optional heading
-    and ``notes`` (one paragraph each) between heading and table."""
+    and ``notes`` (one paragraph each) between heading and table, and under it the ``legend``:
+    one line per ``(column, unit, meaning)`` (unit "" for labels and counts)."""
     rows = _check_rows(rows)
     columns = list(table_columns(rows) if columns is None else columns)
     lines = [f"# {title}", ""] if title else []
@@ -175,7 +177,15 @@ def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[str] | None
     lines.append("| " + " | ".join("-" * (w - 1) + ":" if r else "-" * w
                                    for w, r in zip(widths, numeric)) + " |")
     lines.extend(line(r, numeric) for r in cells)
+    if legend:
+        lines += ["", "Columns:", ""] + [legend_line(*entry) for entry in legend]
     return "\n".join(lines) + "\n"
+
+
+def legend_line(column: str, unit: str, meaning: str) -> str:
+    """One legend line under a Markdown table: ``- `column` (unit): meaning``."""
+    unit = f" ({unit})" if unit else ""
+    return f"- `{column}`{unit}: {meaning}".replace("\n", " ")
 
 
 def _csv_value(value):
@@ -186,13 +196,15 @@ def _csv_value(value):
 def write_table(rows: Sequence[dict[str, Any]], directory: str | os.PathLike[str],
                 name: str = "table",
                 columns: Sequence[str] | None = None,
-                title: str | None = None, notes: Sequence[str] = ()) -> tuple[Path, Path]:
+                title: str | None = None, notes: Sequence[str] = (),
+                legend: Sequence[tuple[str, str, str]] = ()) -> tuple[Path, Path]:
     """Write ``rows`` as ``<directory>/<name>.csv`` and ``<name>.md``; returns both paths.
 
     ``columns`` picks and orders the columns (missing values stay empty); by default all keys in
     first-seen order, less the raw-sample lists (see :func:`table_columns`); ``notes`` go under
-    the Markdown title. Floats are written to the CSV at full precision and to Markdown with four
-    significant digits. Both files are replaced atomically; the Markdown is formatted before
+    the Markdown title and ``legend`` (``(column, unit, meaning)`` each) under its table.
+    Floats are written to the CSV at full precision and to Markdown with four significant
+    digits. Both files are replaced atomically; the Markdown is formatted before
     either is touched, so a row that cannot be formatted leaves the previous table in place.
     Refuses rows that are not dicts, a missing directory and (before writing either file) a
     ``.csv`` or ``.md`` target that exists and is not a regular file.
@@ -202,7 +214,7 @@ def write_table(rows: Sequence[dict[str, Any]], directory: str | os.PathLike[str
     if not directory.is_dir():
         raise FileNotFoundError(f"table directory {directory} does not exist")
     columns = list(table_columns(rows) if columns is None else columns)
-    md_text = markdown_table(rows, columns, title, notes)
+    md_text = markdown_table(rows, columns, title, notes, legend)
     csv_path = output_target(directory / f"{name}.csv")
     md_path = output_target(directory / f"{name}.md")
     with atomic_open(csv_path, "w", encoding="utf-8", newline="") as handle:

@@ -78,6 +78,8 @@ from workbench.paths.exploded import exploded_camera
 from workbench.scene import generators
 from workbench.scene.mesh import FEMesh
 
+from ._declared.fig_exploded import DECLARED
+
 ANGLES = (0.0, 20.0, 40.0, 60.0, 75.0, 85.0)
 EXPONENTS = (1.0, 0.5)  # the thesis's r, and r^0.5
 REVEALED = 0.01  # r at or below which the object counts as fully revealed
@@ -406,7 +408,8 @@ def car_rows(exp: ExperimentContext, car: FEMesh, size, frames) -> tuple[list[di
 
 
 @experiment("fig_exploded", "ghost2013: occlusion-driven ghosted exploded views over view "
-            "angles on the car and a box of panels, against uniform and fixed-offset explosions")
+            "angles on the car and a box of panels, against uniform and fixed-offset explosions",
+            declared=DECLARED)
 def run(exp: ExperimentContext) -> list[dict]:
     size = exp.pick((400, 300), (200, 150), TINY_SIZE)
     frames = exp.pick(60, 40, TINY_FRAMES)

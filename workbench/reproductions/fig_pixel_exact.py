@@ -75,6 +75,8 @@ from workbench.output.tables import atomic_open
 from workbench.paths.colormap import colormap_lut
 from workbench.paths.spacetime import OVERDRAWS, SpacetimeStyle, spacetime_path, top_camera
 
+from ._declared.fig_pixel_exact import DECLARED
+
 U_MAX = 100.0  # kJ/m³, top of the log colour scale
 HEIGHT_SCALE = 800.0  # mm of height per mm/µs (peak speeds ~1e-2 mm/µs)
 COLORMAP = "plasma"  # its dark end is blue, not black, so lighting shows everywhere
@@ -577,7 +579,8 @@ def interleaved_rows(exp: ExperimentContext, views: Views, keep: dict) -> list[d
 
 
 @experiment("fig_pixel_exact", "st2005: pixel-exact rendering of spacetime FE solutions, "
-                               "per vertex against per pixel, with exact images")
+                               "per vertex against per pixel, with exact images",
+            declared=DECLARED)
 def run(exp: ExperimentContext) -> list[dict]:
     views = Views(exp, width=exp.pick(1000, 400, 160))
     exp.say(f"slice sizes on {exp.renderer}")

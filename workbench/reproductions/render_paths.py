@@ -42,6 +42,8 @@ from workbench.references.pyvista import PyvistaReference
 from workbench.scene import generators
 from workbench.scene.needs import MESH_ITEMS, derivation_cost
 
+from ._declared.render_paths import DECLARED
+
 BANDS = 10
 
 
@@ -277,7 +279,8 @@ def save_figures(exp: ExperimentContext, label: str, images: dict, ref_image: np
 
 
 @experiment("render_paths", "first render paths on the car and the es2008 semicylinders: time "
-                            "against error, pyrender, pyvista/VTK and a bare draw beside them")
+                            "against error, pyrender, pyvista/VTK and a bare draw beside them",
+            declared=DECLARED)
 def run(exp: ExperimentContext) -> list[dict]:
     rows: list[dict] = []
     targets: list[dict] = []

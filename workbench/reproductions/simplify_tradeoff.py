@@ -86,6 +86,7 @@ from workbench.references.simplifiers import (
 from workbench.scene import generators
 from workbench.scene.mesh import FEMesh
 
+from ._declared.simplify_tradeoff import DECLARED
 from ._simplify_figures import save_equal_error_figure, save_tradeoff_figure
 
 TOLERANCES_PCT = (0.1, 0.25, 0.5, 1.0, 2.0)
@@ -554,7 +555,8 @@ def peer_rows(exp: ExperimentContext, car: FEMesh | None) -> list[dict]:
 
 
 @experiment("simplify_tradeoff", "crash2000 §3.2: Hausdorff-bounded decimation against pymeshlab, "
-                                 "libigl, open3d and meshoptimizer, with a certified metric")
+                                 "libigl, open3d and meshoptimizer, with a certified metric",
+            declared=DECLARED)
 def run(exp: ExperimentContext) -> list[dict]:
     car = exp.builtin("car")
     rows = []

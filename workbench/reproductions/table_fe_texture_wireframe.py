@@ -77,6 +77,8 @@ from workbench.paths import Style
 from workbench.scene import generators
 from workbench.scene.mesh import FEMesh
 
+from ._declared.table_fe_texture_wireframe import DECLARED
+
 VIEW = {"azimuth": -35.0, "elevation": 25.0, "up": "z"}
 WIRE = (0.0, 0.0, 0.0)
 OVERDRAW = "original + line overdraw"
@@ -493,7 +495,8 @@ def mesh_models(exp: ExperimentContext, case: Case) -> tuple[dict, dict, list[di
 
 
 @experiment("table_fe_texture_wireframe", "fe2003 Tables 1-3: simplified FE meshes with normal "
-                                          "maps and a wire-frame texture against line overdraw")
+                                          "maps and a wire-frame texture against line overdraw",
+            declared=DECLARED)
 def run(exp: ExperimentContext) -> list[dict]:
     size = exp.pick((1000, 750), (500, 375), TINY_SIZE)
     exp.table(params_rows(), "params", "fe2003 Table 1: parameter sets")

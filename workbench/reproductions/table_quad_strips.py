@@ -39,6 +39,8 @@ from workbench.output.tables import atomic_open
 from workbench.paths import Style
 from workbench.scene import generators
 
+from ._declared.table_quad_strips import DECLARED
+
 PAPER_SIZES = (2_215, 26_284, 51_473, 104_749, 255_641)
 # crash2000 Table 1 as printed: #quads, #verts, opTriStripper (#strips, #verts, length),
 # QuadStripper (#strips, #verts, length)
@@ -234,7 +236,8 @@ def draw_rows(exp: ExperimentContext, case: Case, size) -> tuple[list[dict], dic
 
 
 @experiment("table_quad_strips", "crash2000 Table 1: quad strips by bandification against "
-                                 "meshoptimizer triangle strips, drawn stripped and unstripped")
+                                 "meshoptimizer triangle strips, drawn stripped and unstripped",
+            declared=DECLARED)
 def run(exp: ExperimentContext) -> list[dict]:
     suite = list(models(exp))
     rows = []

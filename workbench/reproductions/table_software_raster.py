@@ -69,6 +69,8 @@ from workbench.paths.software import SoftwarePath
 from workbench.scene.generators import semicylinders
 from workbench.scene.needs import derive
 
+from ._declared.table_software_raster import DECLARED
+
 # es2008 Tables 2 (1 M triangles) and 3 (16.6 M): step → (vec-off s, vec-on s, ratio) each
 PAPER_STEPS = {
     "transform and light": ((0.982, 0.043, 24), (10.712, 0.663, 17)),
@@ -437,7 +439,8 @@ def paper_rows() -> list[dict]:
 
 
 @experiment("table_software_raster", "es2008 Tables 2-3: the software rasterizer with a span "
-            "look-up table against llvmpipe, per-step times, sort-last compositing on Dask")
+            "look-up table against llvmpipe, per-step times, sort-last compositing on Dask",
+            declared=DECLARED)
 def run(exp: ExperimentContext) -> list[dict]:
     exp.say(f"renderer: {exp.renderer}")
     rows, images, interleaved = [], {}, []
