@@ -9,9 +9,12 @@ on top. A module
 may import its own layer and the layers below. Imports inside functions count: a lazy import
 that points up, or closes a circle, is the same coupling. The one exception is named in
 ``ROOT_FACADE``: the package root (layer 0, since ``sweep`` reads its ``__version__``) hands
-out ``workbench.view`` from the viewer through a module ``__getattr__``; that edge still counts
-for the circle check. The checks are tested on a small package with the faults they exist to
-catch.
+out ``workbench.load`` and ``workbench.render`` (``paths.facade``), ``workbench.measure``
+(``measurement.rows``) and ``workbench.view`` (the viewer) through a module ``__getattr__``;
+those edges still count for the circle check. No module outside ``paths`` prepares a path by
+hand: a call of ``.prepare(`` (a path's or a backend's) belongs in
+:mod:`workbench.paths.drawing`, which everything else goes through. The checks are tested on a
+small package with the faults they exist to catch.
 """
 
 import ast
@@ -25,8 +28,10 @@ LAYERS = {"gl": 0, "scene": 0, "data": 0, "glsl": 0, "__init__": 0, "algo": 1, "
           "measurement": 3, "output": 3, "references": 4, "results": 4, "distributed": 4,
           "animation": 4, "experiment": 5, "sweep": 6, "reliability": 7, "cli": 8, "viewer": 8,
           "reproductions": 9}
-# upward imports allowed by name: the package root's lazy ``workbench.view``
-ROOT_FACADE = {("workbench", "workbench.viewer")}
+# upward imports allowed by name: the package root's lazy facade (``workbench.load``,
+# ``render``, ``measure``, ``view``)
+ROOT_FACADE = {("workbench", "workbench.paths.facade"), ("workbench", "workbench.measurement.rows"),
+               ("workbench", "workbench.viewer")}
 PACKAGE_DIRS = {"workbench": ROOT / "workbench"}
 
 
@@ -125,6 +130,21 @@ def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return found
 
 
+def prepares_by_hand(dirs: dict[str, Path]) -> list[str]:
+    """``"module:line"`` for every call of ``X.prepare(...)`` in a module outside the ``paths``
+    layer: a path prepared by hand instead of through ``workbench.paths.drawing``."""
+    found = []
+    for package, folder in dirs.items():
+        for module, path in sorted(modules_of(package, folder).items()):
+            if layer_of(module) == "paths":
+                continue
+            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+                if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) \
+                        and node.func.attr == "prepare":
+                    found.append(f"{module}:{node.lineno}")
+    return found
+
+
 @pytest.fixture(scope="module")
 def graph():
     return import_graph(PACKAGE_DIRS)
@@ -134,6 +154,29 @@ def test_every_layer_imports_only_downward(graph):
     checked = {module: {t for t in targets if (module, t) not in ROOT_FACADE}
                for module, targets in graph.items()}
     assert upward_imports(checked, LAYERS) == []
+
+
+def test_no_path_prepared_outside_paths():
+    assert prepares_by_hand(PACKAGE_DIRS) == []
+
+
+def test_the_prepare_check_finds_a_path_prepared_by_hand(tmp_path):
+    """The check itself: a path prepared in ``paths`` passes, one prepared in the CLI (inside
+    a function, through any name) is found."""
+    root = tmp_path / "workbench"
+    files = {
+        "__init__.py": "",
+        "paths/__init__.py": "",
+        "paths/drawing.py": "def prepared(backend, path):\n    backend.prepare(path)\n",
+        "cli/__init__.py": "",
+        "cli/render.py": "from ..paths.drawing import prepared\n\n"
+                         "def run(ctx, path, scene):\n    path.draw()\n"
+                         "    path.prepare(ctx, scene, None)\n",
+    }
+    for name, text in files.items():
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_text(text)
+    assert prepares_by_hand({"workbench": root}) == ["workbench.cli.render:5"]
 
 
 def test_no_import_cycles(graph):

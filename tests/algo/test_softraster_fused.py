@@ -11,8 +11,8 @@ from test_softraster import pixel_projection
 
 from workbench.algo.softraster import SHADINGS, Frame, RasterOptions, Shading, render
 from workbench.algo.softraster import fused as fused_module
-from workbench.measurement.rows import default_camera, prepared
-from workbench.paths import SoftwareRasterizer, Style
+from workbench.measurement.rows import default_camera
+from workbench.paths import SoftwareRasterizer, Style, prepared
 from workbench.scene.generators import crash_sequence, stamped_panels
 
 SIZES = [(64, 48), (97, 61), (160, 120)]

@@ -9,10 +9,10 @@ import pytest
 from workbench.experiment.context import ExperimentContext
 from workbench.gl.context import timer_queries_meaningful
 from workbench.measurement.interleave import Clock, draw_clock, interleaved_ratios, time_interleaved
-from workbench.measurement.rows import measure, prepared
+from workbench.measurement.rows import measure
 from workbench.measurement.stats import StoppingRule
 from workbench.measurement.timing import EMPTY_GPU_NOTE, empty_gpu_note, time_call
-from workbench.paths import Style
+from workbench.paths import Style, prepared
 from workbench.scene import generators
 
 

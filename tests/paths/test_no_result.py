@@ -26,9 +26,9 @@ from workbench.algo.composite.merge import composite
 from workbench.animation.decoration import Decoration
 from workbench.distributed.chunked import ChunkedScene, render_chunked, write_chunked
 from workbench.gl import Camera
-from workbench.measurement.rows import WHITE, default_camera, prepared
+from workbench.measurement.rows import WHITE, default_camera
 from workbench.output.figures import field_figure
-from workbench.paths import ColorScale, SoftwareRasterizer, Style, colormap
+from workbench.paths import ColorScale, SoftwareRasterizer, Style, colormap, prepared
 from workbench.paths.colormap import (
     NO_RESULT_COLOR,
     T_LIMIT,

@@ -70,39 +70,35 @@ def explode_animation(ctx: moderngl.Context, scene: FEMesh, path: ExplodedPath, 
     ``steps`` iterates the frame numbers (default ``range(count)``; a progress bar over it,
     say); ``on_frame(i, offset, r, path)`` is called after frame ``i`` with the offset it was
     drawn at and the occlusion ratio ``r`` that advanced the animation (the frame's pixel
-    counts are in ``path.last_occlusion``). A focus part with no pixels in this view (smaller
+    counts are in ``path.last_occlusion``). The frames are drawn by the one frame loop
+    (:func:`~workbench.animation.frames.draw_frames`) through the path prepared by
+    :func:`~workbench.paths.drawing.prepared`. A focus part with no pixels in this view (smaller
     than a pixel, seen edge-on) has nothing to reveal and is refused with ValueError after the
     first frame. The path and the framebuffer are released on the way out, also when a frame
     raises.
     """
-    from ..gl import Framebuffer
     from ..output.figures import with_progress_bar
+    from ..paths.drawing import prepared
+    from .frames import draw_frames
 
-    fb = Framebuffer(ctx, size)
     frames, offsets, p_unocc, p_occ, ratios = [], [], [], [], []
-    try:
-        with path:
-            path.prepare(ctx, scene, camera)
-            for i in range(count) if steps is None else steps:
-                fb.use()
-                fb.clear()
-                path.draw()
-                frames.append(with_progress_bar(fb.read(), i + 1, count, BAR_PX))
-                offset = path.offset
-                r = path.step_animation()
-                counts = path.last_occlusion
-                if counts["p_unocc"] == 0:
-                    raise ValueError(f"focus part {path.style.focus} has no pixels in this "
-                                     f"{size[0]}x{size[1]} view (smaller than a pixel or seen "
-                                     f"edge-on): there is nothing to reveal")
-                offsets.append(offset)
-                p_unocc.append(int(counts["p_unocc"]))
-                p_occ.append(int(counts["p_occ"]))
-                ratios.append(float(r))
-                if on_frame is not None:
-                    on_frame(i, offset, r, path)
-            offset, o_max = path.offset, path.settings.o_max
-            threshold = path.settings.revealed_below
-    finally:
-        fb.release()
+    with prepared(ctx, scene, path, camera=camera, size=size) as ready:
+        for drawn in draw_frames(ready, range(count) if steps is None else steps):
+            i = drawn.state
+            frames.append(with_progress_bar(drawn.image, i + 1, count, BAR_PX))
+            offset = path.offset
+            r = path.step_animation()
+            counts = path.last_occlusion
+            if counts["p_unocc"] == 0:
+                raise ValueError(f"focus part {path.style.focus} has no pixels in this "
+                                 f"{size[0]}x{size[1]} view (smaller than a pixel or seen "
+                                 f"edge-on): there is nothing to reveal")
+            offsets.append(offset)
+            p_unocc.append(int(counts["p_unocc"]))
+            p_occ.append(int(counts["p_occ"]))
+            ratios.append(float(r))
+            if on_frame is not None:
+                on_frame(i, offset, r, path)
+        offset, o_max = path.offset, path.settings.o_max
+        threshold = path.settings.revealed_below
     return ExplodeAnimation(frames, offsets, p_unocc, p_occ, ratios, threshold, offset, o_max)

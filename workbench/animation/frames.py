@@ -1,5 +1,15 @@
-"""The frames of a time-dependent FE mesh drawn through one render path: a crash (crash2000:
-one topology, coordinates and fields per state) played over its states.
+"""The one frame loop (:func:`draw_frames`), and the frames of a time-dependent FE mesh drawn
+through one render path (:class:`FrameLoop`: a crash, crash2000, played over its states).
+
+:func:`draw_frames` draws a prepared path (:class:`~workbench.paths.drawing.Prepared`) once per
+state of a sequence: an optional update first (``set_step``, an explosion's own extra draw),
+waited for and timed, then the target bound, cleared (outside the clock), the draw waited for
+and timed, and the image read back (timed apart). Every sequence of frames in the package goes
+through it: ``animate`` (:class:`FrameLoop`), ``explode``
+(:func:`workbench.animation.exploded.explode_animation`), the ghost2013 experiment
+(``fig_exploded``) and the live view (:class:`workbench.viewer.live.LiveView`, one frame per
+request). What happens between frames (an explosion's ``step_animation``) is the caller's, done
+when the loop hands it a frame.
 
 :class:`FrameLoop` prepares the path once — topology, index buffer and colour texture uploaded
 once — with one camera fitted to the box of every state
@@ -7,8 +17,8 @@ once — with one camera fitted to the box of every state
 (:meth:`~workbench.paths.base.RenderPath.set_step`: coordinates, normals where the path has
 them, time-dependent field values), draws and reads the image back. Each frame is the image
 ``workbench render MESH --step k --raw`` draws with the same path, style, size and view: the
-same camera, the same preparation (:func:`~workbench.measurement.rows.prepared`), and the
-same clear, draw and read-back as :func:`~workbench.measurement.rows.measure` untimed.
+same camera, the same preparation (:func:`~workbench.paths.drawing.prepared`), and the same
+clear, draw and read-back as :func:`~workbench.paths.drawing.render`.
 
 Colour scale: ``"fixed"`` keeps the path's own, by default the field's range over all states
 (:func:`~workbench.paths.colormap.scale_for`), on every frame; ``"per-step"`` maps each state's
@@ -24,16 +34,16 @@ No file formats here: the frames are arrays; writing them is the caller's.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..measurement.rows import WHITE, prepared
 from ..paths.backends import as_backend
 from ..paths.base import RenderPath
 from ..paths.colormap import missing_count, no_result_label
+from ..paths.drawing import WHITE, Prepared, prepared
 from ..paths.mesh import MeshPath
 from ..paths.registry import make_path, path_class
 
@@ -45,12 +55,65 @@ if TYPE_CHECKING:
     from ..scene.mesh import FEMesh
 
 SCALES = ("fixed", "per-step")
+Background = tuple[float, float, float, float]
 
 # mesh paths whose preparation depends on the state drawn, so that set_step alone does not
 # draw another state as render --step draws it: the flange distances are measured in the
 # state prepared, the exploded view splits the parts of that state
 STATE_BOUND_PATHS = {"flange": "measures its part distances in the one state it is prepared for",
                      "exploded": "splits the parts of the one state it is prepared for"}
+
+
+@dataclass(frozen=True)
+class Drawn:
+    """One frame of :func:`draw_frames`: ``state`` (the item of the sequence it drew),
+    ``image`` ((H, W, 4) uint8 RGBA, row 0 at the top; None when not read), ``update_ms`` (wall
+    ms of the update, waited for; 0 without one), ``sent`` (what the update returned where it
+    is a byte count, say ``set_step``'s; else 0), ``draw_ms`` (wall ms of the draw, waited for,
+    the clear before it excluded) and ``read_ms`` (wall ms of the read-back; 0 when not
+    read)."""
+
+    state: Any
+    image: np.ndarray | None
+    update_ms: float
+    sent: int
+    draw_ms: float
+    read_ms: float
+
+
+def draw_frames(ready: Prepared, states: Iterable[Any], *,
+                update: Callable[[Any], object] | None = None,
+                background: Background = WHITE, read: bool = True) -> Iterator[Drawn]:
+    """The one frame loop: for each item of ``states`` (any iterable: step indices, frame
+    numbers, a progress bar over them), ``update(state)`` where given (waited for and timed),
+    then ``ready``'s target bound and cleared to ``background`` (RGBA in [0, 1]) and the
+    clear waited for outside the clock, ``ready.path.draw()`` waited for and timed, and with
+    ``read`` the image read back (timed apart); yields a :class:`Drawn` per state, lazily, so
+    that the caller acts on the path between frames (an explosion's ``step_animation``).
+    ``ready`` stays prepared; releasing it is its context manager's job."""
+    backend = ready.backend
+    for state in states:
+        sent, update_ms = 0, 0.0
+        if update is not None:
+            start = time.perf_counter()
+            returned = update(state)
+            backend.finish()
+            update_ms = (time.perf_counter() - start) * 1e3
+            if isinstance(returned, (int, np.integer)) and not isinstance(returned, bool):
+                sent = int(returned)
+        ready.bind()
+        ready.target.clear(background)
+        backend.finish()
+        start = time.perf_counter()
+        ready.path.draw()
+        backend.finish()
+        draw_ms = (time.perf_counter() - start) * 1e3
+        image, read_ms = None, 0.0
+        if read:
+            start = time.perf_counter()
+            image = ready.target.read()
+            read_ms = (time.perf_counter() - start) * 1e3
+        yield Drawn(state, image, update_ms, sent, draw_ms, read_ms)
 
 
 @dataclass(frozen=True)
@@ -188,23 +251,20 @@ class FrameLoop:
             yield from self._per_step()
 
     def _fixed(self) -> Iterator[Frame]:
-        """Prepared once; per state ``set_step``, draw, read back."""
-        backend = self.backend
+        """Prepared once; per state ``set_step``, draw, read back (:func:`draw_frames`)."""
         value_range = None if self.colour_scale is None else self.colour_scale.value_range
-        with prepared(backend, self.mesh, self.name, self.style, self.camera, self.size,
+        with prepared(self.backend, self.mesh, self.name, self.style, self.camera, self.size,
                       samples=self.samples) as ready:
             self.prepare_ms, self.prepare_bytes = ready.prepare_ms, ready.path.bytes_uploaded
-            for k in self.steps:
-                start = time.perf_counter()
-                sent = ready.path.set_step(k)
-                backend.finish()
-                upload_ms = (time.perf_counter() - start) * 1e3
-                image, draw_ms = self._draw(ready)
-                yield Frame(k, self.time_of(k), image, value_range, upload_ms, draw_ms, sent,
+            for drawn in draw_frames(ready, self.steps, update=ready.path.set_step):
+                k = drawn.state
+                yield Frame(k, self.time_of(k), drawn.image, value_range, drawn.update_ms,
+                            drawn.draw_ms + drawn.read_ms, drawn.sent,
                             ready.path.bytes_per_step, self.no_result(k))
 
     def _per_step(self) -> Iterator[Frame]:
-        """Prepared again for every state, with that state's value range."""
+        """Prepared again for every state, with that state's value range; each preparation
+        draws its one frame through :func:`draw_frames`."""
         self.prepare_ms, self.prepare_bytes = 0.0, 0
         for k in self.steps:
             value_range = state_value_range(self.mesh, self.field, k)
@@ -214,16 +274,7 @@ class FrameLoop:
                 sent = ready.path.bytes_uploaded
                 self.prepare_ms += ready.prepare_ms
                 self.prepare_bytes += sent
-                image, draw_ms = self._draw(ready)
-                yield Frame(k, self.time_of(k), image, value_range, ready.prepare_ms, draw_ms,
-                            sent, ready.path.bytes_per_step, self.no_result(k))
-
-    def _draw(self, ready) -> tuple[np.ndarray, float]:
-        """(image, ms): the target cleared to white and waited for outside the clock, then the
-        path's draw and the read-back, as measure draws untimed."""
-        ready.target.clear(WHITE)
-        self.backend.finish()
-        start = time.perf_counter()
-        ready.path.draw()
-        image = ready.target.read()
-        return image, (time.perf_counter() - start) * 1e3
+                for drawn in draw_frames(ready, (k,)):
+                    yield Frame(k, self.time_of(k), drawn.image, value_range, ready.prepare_ms,
+                                drawn.draw_ms + drawn.read_ms, sent, ready.path.bytes_per_step,
+                                self.no_result(k))

@@ -1,8 +1,9 @@
-"""``workbench render``: one scene drawn offscreen through the one measurement function
-(untimed) and written as a PNG, with a colour bar when a field is shown; on the headless GL
-context or the es2008 software rasterizer. ``--domains D`` (sort-last) splits the mesh into D
-domains, draws them on Dask workers and composites them by depth; a chunked scene (a folder
-written by ``--write-chunked``) is drawn on the workers from its files
+"""``workbench render``: one scene drawn offscreen, untimed, as every path is drawn
+(:func:`workbench.paths.drawing.render`: the image :func:`~workbench.measurement.rows.measure`
+reads for the same arguments) and written as a PNG, with a colour bar when a field is shown;
+on the headless GL context or the es2008 software rasterizer. ``--domains D`` (sort-last)
+splits the mesh into D domains, draws them on Dask workers and composites them by depth; a
+chunked scene (a folder written by ``--write-chunked``) is drawn on the workers from its files
 (:mod:`.render_sortlast`).
 """
 
@@ -198,8 +199,7 @@ def _backend(args, path):
 
 def cmd_render(args) -> int:
     """Draw the scene, write ``--output``, print what was drawn; 0."""
-    from ..measurement.rows import measure
-    from ..paths import make_path, path_class
+    from ..paths import as_backend, make_path, path_class, render
     from ..paths.registry import scene_path
     from ..scene.builtin import load_scene
     from .render_sortlast import (
@@ -228,15 +228,15 @@ def cmd_render(args) -> int:
     check_extent(scene, args.step)
     if args.domains is not None:
         return render_domains(args, scene, path, camera, size)
-    result = measure(backend, scene, path, camera=camera, size=size, samples=args.samples,
-                     timed=False)
-    check_drawn(result.image, scene, camera, size, args.step)
+    image = render(backend, scene, path, camera=camera, size=size, samples=args.samples)
+    check_drawn(image, scene, camera, size, args.step)
     out = Path(args.output)
     field = args.field if args.field is not None else getattr(path.style, "field", None)
-    write_image(out, result.image, path, field if is_mesh else None, args,
+    write_image(out, image, path, field if is_mesh else None, args,
                 f"{scene.name} ({path_name})", scene=scene if is_mesh else None)
     strips = f", {path.strips} strip{'s' * (path.strips != 1)}" if path.strips else ""
-    print(f"{out}: {result.row['scene']}, {path.triangles} triangles, {path.vertices_sent} "
+    print(f"{out}: {scene.name}, {path.triangles} triangles, {path.vertices_sent} "
           f"vertices sent{strips}, path {path_name}"
-          + (f", {result.row['renderer']}" if args.rasterizer == "software" else ""))
+          + (f", {as_backend(backend).renderer_of(path)}" if args.rasterizer == "software"
+             else ""))
     return 0

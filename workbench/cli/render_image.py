@@ -73,7 +73,7 @@ def check_drawn(image, scene, camera, size: tuple[int, int], step: int) -> None:
     import numpy as np
 
     from ..measurement.images import coverage
-    from ..measurement.rows import WHITE
+    from ..paths.drawing import WHITE
 
     if coverage(image, WHITE).any():
         return

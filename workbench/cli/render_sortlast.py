@@ -47,6 +47,7 @@ def render_domains(args, mesh, path, camera, size) -> int:
     from ..distributed.cluster import sweep_cluster
     from ..distributed.domains import split_domains
     from ..distributed.sortlast import ChunkDomains, GLDomains, SoftwareDomains, render_sortlast
+    from ..paths import SoftwareRasterizer, prepared_path
 
     if args.all_faces:
         raise ValueError("--domains loads the scene again on each worker; --all-faces is not "
@@ -56,7 +57,7 @@ def render_domains(args, mesh, path, camera, size) -> int:
     if args.write_chunked is not None:
         from ..distributed.chunked import write_chunked
 
-        path.prepare(None, mesh, camera)
+        prepared_path(SoftwareRasterizer(path.options), mesh, path, camera=camera)
         folder = write_chunked(path, domains, args.write_chunked)
         print(f"{folder}: chunked scene of {mesh.name}, {args.domains} domains by {args.split}")
         render_domain = ChunkDomains(str(folder.resolve()), camera, size, path.options)
@@ -77,7 +78,7 @@ def render_domains(args, mesh, path, camera, size) -> int:
     if gl:
         path.scale = path.check_mesh(mesh)  # the colour scale of the bar
     elif args.write_chunked is None:
-        path.prepare(None, mesh, camera)
+        prepared_path(SoftwareRasterizer(path.options), mesh, path, camera=camera)
     write_image(out, color, path, args.field, args,
                 f"{mesh.name} ({path.name}, {args.domains} domains)", scene=mesh)
     print(f"{out}: {mesh.name}, {len(mesh.triangles)} triangles in {args.domains} domains "
@@ -96,7 +97,7 @@ def render_chunked_scene(args) -> int:
     from ..distributed.cluster import sweep_cluster
     from ..distributed.sortlast import ChunkDomains, render_sortlast
     from ..measurement.images import coverage
-    from ..measurement.rows import WHITE
+    from ..paths.drawing import WHITE
     from ..paths.software import SoftwarePath
 
     given = [name for name, default in FIXED_BY_CHUNKED.items()

@@ -52,10 +52,9 @@ def write_semicylinders_chunked(folder: str | Path, sheets: int, n: int, path: s
     ``folder`` as a chunked scene of one domain per sheet; returns the folder. ``progress``
     (a callable of the sheet index) is called after each sheet. Refused (ValueError): a path
     that draws element fields (the scene has a node field only)."""
-    from ..paths import Style
+    from ..paths import SoftwareRasterizer, Style, prepared_path
     from ..paths.registry import path_class
     from ..paths.software import SoftwarePath
-    from ..scene.needs import derive
 
     first = semicylinder_sheet(0, n)
     lo, hi = first.field_range("distance")
@@ -66,9 +65,8 @@ def write_semicylinders_chunked(folder: str | Path, sheets: int, n: int, path: s
         for k in range(sheets):
             mesh = first if k == 0 else semicylinder_sheet(k, n)
             first = None
-            drawn = SoftwarePath(path, style)
-            derive(mesh, drawn.needs, drawn.style)
-            drawn.prepare(None, mesh, SoftwarePath.default_camera(mesh, (64, 64)))
+            drawn = prepared_path(SoftwareRasterizer(), mesh, SoftwarePath(path, style),
+                                  camera=SoftwarePath.default_camera(mesh, (64, 64)))
             writer.add(drawn, first_id=k * 2 * n * n)
             drawn.release()
             del mesh

@@ -90,15 +90,12 @@ class SoftwareDomains:
         path = _PREPARED.get(key)
         if path is None:
             from ..algo.softraster import RasterOptions
-            from ..paths.software import SoftwarePath
+            from ..paths import SoftwareRasterizer, prepared_path
             from ..scene.builtin import fresh_scene
-            from ..scene.needs import derive
 
             mesh = fresh_scene(self.scene, self.quick)
-            path = SoftwarePath(self.path, self.style, self.options or RasterOptions())
-            derive(mesh, path.needs, path.style)
-            path.prepare(None, mesh, self.camera)
-            path.make_target(self.size)
+            path = prepared_path(SoftwareRasterizer(self.options or RasterOptions()), mesh,
+                                 self.path, self.style, self.camera, size=self.size)
             _PREPARED.clear()  # one scene per process at a time: they can be large
             _PREPARED[key] = path
         return path
@@ -137,16 +134,13 @@ class GLDomains:
         if held is None:
             from ..gl import Framebuffer
             from ..gl.context import create_context
-            from ..paths import make_path
+            from ..paths import prepared_path
             from ..scene.builtin import fresh_scene
-            from ..scene.needs import derive
 
             _PREPARED.clear()
             mesh = fresh_scene(self.scene, self.quick)
             ctx = create_context()
-            path = make_path(self.path, self.style)
-            derive(mesh, path.needs, path.style)
-            path.prepare(ctx, mesh, self.camera)
+            path = prepared_path(ctx, mesh, self.path, self.style, self.camera)
             target = Framebuffer(ctx, self.size)
             ids = ctx.framebuffer(color_attachments=[ctx.renderbuffer(self.size, 1,
                                                                       dtype="u4")],

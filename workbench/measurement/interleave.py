@@ -9,7 +9,7 @@ is narrow enough (a :class:`~workbench.measurement.stats.StoppingRule`).
 
 A side is a :class:`Clock`: an untimed ``setup`` (clear the target, bind it) and the timed
 ``run`` (draw and wait). :func:`draw_clock` makes one for a prepared path
-(:func:`workbench.measurement.rows.prepared`); any callable can be one (pyrender's render).
+(:func:`workbench.paths.drawing.prepared`); any callable can be one (pyrender's render).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 from .stats import CONFIDENCE, Interval, StoppingRule, paired_ratio_interval
 
 if TYPE_CHECKING:
-    from .rows import Prepared
+    from ..paths.drawing import Prepared
 
 WHITE = (1.0, 1.0, 1.0, 1.0)
 

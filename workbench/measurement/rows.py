@@ -1,7 +1,8 @@
 """The one measurement function: any registered path on any scene, timed the same way everywhere.
 
-:func:`measure` derives what the path declares (``needs``) on the scene, prepares the path,
-warms up, times the draw (GPU and wall, median and spread, read-back apart; see
+:func:`measure` is :func:`~workbench.paths.drawing.prepared` (the path's ``needs`` derived on
+the scene, the path prepared and bound to a target) plus timing plus a row: it warms up,
+times the draw (GPU and wall, median and spread, read-back apart; see
 :func:`workbench.measurement.timing.time_draw`), reads the image and releases the path's GL
 objects in all cases, also when a draw raises. It returns a :class:`Measurement`: the image and
 one table row. Experiments, ``workbench render``, sweeps and tests all call it, so a time means
@@ -11,9 +12,8 @@ or the software rasterizer.
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import ExitStack, contextmanager
+from collections.abc import Callable, Sequence
+from contextlib import ExitStack
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -22,21 +22,18 @@ import numpy as np
 from ..gl import Camera
 from ..paths.backends import as_backend
 from ..paths.base import RenderPath
+from ..paths.drawing import WHITE, Prepared, prepared
 from ..paths.registry import DEFAULT_PATHS, path_class
 from ..paths.style import style_summary
-from ..scene.needs import Derivation, derive, derived_items, needed_items
 from .timing import MIN_REPEATS, TIMING_COLUMNS, Timing, time_draw, time_readback, timed_draw
 
 if TYPE_CHECKING:
     import moderngl
 
-    from ..gl import Framebuffer
     from ..paths.backends import Backend
-    from ..paths.software import SoftwareTarget
     from ..scene.protocol import Scene
     from .stats import StoppingRule
 
-WHITE = (1.0, 1.0, 1.0, 1.0)
 UNTIMED = TIMING_COLUMNS
 
 
@@ -67,68 +64,6 @@ def default_camera(scene: Scene, size: tuple[int, int],
                                  style=style)
 
 
-@dataclass
-class Prepared:
-    """A path prepared on a backend, bound to its own target: what :func:`prepared` yields.
-    ``draw()`` draws into ``target`` (bind it first with ``backend.bind(path, target)`` when
-    another target was used since); ``prepare_ms`` and ``derivation`` say what preparing
-    cost."""
-
-    backend: Backend
-    path: RenderPath
-    target: Framebuffer | SoftwareTarget
-    camera: Camera
-    prepare_ms: float
-    derivation: Derivation
-    samples: int = 0
-
-    def bind(self) -> None:
-        """Make ``target`` the one ``path`` draws into."""
-        self.backend.bind(self.path, self.target)
-
-
-@contextmanager
-def prepared(backend: moderngl.Context | Backend, scene: Scene, path: str | RenderPath,
-             style: object | None = None, camera: Camera | None = None,
-             size: tuple[int, int] = (800, 600), *, samples: int = 0,
-             step: int | None = None) -> Iterator[Prepared]:
-    """``path`` (a registry name made with ``style``, or an unprepared :class:`RenderPath`)
-    prepared to draw ``scene`` with ``camera`` (default the path family's) into a new
-    ``size`` (W, H) target with ``samples`` MSAA samples on ``backend``, bound; the path and the
-    target are released on exit, also when the body raises.
-
-    Derives the path's ``needs`` on an FE mesh first (cached there) and refuses, with
-    RuntimeError, a path whose ``prepare`` derived anything it did not declare. ``step``
-    (default the style's) is uploaded with ``set_step`` after ``prepare``.
-    """
-    backend = as_backend(backend)
-    path = backend.path(path, style)
-    width, height = (int(v) for v in size)
-    if camera is None:
-        camera = path.default_camera(scene, (width, height), style=path.style)
-    derivation, mesh = Derivation({}), scene.kind == "mesh"
-    if mesh:
-        derivation = derive(scene, path.needs, path.style)
-        held = derived_items(scene)
-    fb = backend.target((width, height), samples)
-    try:
-        with path:
-            start = time.perf_counter()
-            backend.prepare(path, scene, camera)
-            prepare_ms = (time.perf_counter() - start) * 1e3
-            if mesh:
-                undeclared = derived_items(scene) - held - needed_items(path.needs, path.style)
-                if undeclared:
-                    raise RuntimeError(f"path {path.name!r} derived {sorted(undeclared)} without "
-                                       f"declaring it in needs {sorted(path.needs)}")
-            if step is not None:
-                path.set_step(step)
-            backend.bind(path, fb)
-            yield Prepared(backend, path, fb, camera, prepare_ms, derivation, samples)
-    finally:
-        fb.release()
-
-
 def measure(backend: moderngl.Context | Backend, scene: Scene, path: str | RenderPath,
             style: object | None = None, camera: Camera | None = None,
             size: tuple[int, int] = (800, 600), repeats: int = 7, *, warmup: int = 2,
@@ -142,7 +77,9 @@ def measure(backend: moderngl.Context | Backend, scene: Scene, path: str | Rende
     :class:`~workbench.paths.backends.SoftwareRasterizer` draws the mesh paths on the CPU,
     timed by the wall clock alone, ``gpu_ms`` None) with ``camera`` (default the path family's
     :meth:`~RenderPath.default_camera`) into a ``size`` (W, H) framebuffer with ``samples``
-    MSAA samples cleared to ``background``, prepared as :func:`prepared` does.
+    MSAA samples cleared to ``background``, prepared as
+    :func:`~workbench.paths.drawing.prepared` does; its image is the one
+    :func:`~workbench.paths.drawing.render` draws for the same arguments.
 
     With ``timed`` it warms up ``warmup`` times and times ``repeats`` (≥ 5) draws, and more
     until ``stop`` (a :class:`~workbench.measurement.stats.StoppingRule`) is satisfied where one

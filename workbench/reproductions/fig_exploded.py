@@ -67,13 +67,14 @@ import time
 import numpy as np
 
 from workbench.algo.explode import o_max_of, occlusion_ratio, uniform_explosion
+from workbench.animation.frames import draw_frames
 from workbench.experiment.context import Case, ExperimentContext
 from workbench.experiment.registry import experiment
-from workbench.gl import Framebuffer, GpuTimer
+from workbench.gl import GpuTimer
 from workbench.gl.camera import up_frame
 from workbench.measurement.rows import default_camera
 from workbench.output.figures import save_animation, save_image_grid, with_progress_bar
-from workbench.paths import make_path
+from workbench.paths import make_path, prepared
 from workbench.paths.exploded import exploded_camera
 from workbench.scene import generators
 from workbench.scene.mesh import FEMesh
@@ -148,25 +149,26 @@ def _tinted(image) -> int:
 
 
 def animate(ctx, scene, focus, plane, camera, size, frames, exponent=1.0, keep_images=False):
-    """Run the animation for ``frames`` frames; returns the per-frame record.
+    """Run the animation for ``frames`` frames through the one frame loop
+    (:func:`~workbench.animation.frames.draw_frames`); returns the per-frame record.
 
-    Each frame is drawn twice at the same state, without and with the in-frame count (their
-    wall clock difference is the count's cost), then ``step_animation`` reads the count and
+    Each frame is drawn twice at the same state: first, as the loop's update, without the
+    in-frame count (timed on the wall clock and the GPU timer), then by the loop with it (their
+    wall clock difference is the count's cost); then ``step_animation`` reads the count and
     moves the halves (its wall clock: the readback, or the separate pass on a ghosted frame);
     the separate ``p_occ`` pass alone, as every frame would need it without the in-frame count,
     is timed after it for comparison."""
     path = make_path("exploded", focus=focus, plane=plane, speed=1.0, dt=0.1,
                      ratio_exponent=exponent)
-    fb = Framebuffer(ctx, size)
     rec = {key: [] for key in ("r", "offset", "alpha", "in_frame", "step_wall", "sep_gpu",
                                "sep_wall", "d_gpu", "d_wall", "c_wall", "images")}
-    try:
-        path.prepare(ctx, scene, camera)
+    with prepared(ctx, scene, path, camera=camera, size=size) as ready:
         timer = GpuTimer(ctx)
-        for i in range(frames):
-            fb.use()
+
+        def uncounted(_frame) -> None:
+            ready.bind()
             path.count_in_draw = False
-            fb.clear()
+            ready.target.clear()
             ctx.finish()
             start = time.perf_counter()
             with timer:
@@ -175,14 +177,12 @@ def animate(ctx, scene, focus, plane, camera, size, frames, exponent=1.0, keep_i
             rec["d_wall"].append((time.perf_counter() - start) * 1e3)
             rec["d_gpu"].append(timer.elapsed_ms)
             path.count_in_draw = True
-            fb.clear()
-            ctx.finish()
-            start = time.perf_counter()
-            path.draw()
-            ctx.finish()
-            rec["c_wall"].append((time.perf_counter() - start) * 1e3)
+
+        for drawn in draw_frames(ready, range(frames), update=uncounted, read=keep_images):
+            rec["c_wall"].append(drawn.draw_ms)
             if keep_images:
-                rec["images"].append(with_progress_bar(fb.read(), i + 1, frames, BAR_PX))
+                rec["images"].append(with_progress_bar(drawn.image, drawn.state + 1, frames,
+                                                       BAR_PX))
             rec["r"].append(path.step_animation())
             rec["step_wall"].append(path.last_occlusion["wall_ms"])
             rec["in_frame"].append(path.last_occlusion["in_frame"])
@@ -191,32 +191,25 @@ def animate(ctx, scene, focus, plane, camera, size, frames, exponent=1.0, keep_i
             path.measure_occlusion()
             rec["sep_gpu"].append(path.last_occlusion["gpu_ms"])
             rec["sep_wall"].append(path.last_occlusion["wall_ms"])
-        fb.use()
+        ready.bind()
         p_unocc, p_occ, _ = path.measure_occlusion()
         rec["final_r"] = occlusion_ratio(p_unocc, p_occ)
-        fb.clear()
-        path.draw()
-        shown = _tinted(fb.read())
-        fb.clear()
+        shown = _tinted(ready.image())
+        ready.target.clear()
         path.draw_focus()
-        alone = _tinted(fb.read())
+        alone = _tinted(ready.target.read())
         rec["ghost_visible"] = shown / alone if alone else None
         rec["o_max"] = path.settings.o_max
         rec["normal"] = np.asarray(path.normal, np.float64)
         rec["phase"] = path.state.phase
-    finally:
-        fb.release()
-        path.release()
     return rec
 
 
 def measured_reveal_offset(ctx, scene, focus, plane, camera, size, o_max, iters=18):
     """The smallest offset (bisection) at which r <= REVEALED, None if not within o_max."""
-    path = make_path("exploded", focus=focus, plane=plane)
-    fb = Framebuffer(ctx, size)
-    try:
-        path.prepare(ctx, scene, camera)
-        fb.use()
+    with prepared(ctx, scene, make_path("exploded", focus=focus, plane=plane), camera=camera,
+                  size=size) as ready:
+        path = ready.path
 
         def r_at(o):
             path.set_offset(o)
@@ -229,23 +222,14 @@ def measured_reveal_offset(ctx, scene, focus, plane, camera, size, o_max, iters=
             mid = 0.5 * (lo + hi)
             lo, hi = (lo, mid) if r_at(mid) <= REVEALED else (mid, hi)
         return hi
-    finally:
-        fb.release()
-        path.release()
 
 
 def r_fixed(ctx, scene, focus, plane, camera, size, offset) -> float:
     """The occlusion ratio r of ``focus`` with the halves held at ``offset`` (no dynamics)."""
-    path = make_path("exploded", focus=focus, plane=plane)
-    fb = Framebuffer(ctx, size)
-    try:
-        path.prepare(ctx, scene, camera)
-        fb.use()
-        path.set_offset(offset)
-        return path.occlusion_ratio()
-    finally:
-        fb.release()
-        path.release()
+    with prepared(ctx, scene, make_path("exploded", focus=focus, plane=plane), camera=camera,
+                  size=size) as ready:
+        ready.path.set_offset(offset)
+        return ready.path.occlusion_ratio()
 
 
 def uniform_mesh(scene: FEMesh, displacement: float) -> FEMesh:
@@ -279,15 +263,9 @@ def most_hidden_part(ctx, scene, size) -> tuple[int, list[dict]]:
     camera = default_view_camera(scene, size)
     found = []
     for p in sorted(int(v) for v in np.unique(scene.parts)):
-        path = make_path("exploded", focus=p, plane="x")
-        fb = Framebuffer(ctx, size)
-        try:
-            path.prepare(ctx, scene, camera)
-            fb.use()
-            pu, po, _ = path.measure_occlusion()
-        finally:
-            fb.release()
-            path.release()
+        with prepared(ctx, scene, make_path("exploded", focus=p, plane="x"), camera=camera,
+                      size=size) as ready:
+            pu, po, _ = ready.path.measure_occlusion()
         found.append({"part": p, "p_unocc": pu, "p_occ": po, "r": occlusion_ratio(pu, po)})
     best = max(found, key=lambda f: (f["r"], f["p_unocc"]))
     return best["part"], found

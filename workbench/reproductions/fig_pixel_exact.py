@@ -68,11 +68,11 @@ from workbench.experiment.registry import experiment
 from workbench.gl import Camera
 from workbench.measurement.images import crack_pixels
 from workbench.measurement.interleave import draw_clock, interleaved_ratios
-from workbench.measurement.rows import prepared
 from workbench.measurement.timing import time_call
 from workbench.output.figures import save_field_figure, save_image_grid
 from workbench.output.tables import atomic_open
 from workbench.paths.colormap import colormap_lut
+from workbench.paths.drawing import prepared
 from workbench.paths.spacetime import OVERDRAWS, SpacetimeStyle, spacetime_path, top_camera
 
 from ._declared.fig_pixel_exact import DECLARED

@@ -31,10 +31,10 @@ from workbench.experiment.registry import experiment
 from workbench.gl import Camera
 from workbench.measurement.images import compare_drawn, difference_image
 from workbench.measurement.interleave import Clock, draw_clock, interleaved_ratios
-from workbench.measurement.rows import Together, measure_together, prepared
+from workbench.measurement.rows import Together, measure_together
 from workbench.measurement.timing import time_call
 from workbench.output.figures import save_field_figure, save_image_grid
-from workbench.paths import Style, make_path
+from workbench.paths import Style, make_path, prepared
 from workbench.paths.colormap import scale_for
 from workbench.references.pyrender import PyrenderReference
 from workbench.references.pyvista import LIGHTING as VTK_LIGHTING

@@ -61,13 +61,12 @@ from workbench.experiment.context import ExperimentContext
 from workbench.experiment.registry import experiment
 from workbench.measurement.images import compare_images, difference_map
 from workbench.measurement.interleave import draw_clock, interleaved_ratios
-from workbench.measurement.rows import default_camera, prepared
+from workbench.measurement.rows import default_camera
 from workbench.output.figures import save_image_grid
 from workbench.output.tables import atomic_open
-from workbench.paths import SoftwareRasterizer, Style
+from workbench.paths import SoftwareRasterizer, Style, prepared, prepared_path
 from workbench.paths.software import SoftwarePath
 from workbench.scene.generators import semicylinders
-from workbench.scene.needs import derive
 
 from ._declared.table_software_raster import DECLARED
 
@@ -267,9 +266,7 @@ def small_case_steps(exp: ExperimentContext) -> dict:
     camera = default_camera(mesh, size, view=(0.0, 0.0), up="y")
     path = SoftwarePath("pixel_color", Style(**BANDS),
                         RasterOptions(generator="table", subpixel_bits=0, early_depth=False))
-    derive(mesh, path.needs, path.style)
-    path.prepare(None, mesh, camera)
-    path.make_target(size)
+    prepared_path(SoftwareRasterizer(path.options), mesh, path, camera=camera, size=size)
     path.draw()  # compiled once
     on = {name: [] for name, _ in STEPS}
     for _ in range(5):

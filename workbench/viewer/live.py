@@ -1,5 +1,8 @@
-"""The drawing side of a live view: one mesh path prepared once on an EGL context of its own,
-drawn on request into an offscreen framebuffer and read back as an RGB frame (no Jupyter here).
+"""The drawing side of a live view: one mesh path prepared once on an EGL context of its own
+(:func:`~workbench.paths.drawing.prepared`, held open while the path is shown), drawn on request
+into an offscreen framebuffer by the one frame loop
+(:func:`~workbench.animation.frames.draw_frames`) and read back as an RGB frame (no Jupyter
+here).
 
 What each interaction costs:
 
@@ -28,23 +31,24 @@ process.
 
 from __future__ import annotations
 
+from contextlib import ExitStack
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..gl import Framebuffer, create_context
+from ..animation.frames import draw_frames
+from ..gl import create_context
+from ..paths.drawing import WHITE, Prepared, prepared
 from ..paths.exploded import ExplodedPath, exploded_camera
 from ..paths.flange import FlangePath
 from ..paths.registry import make_path, scene_path
-from ..scene.needs import derive
 from .orbit import Orbit
 
 if TYPE_CHECKING:
-    from ..gl import Camera
+    from ..gl import Camera, Framebuffer
     from ..paths.base import RenderPath
     from ..scene.mesh import FEMesh
 
-WHITE = (1.0, 1.0, 1.0, 1.0)
 SETTLED_PX = 0.25  # an explosion moving less than this per frame (image pixels) has settled
 
 
@@ -90,30 +94,43 @@ class LiveView:
                                   projection=projection, up=up)
         self.animating = self.path_name == "exploded"
         self.ctx = create_context(device=device)
-        self.path: RenderPath | None = None
+        self._ready: Prepared | None = None
+        self._held = ExitStack()  # keeps the prepared path (and its target) until it changes
         self._o_max: float | None = None
-        self.target: Framebuffer | None = None
         try:
             with self.ctx:
-                self.target = Framebuffer(self.ctx, self.orbit.size)
-                self.path = self._prepared(self.options, self.step)
+                self._ready, self._held = self._prepared(self.options, self.step)
         except BaseException:
             self.release()
             raise
 
+    @property
+    def path(self) -> RenderPath | None:
+        """The prepared path drawn now (None once released)."""
+        return None if self._ready is None else self._ready.path
+
+    @property
+    def target(self) -> Framebuffer | None:
+        """The offscreen framebuffer the frames are drawn into (None once released)."""
+        return None if self._ready is None else self._ready.target
+
     # ------------------------------------------------------------------ preparing
-    def _prepared(self, options: dict[str, Any], step: int) -> RenderPath:
+    def _prepared(self, options: dict[str, Any], step: int) -> tuple[Prepared, ExitStack]:
         """A new path of ``path_name`` with ``options`` at ``step``, prepared for the current
-        view (the context current); ``_o_max`` follows it once it is prepared."""
+        view and size (the context current) and held open by the returned stack (closing it
+        releases the path and its target); ``_o_max`` follows it once it is prepared."""
         path = make_path(self.path_name, **options, step=step)
-        derive(self.scene, path.needs, path.style)
         o_max = None
         if isinstance(path, ExplodedPath):
             o_max = path.style.o_max
             o_max = float(o_max) if o_max is not None else _o_max_of(self.scene)
-        path.prepare(self.ctx, self.scene, self._camera(o_max))
+        with ExitStack() as stack:
+            ready = stack.enter_context(prepared(self.ctx, self.scene, path,
+                                                 camera=self._camera(o_max),
+                                                 size=self.orbit.size))
+            held = stack.pop_all()
         self._o_max = o_max
-        return path
+        return ready, held
 
     def restyle(self, **changes: Any) -> None:
         """Make the path again with its style options changed by ``changes`` (``bands=8``,
@@ -122,11 +139,11 @@ class LiveView:
         options = {**self.options, **changes}
         step = int(options.pop("step", self.step))
         with self.ctx:
-            path = self._prepared(options, step)
-            old, self.path = self.path, path
-            old.release()
+            ready, held = self._prepared(options, step)
+            old, self._ready, self._held = self._held, ready, held
+            old.close()
         self.options, self.step = options, step
-        self.animating = isinstance(path, ExplodedPath)
+        self.animating = isinstance(ready.path, ExplodedPath)
 
     # ------------------------------------------------------------------ the camera
     def camera(self) -> Camera:
@@ -169,9 +186,7 @@ class LiveView:
         if orbit.size == self.orbit.size:
             return
         with self.ctx:
-            target = Framebuffer(self.ctx, orbit.size)
-            self.target.release()
-            self.target = target
+            self._ready.resize(orbit.size)
         self._set_orbit(orbit)
 
     @property
@@ -217,9 +232,7 @@ class LiveView:
         """(H, W, 3) uint8 RGB of the current state on white, row 0 at the top. With the
         exploded path the explosion then advances one animation step (see ``animating``)."""
         with self.ctx:
-            self.target.clear(WHITE)
-            self.path.draw()
-            image = self.target.read()
+            image = next(draw_frames(self._ready, (self.step,), background=WHITE)).image
             if isinstance(self.path, ExplodedPath):
                 before = self.path.offset
                 self.path.step_animation(size=self.size)
@@ -232,12 +245,9 @@ class LiveView:
         if self.ctx is None:
             return
         with self.ctx:
-            if self.path is not None:
-                self.path.release()
-            if self.target is not None:
-                self.target.release()
+            self._held.close()
         self.ctx.release()
-        self.ctx = self.path = self.target = None
+        self.ctx = self._ready = None
 
 
 def _o_max_of(mesh: FEMesh) -> float:
