@@ -9,10 +9,10 @@ Saint Venant–Kirchhoff membrane deformed from the geometry of ``reference_step
 **Kinematics, per triangle.** Quads are split into the triangles (0, 1, 2) and (0, 2, 3), as
 :mod:`~workbench.algo.forcetube` splits them; a triangle element (third node repeated) is
 its first triangle. With reference edges A₁ = X₁ − X₀, A₂ = X₂ − X₀ and current edges
-a₁, a₂, the reference triangle gets the orthonormal in-plane frame e₁ = A₁/|A₁|,
+a₁, a₂, the reference triangle gets the orthonormal in-plane frame ``e₁ = A₁/|A₁|``,
 e₂ = ν̂ × e₁ (ν̂ the unit reference normal), in which its edges are the columns of
 
-    D = [[|A₁|, A₂·e₁], [0, A₂·e₂]].
+    ``D = [[|A₁|, A₂·e₁], [0, A₂·e₂]]``.
 
 The in-plane deformation gradient (3 × 2, from the reference frame to the current tangent
 plane, in global coordinates) is F = [a₁ a₂] D⁻¹ — uniform over the triangle, exact for
@@ -33,13 +33,13 @@ a large deformation far exceed a real metal's.
 **Push-forward.** The Cauchy stress is σ = F S Fᵀ / J, a 3 × 3 tensor in global coordinates
 whose components along the current normal are zero (F maps into the tangent plane). **The
 thickness is assumed unchanged**, so the volume ratio J is the area ratio of the triangle,
-|a₁ × a₂| / |A₁ × A₂|, and σ · t (t the undeformed thickness) is the force per unit current
+``|a₁ × a₂| / |A₁ × A₂|``, and σ · t (t the undeformed thickness) is the force per unit current
 length of a cut, as :func:`~workbench.algo.forcetube.section_force` integrates it. Units: the
 modulus' (N/mm² = MPa for the default steel values and a model in mm).
 
 **Per element.** The element's stress is the mean of its triangles' Cauchy stresses weighted
 by their current areas (the area-average of σ over the current element). A triangle is
-degenerate when its reference or current doubled area |A₁ × A₂| is at most 1e-12 times the
+degenerate when its reference or current doubled area ``|A₁ × A₂|`` is at most 1e-12 times the
 square of its longest edge (zero-length edges included); it gets weight 0, and an element
 with no non-degenerate triangle gets the zero tensor.
 

@@ -42,6 +42,7 @@ from ..scene.derived import as_elements, classify_elements, triangulate
 __all__ = ["RESTART", "QuadStrips", "TriStrips", "join_strips", "quad_strips", "tri_strips",
            "unstripify"]
 
+#: the primitive-restart index that separates strips in one index buffer
 RESTART = 0xFFFFFFFF
 
 

@@ -2,12 +2,12 @@
 where a field is shown, the colour bar of the frame's scale beside it (with the no-result
 colour and its count under it in a frame whose field has non-finite values).
 
-The layout is that of ``workbench render``'s field images (:func:`~workbench.experiment.
-figures.field_figure`: the image at its native resolution, or each pixel repeated k × k under
-160 pixels of height, the bar and its labels to the right, a title row on top); a frame
-without a field gets the same title row and margins without the bar. Frames are drawn by
-matplotlib's Agg canvas alone, so the same frame gives the same pixels every time, and a
-fixed scale gives the same bar on every frame.
+The layout is that of ``workbench render``'s field images
+(:func:`~workbench.output.figures.field_figure`: the image at its native resolution, or each pixel
+repeated k × k under 160 pixels of height, the bar and its labels to the right, a title row on top);
+a frame without a field gets the same title row and margins without the bar. Frames are drawn by
+matplotlib's Agg canvas alone, so the same frame gives the same pixels every time, and a fixed scale
+gives the same bar on every frame.
 """
 
 from __future__ import annotations

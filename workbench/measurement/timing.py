@@ -101,6 +101,7 @@ class Timing:
         return {prefix + name: getattr(self, name) for name in TIMING_COLUMNS}
 
 
+#: the columns a timing adds to a row, in milliseconds (``repeats``: how many draws were timed)
 TIMING_COLUMNS = ("gpu_ms", "gpu_ms_min", "gpu_ms_max", "wall_ms", "wall_ms_min", "wall_ms_max",
                   "readback_ms", "repeats", "wall_ms_lo", "wall_ms_hi", "wall_samples_ms")
 

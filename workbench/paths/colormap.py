@@ -106,7 +106,7 @@ def _lerp_table(table: np.ndarray, t: np.ndarray) -> np.ndarray:
     return lo + w * (hi - lo)
 
 
-NO_RESULT_COLOR = (0.0, 1.0, 0.0)  # RGB in [0, 1] of what has no value (module notes)
+NO_RESULT_COLOR = (0.0, 1.0, 0.0)  #: RGB in [0, 1] of what has no value (module notes)
 # the largest |t| uploaded: a value a million ranges beyond the scale takes its end colour
 # either way, and float32 (largest number 3.4e38) would turn t = 1e60 into an infinity that
 # GL and the software rasterizer interpolate differently (a range of (0, 1e-30) and values 1e30)

@@ -14,7 +14,7 @@ Three paths draw a :class:`~workbench.algo.fepatch.surface.TexturedSurface`:
 The outline test is the one of :mod:`workbench.algo.fepatch.surface`: each channel pair says
 "on the outline" where one distance is within half a pixel of zero and the other not below
 minus half a pixel, a pixel measured as the distance's change per pixel along the minor axis of
-its iso-line (max(|∂/∂x|, |∂/∂y|)), like an aliased one-pixel ``GL_LINES`` line. Outline pixels
+its iso-line (``max(|∂/∂x|, |∂/∂y|)``), like an aliased one-pixel ``GL_LINES`` line. Outline pixels
 take ``Style.wire_color`` exactly; the rest ``Style.base_color`` times the headlight. The
 surface's ``line_edges`` (element edges the texture cannot show) are drawn afterwards as
 ``GL_LINES`` in ``Style.wire_color``, the fill under polygon offset (1, 1) as in
@@ -31,7 +31,7 @@ configuration, so only step 0 is drawn: ``Style.step`` other than 0, a deformati
 "none" (the paths draw the surface's own triangle list) are refused with ValueError.
 ``Style.field`` and ``Style.quad_diagonal`` are ignored. Positions are uploaded as float32
 relative to ``camera.origin`` (float64 subtraction first); clip planes and the camera work as in
-:class:`~workbench.paths.base.MeshPath`.
+:class:`~workbench.paths.mesh.MeshPath`.
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ edge shared with quad k + 1, and v runs 0 → 1 across the strip: every quad edg
 u or v, the diagonal on neither. A triangle element gets the corners (0, 0, 1), (0, 1, 0),
 (1, 0, 0), one component zero on each edge; quads keep w = ½. The fragment shader paints
 ``Style.wire_color`` where a component is close to an edge's value, measured in pixels along the
-minor axis of that iso-line (the component's change per pixel is max(|∂/∂x|, |∂/∂y|)), like an
+minor axis of that iso-line (the component's change per pixel is ``max(|∂/∂x|, |∂/∂y|)``), like an
 aliased one-pixel ``GL_LINES`` line: one pixel per step along the line's major axis, no second
 pass of lines and no diagonals. An edge two elements share is drawn within ½ pixel on each side;
 an edge of one element only (the model's boundary, a hole; flagged per triangle through its

@@ -51,11 +51,11 @@ Degenerate triangles are taken (measured as their edges); float32 or Fortran-ord
 converted by nanobind, but the wrapper hands over C-order float64 and int32 itself.
 
 **Rounding**: it works on the raw coordinates (no translation to a local origin) and does not
-widen its bracket for float64 rounding: on A against itself it returns ``lower`` 1e-16 above
-the exact 0 near the origin and 2e-10 above it at coordinates around 1e6. :attr:`PeerBracket.
-rounding` (:data:`PEER_ROUNDING` times the largest coordinate magnitude of both meshes) is the
-slack we grant it where we check its bracket against ours or against an exact value; its raw
-bracket is what we report.
+widen its bracket for float64 rounding: on A against itself it returns ``lower`` 1e-16 above the
+exact 0 near the origin and 2e-10 above it at coordinates around 1e6. :attr:`PeerBracket.rounding`
+(:data:`PEER_ROUNDING` times the largest coordinate magnitude of both meshes) is the slack we grant
+it where we check its bracket against ours or against an exact value; its raw bracket is what we
+report.
 
 **Slivers**: its point-triangle distance (libigl's, as the ``libigl`` package computes it
 too) loses the plane of a thin tilted triangle: a segment 2^-40·√2 above the middle of a sliver

@@ -198,7 +198,8 @@ def _meshopt_locked(v, f, target):
     return _meshopt(v, f, target, lock_border=True)
 
 
-# on the whole mesh: part borders free (pymeshlab's open boundary too)
+#: the reference simplifiers by name, on the whole mesh: part borders free (pymeshlab's open
+#: boundary too)
 SIMPLIFIERS = {
     "pymeshlab quadric": _pymeshlab_free,
     "libigl qslim": _igl("qslim"),

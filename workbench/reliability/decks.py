@@ -42,7 +42,8 @@ def _grid_quads(nx: int, ny: int, first_id: int = 1) -> list[tuple[int, int, int
 
 
 def fixed_deck() -> bytes:
-    """A standard-format deck: *PART, *SECTION_SHELL, *NODE and *ELEMENT_SHELL (with a triangle)."""
+    """A standard-format deck: ``*PART``, ``*SECTION_SHELL``, ``*NODE`` and ``*ELEMENT_SHELL`` (with
+    a triangle)."""
     lines = ["$ generated fixed-format deck", "*KEYWORD", "*PART", "plate",
              f"{1:>10}{1:>10}{1:>10}", "*SECTION_SHELL", f"{1:>10}{2:>10}",
              f"{1.5:>10}{1.5:>10}{1.5:>10}{1.5:>10}", "*NODE"]
@@ -57,7 +58,7 @@ def fixed_deck() -> bytes:
 
 
 def comma_deck() -> bytes:
-    """A comma-separated deck that starts with its *NODE block (no *KEYWORD line)."""
+    """A comma-separated deck that starts with its ``*NODE`` block (no ``*KEYWORD`` line)."""
     lines = ["*NODE"]
     lines += [f"{n},{x},{y},{z}" for n, x, y, z in _grid_nodes(3, 3, 5.0)]
     lines.append("*ELEMENT_SHELL")
@@ -67,7 +68,8 @@ def comma_deck() -> bytes:
 
 
 def thickness_deck() -> bytes:
-    """A standard-format deck with an *ELEMENT_SHELL block and an *ELEMENT_SHELL_THICKNESS block."""
+    """A standard-format deck with an ``*ELEMENT_SHELL`` block and an
+    ``*ELEMENT_SHELL_THICKNESS`` block."""
     lines = ["*KEYWORD", "*NODE"]
     lines += [f"{n:>8}{x:>16}{y:>16}{z:>16}" for n, x, y, z in _grid_nodes(5, 3)]
     quads = _grid_quads(5, 3)
@@ -83,8 +85,9 @@ def thickness_deck() -> bytes:
 
 
 def long_deck() -> bytes:
-    """A long-format deck (``*KEYWORD LONG=Y``: every field 20 columns) with *PARAMETER,
-    *PART, *SECTION_SHELL (thickness by a parameter), *NODE and *ELEMENT_SHELL_THICKNESS."""
+    """A long-format deck (``*KEYWORD LONG=Y``: every field 20 columns) with ``*PARAMETER``,
+    ``*PART``, ``*SECTION_SHELL`` (thickness by a parameter), ``*NODE`` and
+    ``*ELEMENT_SHELL_THICKNESS``."""
     lines = ["*KEYWORD LONG=Y", "*PARAMETER", f"{'Rtlong':<20}{0.75:>20}", "*PART",
              "long part", f"{4:>20}{9:>20}{1:>20}", "*SECTION_SHELL", f"{9:>20}{2:>20}",
              f"{'&tlong':<20}", "*NODE"]

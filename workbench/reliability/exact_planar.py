@@ -14,7 +14,7 @@ coverage, in rational or exact integer arithmetic, sharing no code with :mod:`wo
 * :func:`strictly_inside` -- pixel centres strictly inside a closed polygon (winding number ≠ 0,
   no centre on an edge), exactly.
 
-Integer arrays are int64 after a check that no product can overflow (|coordinates| < 2^30).
+Integer arrays are int64 after a check that no product can overflow (``|coordinates| < 2^30``).
 """
 
 from __future__ import annotations

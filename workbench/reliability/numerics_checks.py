@@ -4,7 +4,7 @@ each against exact rational arithmetic (:mod:`~workbench.reliability.exact`,
 
 a. **point–triangle distance** (:func:`workbench.algo.nearest.triangle.closest_point_on_triangle`,
    looked up on its module at every query, so that a test may replace it): the distance
-   within 1e-12·R of the exact one, R = max_i |p − corner_i| (the issue's target; the row
+   within 1e-12·R of the exact one, ``R = max_i |p − corner_i|`` (the issue's target; the row
    reports it in those units and its note in units of the documented 64·u·R, which also
    bounds it); the returned point within :data:`POINT_ULPS`·u·M of the triangle (exactly
    measured; M the largest coordinate magnitude of p and the corners).
@@ -23,11 +23,12 @@ d. **simplifier bounds** (:func:`workbench.algo.simplify.hausdorff_decimate`): f
    points; dyadic, exact), the exact distance to the simplified surface at most that triangle's
    reported bound, and at most the part's tolerance. The worst is the largest
    ``distance − bound`` in u·D (D the diagonal of the mesh's box; ≤ 0 keeps the promise).
+
 g. **spacetime slice areas** (:func:`workbench.algo.spacetime.slicing.slice_at`): every
    tetrahedron with tmin < t ≤ tmax cut once, and its polygon's area within
    :data:`SLICE_ULPS`·u·D·(D + M) of the exact area of the section (D the spatial diameter of
-   the tetrahedron, M its largest |x|, |y|): corners built by one interpolation each are within
-   a few u·(D + M) of the exact ones, and the area moves by at most the perimeter times that.
+   the tetrahedron, M its largest ``|x|``, ``|y|``): corners built by one interpolation each are
+   within a few u·(D + M) of the exact ones, and the area moves by at most the perimeter times that.
 """
 
 from __future__ import annotations

@@ -16,6 +16,7 @@ f. **GL against software images** (:func:`workbench.measurement.rows` on the EGL
    shaded paths, here counting the pixels off by more than 1/255: the sliver sheets' sloped
    faces put up to 2.3 % of the pixels one level apart in one channel, the rounding of the
    interpolated light; the note gives that share).
+
 h. **fields through the colour paths** (``vertex_color``, ``pixel_color``, ``element_color``,
    GL and software, the sheet facing the camera so that the headlight is 1): constant fields
    (0, ±1e-30, 3.7, 2^60, −1e30) take the scale's first colour; values exactly on band

@@ -143,7 +143,7 @@ def gouraud_split(elements: ArrayLike, coords_list: np.ndarray | Sequence[ArrayL
     and g is measured after turning g's normal to f's orientation, read from the topology: two
     elements agree when they traverse the shared edge in opposite directions. A flipped element
     is therefore not split from its neighbours, while a fold-back beyond 90 degrees (a hem) still
-    is -- which |cos| of unoriented normals would get wrong (it merges a hem, and with it a
+    is -- which ``|cos|`` of unoriented normals would get wrong (it merges a hem, and with it a
     crease angle of 90 degrees or more splits nothing). For :meth:`GouraudSplit.normals`, every
     element gets a sign that orients its smooth patch (elements joined by smooth links)
     consistently, in the orientation of the patch's area majority in the first coordinate set (by

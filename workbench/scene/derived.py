@@ -185,10 +185,10 @@ class Triangulation:
 def triangulate(elements: ArrayLike, nodes: ArrayLike) -> Triangulation:
     """Split elements into triangles, quads along their shorter diagonal.
 
-    A quad (a, b, c, d) becomes (a, b, c), (a, c, d) when |a - c| <= |b - d| (compared as squared
-    float64 lengths of ``nodes``), else (a, b, d), (b, c, d). A triangle (a, b, c, c) -- or a quad
-    with one pair of adjacent corners on the same node -- becomes the one triangle of its distinct
-    nodes in winding order. Degenerate elements (see the module notes) give no triangle, so
+    A quad (a, b, c, d) becomes (a, b, c), (a, c, d) when ``|a - c| <= |b - d|`` (compared as
+    squared float64 lengths of ``nodes``), else (a, b, d), (b, c, d). A triangle (a, b, c, c) -- or
+    a quad with one pair of adjacent corners on the same node -- becomes the one triangle of its
+    distinct nodes in winding order. Degenerate elements (see the module notes) give no triangle, so
     K = 2 * quads + triangles. Winding is kept; triangles come in element order.
 
     Refuses elements that are not (M, 4)/(M, 3) non-negative integers and ``nodes`` that are not

@@ -14,7 +14,7 @@ The items registered here are the mesh's own:
 * ``gouraud`` — the crease-split vertices at ``Style.crease_deg`` (brings the triangulation).
 
 Algorithms register theirs next to their code: ``fepatch`` (the fe2003 model of
-``Style.fepatch``, :mod:`workbench.algo.fepatch.model`) and ``part_distances`` (every node's
+``Style.fepatch``, :mod:`workbench.algo.fepatch.mesh_model`) and ``part_distances`` (every node's
 distance to the nearest other part, :mod:`workbench.algo.nearest.parts`).
 
 Cache keys are tuples ``(name, *parameters)``: ``("triangles",)``, ``("gouraud", 30.0)``,

@@ -72,9 +72,9 @@ import numpy as np
 __all__ = ["HEX", "PENTA", "TET", "SolidFaces", "boundary_surface", "solid_faces", "solid_kinds"]
 
 TET, PENTA, HEX = 4, 6, 8  # kind codes = number of distinct nodes
-# From this many solids on, the compiled kernels (workbench.scene.solid_kernels) are used:
-# below it numpy is as quick, and a fresh process does not pay ``import numba`` (~0.5 s) and
-# the loading of the kernels for a small model.
+#: From this many solids on, the compiled kernels (workbench.scene.solid_kernels) are used:
+#: below it numpy is as quick, and a fresh process does not pay ``import numba`` (~0.5 s) and
+#: the loading of the kernels for a small model.
 COMPILED_FROM = 100_000
 
 # Face tables in column indices of the 8-column LS-DYNA row, outward for positive volume.

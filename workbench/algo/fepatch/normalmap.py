@@ -77,7 +77,7 @@ def restore_error_bound(min_dropped: float) -> float:
     component has magnitude at least ``min_dropped`` (1/√3 when it is the largest).
 
     Each kept component is off by at most e = 1/255; the restored one by at most
-    (|a| + |b|)·e / c_min plus the second-order term, bounded here by the first-order chord
+    ``(|a| + |b|)·e / c_min`` plus the second-order term, bounded here by the first-order chord
     length ``e·sqrt(2 + (sqrt(2)/c_min)²)`` with a 10 % margin for the square root's curvature.
     """
     e = 1.0 / 255.0

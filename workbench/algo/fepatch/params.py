@@ -39,6 +39,7 @@ class FEPatchParams:
                              f"{self.l_inner:g}")
 
 
+#: the paper's parameter sets A and B by name
 PARAMETER_SETS = {"A": FEPatchParams(12.0, 1.0, 0.5, 8.0, "A"),
                   "B": FEPatchParams(18.0, 3.0, 2.5, 15.0, "B")}
 

@@ -298,8 +298,8 @@ def decode_wire(texture, points, wire_range: float = WIRE_RANGE) -> np.ndarray:
 
 def on_outline(texture, points, h: float, wire_range: float = WIRE_RANGE) -> np.ndarray:
     """(P,) bool: whether ``points`` (P, 2) in texel units lie on an outline, the fragment
-    shader's test: in either pair one channel is within ``h`` texels of zero (|d| ≤ h, a tie on a
-    pixel boundary draws both pixels rather than neither) while the other is at least −h. ``h``
+    shader's test: in either pair one channel is within ``h`` texels of zero (``|d| ≤ h``, a tie
+    on a pixel boundary draws both pixels rather than neither) while the other is at least −h. ``h``
     is half the line width in texels (> 0)."""
     if not h > 0:
         raise ValueError(f"h must be positive, got {h}")

@@ -38,9 +38,9 @@ def tube_mesh(tube: ForceTube, step: int | None, *, radius_range, sides: int = 1
     Ring i is a regular ``sides``-gon of nodes around plane i's point, in the plane (radius
     r_i, model units); consecutive rings are joined by ``sides`` quads each (normals outward),
     so the tube has ``sides × planes`` nodes and ``sides × (planes − 1)`` quads, all of part
-    ``part_id`` ("force tube"). The radius maps |axial force| linearly: ``force_range`` (lo, hi)
+    ``part_id`` ("force tube"). The radius maps ``|axial force|`` linearly: ``force_range`` (lo, hi)
     to ``radius_range`` (r_lo, r_hi), clipped; by default lo = 0 and hi = the largest finite
-    |axial force| over all computed steps (so rings are comparable between steps; all rings
+    ``|axial force|`` over all computed steps (so rings are comparable between steps; all rings
     get r_lo when that is 0). The node field ``"section_force"`` holds the axial force of the
     node's ring (NaN rings get r_lo and NaN), for drawing with the colour map.
 

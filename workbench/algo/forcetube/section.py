@@ -9,6 +9,7 @@ import numpy as np
 
 from ...scene.mesh import FEMesh
 
+#: the element fields of the membrane stress tensor (global axes) the section force reads
 STRESS_FIELDS = ("stress_xx", "stress_yy", "stress_zz", "stress_xy", "stress_yz", "stress_zx")
 THICKNESS_FIELD = "thickness"
 

@@ -21,14 +21,14 @@ Hausdorff-bounded decimator (:mod:`workbench.algo.simplify`), compiled with numb
 All inputs are float64 in model units; translate far-away geometry near the origin first
 (:func:`workbench.algo.hausdorff.hausdorff` does) so differences keep their digits.
 
-**Error model** (u = 2⁻⁵³, the unit roundoff; first order in u). Let R = max_i |p − corner_i|.
+**Error model** (u = 2⁻⁵³, the unit roundoff; first order in u). Let ``R = max_i |p − corner_i|``.
 
 * The distance of :func:`closest_point_on_triangle` is within ``DISTANCE_ERROR · u · R``
   (64 u R, about 7e-15 R) of the exact one. Derivation: the differences p − o and the edges
   carry a relative u, which moves p and the corners by at most u R and 2 u R; the frame on the
-  longest edge e (|e| <= 2R) is orthogonal to within 3 u after two Gram–Schmidt passes, and
-  the orthogonalised third corner moves by at most 4 u |e|; the projection coordinates and the
-  plane distance ``(q·n)/|n|`` carry at most 8 u |q|; a wrong inside/outside decision happens
+  longest edge e (``|e| <= 2R``) is orthogonal to within 3 u after two Gram–Schmidt passes, and
+  the orthogonalised third corner moves by at most ``4 u |e|``; the projection coordinates and the
+  plane distance ``(q·n)/|n|`` carry at most ``8 u |q|``; a wrong inside/outside decision happens
   only within 10 u R of an edge line, where face and edge distances agree to that; a segment
   distance carries at most 10 u R. Summed, 32 u R; the constant doubles it. The worst seen
   against exact rational arithmetic on adversarial inputs (``workbench stress numerics``) is

@@ -185,7 +185,7 @@ class ElasticField(ABC):
         return self._gradient(*self._shift(x, y, t))
 
     def speed(self, x, y, t) -> np.ndarray:
-        """Velocity magnitude |∂u/∂t| in mm/µs, shape (...)."""
+        """Velocity magnitude ``|∂u/∂t|`` in mm/µs, shape (...)."""
         v = self.velocity(x, y, t)
         return np.hypot(v[..., 0], v[..., 1])
 
@@ -328,7 +328,7 @@ class ReflectingWave(ElasticField):
 class RadialPulse(ElasticField):
     """Radially spreading P pulse in 2-D, exact: u = ∇φ with
 
-        φ = A Re[(s² − r²)^(−1/2)],  s = c (t + t0) − i a,  r = |x − centre|.
+        φ = A Re[(s² − r²)^(−1/2)],  s = c (t + t0) − i a,  r = ``|x − centre|``.
 
     (s² − r²)^(−1/2) is the 2-D fundamental solution of the scalar wave equation continued to
     complex time, so φ_tt = c² Δφ and u = ∇φ solves Navier's equations with the P-wave speed c.

@@ -319,16 +319,16 @@ def tent_pitch(space_points, space_simplices, t_start: float, t_end: float, wave
     of τ among its mesh neighbours (ties broken by a seeded random rank, so the lifted set is
     independent: no two lifted vertices share an edge) and is below t_end, to
 
-        τ_new(v) = min(t_end, min_u τ(u) + f_v · safety · |x_v − x_u| / wave_speed),
+        ``τ_new(v) = min(t_end, min_u τ(u) + f_v · safety · |x_v − x_u| / wave_speed)``,
 
     u over its neighbours, f_v a seeded random factor in [0.8, 1]. Each space simplex s around
     v sweeps the spacetime simplex (s at the front, v at τ_old) + (v at τ_new); v at τ_new is a
     new spacetime point. Rounds end when the front is flat at t_end.
 
     Guarantee (the causality bound): every spacetime edge that is not purely in time has
-    slope |Δt| / |Δx| ≤ safety / wave_speed, since every front edge keeps that bound.
+    slope ``|Δt| / |Δx| ≤ safety / wave_speed``, since every front edge keeps that bound.
     Spacetime simplices are positively oriented (space simplices are oriented first), so their
-    volumes are positive and sum to |domain| × (t_end − t_start).
+    volumes are positive and sum to ``|domain| × (t_end − t_start)``.
     Size (measured on jittered grids): about 2.8·K·c·(t_end − t_start)/(safety·h) tetrahedra
     for K triangles with cell size h, 1.5·K·c·(t_end − t_start)/(safety·h) triangles for K
     segments of length h; e.g. a 100 × 100 grid of the unit square over t ∈ [0, 0.1] with

@@ -362,11 +362,11 @@ def evaluate(coeffs, centre, extent, element, x, y, t, material: Material | None
     """Evaluate the element polynomials at K global points (x, y, t) (mm, µs), point k lying in
     element ``element[k]``; x, y, t of shape (K,) or scalars (e.g. the slice time).
 
-    Returns a dict of float64 arrays: "displacement" (K, 2) mm, "velocity" (K, 2) mm/µs,
-    "grad_u" (K, 2, 2) with grad_u[k, i, j] = ∂u_i/∂x_j, "speed" (K,) |v| in mm/µs, "grad_speed"
-    (K, 2) the spatial gradient of |v| in (mm/µs)/mm (0 where |v| == 0, never NaN) and, when a
-    ``material`` is given, "U" (K,) the strain energy density in kJ/m³. Derivatives follow the
-    chain rule ∂/∂x̂ = (1/w_x) ∂/∂x_local etc. Refused: bad shapes, element indices out of range.
+    Returns a dict of float64 arrays: "displacement" (K, 2) mm, "velocity" (K, 2) mm/µs, "grad_u"
+    (K, 2, 2) with grad_u[k, i, j] = ∂u_i/∂x_j, "speed" (K,) ``|v|`` in mm/µs, "grad_speed" (K, 2)
+    the spatial gradient of ``|v|`` in (mm/µs)/mm (0 where ``|v| == 0``, never NaN) and, when a
+    ``material`` is given, "U" (K,) the strain energy density in kJ/m³. Derivatives follow the chain
+    rule ∂/∂x̂ = (1/w_x) ∂/∂x_local etc. Refused: bad shapes, element indices out of range.
     """
     c, ce, ex, el, xyt = _check_eval(coeffs, centre, extent, element, x, y, t)
     p = (xyt - ce[el]) / ex[el]
@@ -418,8 +418,8 @@ def evaluate_float32_local(coeffs, centre, extent, element, x, y, t, material: M
 
 
 def height_normal(grad_speed, height_scale: float) -> np.ndarray:
-    """Unit normals (K, 3) of the height field z = height_scale · |v|:
-    normalize(−h ∂|v|/∂x, −h ∂|v|/∂y, 1); exactly (0, 0, 1) where the gradient is zero.
+    """Unit normals (K, 3) of the height field ``z = height_scale · |v|``:
+    ``normalize(−h ∂|v|/∂x, −h ∂|v|/∂y, 1)``; exactly (0, 0, 1) where the gradient is zero.
     ``grad_speed`` (K, 2) in (mm/µs)/mm, ``height_scale`` h in mm per (mm/µs). Refused: bad
     shape, non-finite values."""
     g = np.asarray(grad_speed, dtype=np.float64)

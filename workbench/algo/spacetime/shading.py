@@ -8,7 +8,7 @@ arithmetic that matters:
   clamped to [0, 1] (the paper's log scale), and ``s`` to a colour by piecewise-linear
   interpolation of a 256-entry RGB ramp at ``s·255`` (a 1-D texture with linear filtering
   and texel centres at ``i/255``);
-* **height field** — ``z = height_scale·|v|`` (mm, with |v| in mm/µs); its exact normal is
+* **height field** — ``z = height_scale·|v|`` (mm, with ``|v|`` in mm/µs); its exact normal is
   ``normalize(−h ∂|v|/∂x, −h ∂|v|/∂y, 1)``, and ``(0, 0, 1)`` where the gradient vanishes;
 * **Phong lighting** with diffuse and specular reflectances that are multiples of the colour
   (the paper's choice):
