@@ -340,7 +340,7 @@ def test_run_experiment_writes_table(tmp_path):
     messages = []
     try:
         rows, out_dir = run_experiment("dummy-harness-check", tmp_path / "figures", quick=True,
-                                       progress=messages.append)
+                                       progress=messages.append, warm=False)
     finally:
         del EXPERIMENTS["dummy-harness-check"]
     assert out_dir == tmp_path / "figures" / "dummy-harness-check"
@@ -641,9 +641,9 @@ def test_experiment_outputs_are_replaced_as_a_set(tmp_path):
 
     root = tmp_path / "figures"
     try:
-        _, out_dir = run_experiment("dummy-set", root)
+        _, out_dir = run_experiment("dummy-set", root, warm=False)
         with pytest.raises(RuntimeError):
-            run_experiment("dummy-set", root)
+            run_experiment("dummy-set", root, warm=False)
         assert (out_dir / "figure.txt").read_text() == "run 1"  # the previous set, whole
         assert read_table(out_dir / "table.csv") == [{"run": 1}]
         assert sorted(p.name for p in root.iterdir()) == ["dummy-set"]
@@ -655,7 +655,7 @@ def test_experiment_outputs_are_replaced_as_a_set(tmp_path):
             f".dummy-set.{dead}.old", f".dummy-set.abc.{dead}.partial"}
         assert (root / "dummy-set" / "figure.txt").read_text() == "run 1"  # put back
         (root / "dummy-set" / ".table.csv.x1y2.tmp").write_text("half")
-        rows, out_dir = run_experiment("dummy-set", root)
+        rows, out_dir = run_experiment("dummy-set", root, warm=False)
         assert rows == [{"run": 3}] and (out_dir / "figure.txt").read_text() == "run 3"
         assert sorted(p.name for p in out_dir.iterdir()) == ["figure.txt", "table.csv", "table.md"]
         assert sorted(p.name for p in root.iterdir()) == ["dummy-set"]

@@ -1,10 +1,12 @@
-"""``workbench list``, ``run`` and ``reproduce``: the registered experiments, one of them, or
-all of them with a progress bar, each writing ``figures/<experiment>/`` and appending its rows
-to the results store (one run record for the command)."""
+"""``workbench list``, ``run``, ``reproduce`` and ``warm``: the registered experiments, one of
+them, or all of them with a progress bar, each writing ``figures/<experiment>/`` and appending
+its rows to the results store (one run record for the command); ``warm`` compiles every kernel
+the experiments use (their tiny runs, thrown away), as ``install.sh`` does once."""
 
 from __future__ import annotations
 
 import sys
+import time
 from pathlib import Path
 
 from .arguments import add_device_argument, apply_process_options
@@ -31,6 +33,16 @@ def add_parser(subparsers) -> None:
     _add_drawing_arguments(p)
     add_results_option(p)
     p.set_defaults(func=cmd_reproduce)
+
+    p = subparsers.add_parser(
+        "warm", help="compile every kernel the experiments use (their tiny runs, thrown away)",
+        description="Run every experiment (or the NAMEs) at its tiny size into a temporary "
+                    "folder, untimed and unrecorded, so that the compiled kernels are in the "
+                    "disk cache before anything is timed. install.sh runs it once.")
+    p.add_argument("names", nargs="*", metavar="NAME", help="experiments (default: all)")
+    p.add_argument("--jobs", type=int, default=2,
+                   help="processes at once (default 2; each compiles its own kernels)")
+    p.set_defaults(func=cmd_warm)
 
 
 def _add_drawing_arguments(p) -> None:
@@ -86,10 +98,34 @@ def cmd_reproduce(args) -> int:
     bar = tqdm(names, desc="reproduce", unit="experiment")
     for name in bar:
         bar.set_postfix_str(name)
+        start = time.perf_counter()
         rows, out_dir = run_experiment(name, figures_root=Path(args.figures), quick=args.quick,
                                        progress=lambda msg: bar.write(f"  {name}: {msg}"),  # noqa: B023
                                        recorder=recorder)
-        bar.write(f"{name}: {len(rows)} rows -> {out_dir}")
+        bar.write(f"{name}: {len(rows)} rows -> {out_dir} "
+                  f"({time.perf_counter() - start:.0f} s)")
     print(f"results: run {recorder.run_id}, {recorder.appended} rows -> "
           f"{recorder.store.root}", file=sys.stderr)
+    return 0
+
+
+def cmd_warm(args) -> int:
+    """Warm the named experiments (all by default) in ``--jobs`` processes; 0, or 2 with one
+    line for an unknown name or a bad ``--jobs``."""
+    from ..experiment.registry import discover
+    from ..experiment.warm import warm_all
+
+    found = discover()
+    names = args.names or sorted(found)
+    unknown = [n for n in names if n not in found]
+    if unknown:
+        print(f"workbench warm: error: unknown experiment {unknown[0]!r}; known: "
+              f"{', '.join(sorted(found))}", file=sys.stderr)
+        return 2
+    if args.jobs < 1:
+        print(f"workbench warm: error: --jobs must be >= 1, got {args.jobs}", file=sys.stderr)
+        return 2
+    start = time.perf_counter()
+    warm_all(names, jobs=args.jobs, progress=lambda msg: print(f"  warmed {msg}", flush=True))
+    print(f"warm: {len(names)} experiments in {time.perf_counter() - start:.0f} s")
     return 0

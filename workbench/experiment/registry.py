@@ -31,6 +31,7 @@ from ..output.targets import output_folder
 from ..results.store import process_alive
 from .context import SIZES, ExperimentContext
 from .declare import Declaration
+from .warm import warm_experiment
 
 if TYPE_CHECKING:
     from ..results.recording import Recorder
@@ -120,7 +121,8 @@ def get_experiment(name: str) -> Experiment:
 def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figures"),
                    quick: bool = False, progress: Progress | None = None,
                    size: str | None = None,
-                   recorder: Recorder | None = None) -> tuple[list[dict], Path]:
+                   recorder: Recorder | None = None,
+                   warm: bool = True) -> tuple[list[dict], Path]:
     """Run experiment ``name`` into ``figures_root/<name>/`` and write its table there.
 
     ``size`` is "full", "quick" or "tiny" (see :mod:`workbench.experiment.context`); by
@@ -132,7 +134,10 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     output folder, so a run's outputs change as a set: a run that fails or is killed leaves the
     previous outputs whole. With a ``recorder`` every table's rows are then appended to its
     results store (columns ``experiment``, ``table`` and ``experiment_size`` added), once the
-    folder is in place. What killed runs left behind (staging folders, a previous output
+    folder is in place. With ``warm`` (the default) a quick or full run is preceded by the
+    experiment's tiny run, untimed and thrown away
+    (:func:`~workbench.experiment.warm.warm_experiment`), so that no table times the
+    compilation of a kernel. What killed runs left behind (staging folders, a previous output
     folder set aside, temporary files) is cleaned up first. Returns ``(rows, out_dir)``.
     Unknown names raise KeyError listing the known ones; rows that are not dicts raise TypeError.
     An output folder that is a symbolic link (wherever it points) or not a folder is refused
@@ -149,6 +154,10 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     out_dir = root / exp.name
     clean_dead_runs(root, exp.name)
     output_folder(out_dir)
+    if warm and size != "tiny":
+        took = warm_experiment(exp)
+        if progress is not None:
+            progress(f"kernels warmed by the tiny run ({took:.1f} s, not timed)")
     staging = Path(tempfile.mkdtemp(dir=root, prefix=f".{exp.name}.",
                                     suffix=f".{os.getpid()}.partial"))
     os.chmod(staging, 0o777 & ~current_umask())  # mkdtemp makes 0700; the output folder is public
