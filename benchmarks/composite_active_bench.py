@@ -2,70 +2,33 @@
 
 The es2008 benchmark (8 semi-cylindrical sheets of 250 × 250 quads, 1 M triangles, seen from
 the front at 1000 × 1000 with per-pixel distance bands, as the compositing table of
-``table_software_raster`` draws it) is split into 8 domains by space
-(:func:`workbench.distributed.domains.split_domains`) and each domain drawn by the software
-rasterizer. The 8 frames are then composited, in this process, by:
+``table_software_raster`` draws it; quick: 32 × 32 quads at 200 × 200) is split into 8
+domains by space (:func:`workbench.distributed.domains.split_domains`) and each domain drawn
+by the software rasterizer (untimed). The 8 frames are then composited, in this process, by:
 
 * full-frame binary tree and binary swap (:mod:`workbench.algo.composite.merge`: whole
   frames or halves sent, 16 bytes a pixel);
-* active-pixel binary tree, binary swap and radix-k with factors 2x2x2, 2x4, 4x2 and 8 (direct
-  send) (:mod:`workbench.algo.composite.active`: bounding box + run lengths of the drawn
-  pixels sent).
+* active-pixel binary tree, binary swap and radix-k with factors 2x2x2, 2x4, 4x2 and 8
+  (direct send) (:mod:`workbench.algo.composite.schedules`: bounding box + run lengths of
+  the drawn pixels sent).
 
-Per schedule: bytes sent between ranks (as the schedule counts them), their share of the
-full-frame tree's and swap's, and the composite wall time (the whole in-process schedule,
-domain frames in, final frame out; median and minimum of ``--repeat`` runs, the schedules run
-in turn so that load drifts hit them alike). Every result is checked against
-``functools.reduce(composite, frames)`` and the one-process image of all triangles.
-Targets for the active schedules: bytes <= 25 % of the full-frame schedules', composite
-<= 0.1 s.
+Every result is checked against ``functools.reduce(composite, frames)`` and the one-process
+image of all triangles first. Timed interleaved: each schedule's own composite seconds (the
+whole in-process schedule, domain frames in, final frame out); each active schedule carries
+``over_full_frame_swap``. Columns: ``rounds``, ``bytes_sent`` and its share of the full-frame
+tree's and swap's (``share_of_tree``, ``share_of_swap``). Targets for the active schedules:
+bytes <= 25 % of the full-frame schedules', composite <= 0.1 s at full size.
 
-Run: ``.venv/bin/python benchmarks/composite_active_bench.py [--quads 250] [--size 1000]
-[--domains 8] [--repeat 7]``.
+Run: ``workbench bench composite_active_bench [--quick]``.
 """
 
 from __future__ import annotations
 
-import argparse
 import functools
-import statistics
-import time
 
-import numpy as np
-
-from workbench.algo.composite.merge import binary_swap, binary_tree, composite
-from workbench.algo.composite.schedules import active_radix, active_swap, active_tree
-from workbench.distributed.domains import split_domains
-from workbench.distributed.sortlast import SoftwareDomains
-from workbench.measurement.rows import default_camera
-from workbench.paths import Style
-from workbench.scene.generators import semicylinders
+from workbench.measurement.bench import Case, benchmark
 
 BANDS = dict(field="distance", bands=10)  # the compositing table's shading
-TARGET_SHARE, TARGET_S = 0.25, 0.1
-
-
-def frames_of(quads: int, size: int, domains: int):
-    """(domain frames, one-process frame, seconds to draw the domains)."""
-    camera = default_camera(semicylinders(8, quads), (size, size), view=(0.0, 0.0), up="y")
-    render = SoftwareDomains(f"semicylinders:{quads}", "pixel_color", Style(**BANDS), camera,
-                             (size, size))
-    parts = split_domains(render.prepared().mesh, domains, by="space")
-    start = time.perf_counter()
-    frames = [render(ids) for ids in parts]
-    drawn = time.perf_counter() - start
-    whole = render(np.arange(render.prepared().triangles))
-    return frames, whole, drawn
-
-
-def schedules(domains: int):
-    yield "full-frame tree", binary_tree
-    yield "full-frame swap", binary_swap
-    yield "active tree", active_tree
-    yield "active swap", active_swap
-    for factors in radix_factors(domains):
-        name = "active radix-k " + "x".join(map(str, factors))
-        yield name, functools.partial(active_radix, factors=factors)
 
 
 def radix_factors(domains: int) -> list[tuple[int, ...]]:
@@ -77,57 +40,51 @@ def radix_factors(domains: int) -> list[tuple[int, ...]]:
 
 
 def same(a, b) -> bool:
+    """Whether frames ``a`` and ``b`` hold the same colour, depth and triangle bytes."""
     return all(x.dtype == y.dtype and x.tobytes() == y.tobytes()
                for x, y in ((a.color, b.color), (a.depth, b.depth), (a.triangle, b.triangle)))
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--quads", type=int, default=250, help="quads per sheet side")
-    parser.add_argument("--size", type=int, default=1000, help="image side in pixels")
-    parser.add_argument("--domains", type=int, default=8)
-    parser.add_argument("--repeat", type=int, default=7, help="timed runs per schedule")
-    args = parser.parse_args()
+@benchmark("composite_active_bench", "sort-last compositing in one process: whole frames "
+                                     "against active pixels",
+           cases=[Case("es2008", {"quads": 250, "size": 1000, "domains": 8},
+                       {"quads": 32, "size": 200, "domains": 8})])
+def composite_active(bench, quads: int, size: int, domains: int) -> None:
+    import numpy as np
 
-    frames, whole, drawn = frames_of(args.quads, args.size, args.domains)
-    covered = [float((f.triangle >= 0).mean()) for f in frames]
-    print(f"semicylinders:{args.quads} at {args.size}x{args.size}, {args.domains} domains by "
-          f"space, drawn in {drawn:.2f} s; drawn share per frame "
-          f"{min(covered):.1%}..{max(covered):.1%}")
+    from workbench.algo.composite.merge import binary_swap, binary_tree, composite
+    from workbench.algo.composite.schedules import active_radix, active_swap, active_tree
+    from workbench.distributed.domains import split_domains
+    from workbench.distributed.sortlast import SoftwareDomains
+    from workbench.measurement.rows import default_camera
+    from workbench.paths import Style
+    from workbench.scene.generators import semicylinders
+
+    camera = default_camera(semicylinders(8, quads), (size, size), view=(0.0, 0.0), up="y")
+    render = SoftwareDomains(f"semicylinders:{quads}", "pixel_color", Style(**BANDS), camera,
+                             (size, size))
+    parts = split_domains(render.prepared().mesh, domains, by="space")
+    frames = [render(ids) for ids in parts]
     expected = functools.reduce(composite, frames)
-    assert same(expected, whole), "the composite of the domains is not the one-process image"
-
-    runs = dict(schedules(args.domains))
-    seconds = {name: [] for name in runs}
+    if not same(expected, render(np.arange(render.prepared().triangles))):
+        raise ValueError("the composite of the domains is not the one-process image")
+    schedules = {"full-frame tree": binary_tree, "full-frame swap": binary_swap,
+                 "active tree": active_tree, "active swap": active_swap}
+    for factors in radix_factors(domains):
+        schedules["active radix-k " + "x".join(map(str, factors))] = functools.partial(
+            active_radix, factors=factors)
     stats = {}
-    for name, schedule in runs.items():  # warm-up and check
+    for name, schedule in schedules.items():
         out, stats[name] = schedule(frames)
-        assert same(out, expected), f"{name}: not functools.reduce(composite, frames)"
-    for _ in range(args.repeat):
-        for name, schedule in runs.items():
-            seconds[name].append(schedule(frames)[1].seconds)
-
-    full = {"tree": stats["full-frame tree"].bytes_moved,
-            "swap": stats["full-frame swap"].bytes_moved}
-    print(f"\n{'schedule':24s} {'rounds':>6s} {'MB sent':>8s} {'/ tree':>7s} {'/ swap':>7s} "
-          f"{'median s':>9s} {'min s':>7s}  per round MB")
-    failed = []
-    for name in runs:
-        s, t = stats[name], seconds[name]
-        median = statistics.median(t)
-        per_round = getattr(s, "round_bytes", ())
-        print(f"{name:24s} {s.rounds:6d} {s.bytes_moved / 1e6:8.1f} "
-              f"{s.bytes_moved / full['tree']:7.1%} {s.bytes_moved / full['swap']:7.1%} "
-              f"{median:9.3f} {min(t):7.3f}  " + " ".join(f"{b / 1e6:.1f}" for b in per_round))
-        if name.startswith("active"):
-            if s.bytes_moved > TARGET_SHARE * min(full.values()):
-                failed.append(f"{name}: {s.bytes_moved / 1e6:.1f} MB")
-            if median > TARGET_S:
-                failed.append(f"{name}: {median:.3f} s")
-    print(f"\ntargets (active): bytes <= {TARGET_SHARE:.0%} of the smaller full-frame schedule's "
-          f"({TARGET_SHARE * min(full.values()) / 1e6:.1f} MB), median composite <= "
-          f"{TARGET_S} s: " + ("met" if not failed else "missed by " + "; ".join(failed)))
-
-
-if __name__ == "__main__":
-    main()
+        if not same(out, expected):
+            raise ValueError(f"{name}: not functools.reduce(composite, frames)")
+    tree, swap = stats["full-frame tree"].bytes_moved, stats["full-frame swap"].bytes_moved
+    bench.interleave(
+        {name: (lambda s=schedule: s(frames)[1].seconds) for name, schedule in schedules.items()},
+        [(name, "full-frame swap") for name in schedules if name.startswith("active")],
+        reported=True,
+        columns_of={name: dict(rounds=s.rounds, bytes_sent=s.bytes_moved,
+                               share_of_tree=s.bytes_moved / tree,
+                               share_of_swap=s.bytes_moved / swap)
+                    for name, s in stats.items()},
+        triangles=int(render.prepared().triangles))

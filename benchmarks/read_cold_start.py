@@ -3,27 +3,29 @@
 solid steps chosen by model size (numpy below ``COMPILED_FROM`` solids, "by size") and with the
 compiled kernels for every size ("compiled always", as before that threshold).
 
-Decks: the shared car deck (shells only) when present, and a generated block of n x n x n
-hexahedra (``--n``, default 20: 8 000 solids) written as ``*ELEMENT_SOLID``. Each run is a new
-Python process that imports the reader and reads the deck; the process measures itself
-(``time.perf_counter`` from before the import to after the read) and reports whether numba was
-imported. "cold" points ``NUMBA_CACHE_DIR`` at a new empty folder; "cached" at one a previous
-process filled. The cases are interleaved, ``--repeat`` rounds (default 7); medians and the
-range are printed, one process at a time, with the ratio of medians compiled always / by size.
+Cases (decks): ``import only``; ``solid block``, a generated block of n x n x n hexahedra
+(full n = 20: 8 000 solids; quick n = 8, without the cold compiled-always process, which
+compiles for some 16 s) written as ``*ELEMENT_SOLID``; ``car deck`` (the
+shared deck, shells only; full size only). Each call is a new Python process that imports the
+reader and reads the deck, measuring itself (``time.perf_counter`` from before the import to
+after the read; the reported seconds); "cold" points ``NUMBA_CACHE_DIR`` at a new empty
+folder, "cached" at one a previous process filled. The four clocks (cold/cached × by size /
+compiled always) are interleaved; the "compiled always" rows carry ``over_cold_by_size`` /
+``over_cached_by_size``, and every row ``numba`` (whether the process imported numba).
 
-Run: ``.venv/bin/python benchmarks/read_cold_start.py [--n 20] [--repeat 7]``.
+Run: ``workbench bench read_cold_start [--quick]``.
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
-import statistics
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from workbench.measurement.bench import Case, benchmark
 
 STEPS = ("by size", "compiled always")
 _PROBE = """
@@ -68,50 +70,51 @@ def solid_deck(n: int, folder: Path) -> Path:
     return path
 
 
-def run(deck: str, cache: Path, steps: str) -> dict:
+def probe(deck: str, cache: Path, steps: str) -> dict:
+    """What one fresh process reading ``deck`` with numba's cache at ``cache`` reports."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
     out = subprocess.run([sys.executable, "-c", _PROBE, deck, steps], env=env, check=True,
                          capture_output=True, text=True).stdout
     return json.loads(out.strip().splitlines()[-1])
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--n", type=int, default=20, help="hexahedra per block edge (20)")
-    parser.add_argument("--repeat", type=int, default=7, help="interleaved rounds (7)")
-    args = parser.parse_args(argv)
+@benchmark("read_cold_start", "reading a deck in a fresh process, cold and with numba's cache",
+           cases=[Case("import only"),
+                  Case("solid block", {"n": 20}, {"n": 8, "cold_compiled": False}),
+                  Case("car deck")])
+def read_cold_start(bench, n: int = 0, cold_compiled: bool = True) -> None:
     from workbench.data import CAR_DECK, shared_file
 
-    with tempfile.TemporaryDirectory(prefix="cold-start-") as folder:
-        folder = Path(folder)
-        decks = {"import only": "-", f"solid block ({args.n ** 3} hexahedra)":
-                 str(solid_deck(args.n, folder))}
-        car = shared_file(CAR_DECK)
-        if car is not None:
-            decks["car deck (shells)"] = str(car)
+    with tempfile.TemporaryDirectory(prefix="cold-start-") as name:
+        folder = Path(name)
+        if bench.case.name == "import only":
+            deck = "-"
+        elif bench.case.name == "solid block":
+            deck = str(solid_deck(n, folder))
+        else:
+            bench.require(bench.quick and "the car deck is read at full size only")
+            car = shared_file(CAR_DECK)
+            bench.require(car is None and f"needs the shared data file {CAR_DECK}")
+            deck = str(car)
         warm = folder / "warm-cache"
-        for deck in decks.values():
-            run(deck, warm, STEPS[1])  # fills the cache the "cached" runs use
-        times: dict[tuple[str, str, str], list[float]] = {}
-        numba_used = {}
-        for r in range(args.repeat):
-            for name, deck in decks.items():
-                for case in ("cold", "cached"):
-                    for steps in STEPS:
-                        cache = folder / f"cold-{r}-{len(times)}-{steps[0]}" \
-                            if case == "cold" else warm
-                        result = run(deck, cache, steps)
-                        times.setdefault((name, case, steps), []).append(result["total_s"])
-                        numba_used[(name, steps)] = result["numba"]
-        print(f"{'deck':<34}{'case':<8}{'solid steps':<17}{'median s':>9}{'min s':>8}"
-              f"{'max s':>8}  numba  ratio")
-        for (name, case, steps), values in times.items():
-            ratio = statistics.median(times[(name, case, STEPS[1])]) / statistics.median(values)
-            print(f"{name:<34}{case:<8}{steps:<17}{statistics.median(values):>9.3f}"
-                  f"{min(values):>8.3f}{max(values):>8.3f}  "
-                  f"{'yes' if numba_used[(name, steps)] else 'no':<5}  {ratio:.2f}")
-    return 0
+        probe(deck, warm, STEPS[1])  # fills the cache the "cached" runs use
+        used: dict[str, bool] = {}
+        fresh = iter(range(10**6))
 
+        def clock(case: str, steps: str):
+            def run() -> float:
+                cache = folder / f"cold-{next(fresh)}" if case == "cold" else warm
+                result = probe(deck, cache, steps)
+                used[f"{case} {steps}"] = result["numba"]
+                return result["total_s"]
+            return run
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+        clocks = {f"{case} {steps}": clock(case, steps)
+                  for case in ("cold", "cached") for steps in STEPS}
+        if not cold_compiled:  # some 16 s a process: left out of the quick size
+            del clocks[f"cold {STEPS[1]}"]
+        timings = bench.interleave(
+            clocks, [(f"{case} {STEPS[1]}", f"{case} {STEPS[0]}") for case in ("cold", "cached")
+                     if f"{case} {STEPS[1]}" in clocks], warmup=0, reported=True)
+        for row in bench.rows[-len(timings):]:
+            row["numba"] = used[row["function"]]

@@ -2,33 +2,29 @@
 
 The rows (columns experiment, table, scene, path, style, renderer, size, wall_ms, wall_ms_lo,
 wall_ms_hi, ssim, error, max_diff_255, triangles and a 9-sample ``wall_samples_ms`` list) go
-through ``ResultsStore.append_rows`` into ``--files`` files spread over 10 runs on 2 machines,
-in a temporary folder. Each query then runs ``--repeat`` times, each time through a new
-``ResultsStore`` (no cached footers) and a new DuckDB connection; the time covers connecting,
-creating the views, running the query and fetching the result as a pyarrow Table.
+through ``ResultsStore.append_rows`` into ``files`` files spread over 10 runs on 2 machines,
+in a temporary folder (full: 1 000 000 rows in 100 files; quick: 20 000 in 10). Each query is
+then timed, each call through a new ``ResultsStore`` (no cached footers) and a new DuckDB
+connection: connecting, creating the views, running the query and fetching the result.
 
 1. **median**: ``SELECT path, median(wall_ms) FROM rows WHERE renderer = 'x' GROUP BY path``
    (target: < 1 s for 1 000 000 rows in 100 files).
 2. **join**: rows × runs × machines, filtered by ``error < e``, counted per machine and path.
 3. **count**: ``SELECT count(*) FROM rows``.
 
-Prints the write time and, per query, the median and min–max in ms.
+Rows: one per query, and ``append_rows`` (the write, timed per file).
 
-Run: ``.venv/bin/python benchmarks/results_query_bench.py [--rows 1000000] [--files 100]
-[--repeat 7] [--seed 0] [--keep DIR]``.
+Run: ``workbench bench results_query_bench [--quick]``.
 """
 
 from __future__ import annotations
 
-import argparse
 import random
 import shutil
-import statistics
 import tempfile
-import time
 from pathlib import Path
 
-from workbench.results.store import ResultsStore
+from workbench.measurement.bench import Case, benchmark
 
 SCENES = ["semicylinders:32", "car", "flange", "membrane", "forcetube"]
 PATHS = ["position", "flat", "gouraud", "vertex_color", "pixel_color", "texture", "software"]
@@ -62,57 +58,33 @@ def synthetic_rows(n: int, rng: random.Random) -> list[dict]:
     return rows
 
 
-def write_store(root: Path, rows: int, files: int, seed: int) -> float:
-    """Fill a store at ``root``; returns the seconds spent in ``append_rows`` (generation
-    excluded)."""
-    rng = random.Random(seed)
-    store = ResultsStore(root)
-    runs = [f"bench-{i:02d}" for i in range(10)]
-    for i in range(2):
-        store.record_machine({"machine_id": f"m{i}", "cpu": f"cpu {i}", "renderer": "x"})
-    for i, run_id in enumerate(runs):
-        store.record_run({"run_id": run_id, "machine_id": f"m{i % 2}", "started": float(i)})
-    spent = 0.0
-    for f in range(files):
-        batch = synthetic_rows(rows // files + (f < rows % files), rng)
-        start = time.perf_counter()
-        store.append_rows(runs[f % len(runs)], batch, experiment="render_paths", table="table")
-        spent += time.perf_counter() - start
-    return spent
+@benchmark("results_query_bench", "results store: append rows, then three DuckDB queries",
+           cases=[Case("store", {"rows": 1_000_000, "files": 100},
+                       {"rows": 20_000, "files": 10})])
+def results_query(bench, rows: int, files: int) -> None:
+    from workbench.results.store import ResultsStore
 
-
-def time_query(root: Path, sql: str, repeat: int) -> list[float]:
-    """Milliseconds for each of ``repeat`` runs of ``sql`` through a fresh store and
-    connection."""
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        ResultsStore(root).query(sql)
-        times.append((time.perf_counter() - start) * 1e3)
-    return times
-
-
-def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--rows", type=int, default=1_000_000)
-    parser.add_argument("--files", type=int, default=100)
-    parser.add_argument("--repeat", type=int, default=7)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--keep", type=Path, help="write the store here and keep it")
-    args = parser.parse_args(argv)
-    root = args.keep or Path(tempfile.mkdtemp(prefix="results_bench_"))
+    rng = random.Random(0)
+    root = Path(tempfile.mkdtemp(prefix="results_bench_"))
     try:
-        write_s = write_store(root, args.rows, args.files, args.seed)
-        print(f"write: {args.rows} rows in {args.files} files: {write_s:.2f} s "
-              f"({write_s / args.files * 1e3:.0f} ms per append_rows)")
+        store = ResultsStore(root)
+        runs = [f"bench-{i:02d}" for i in range(10)]
+        for i in range(2):
+            store.record_machine({"machine_id": f"m{i}", "cpu": f"cpu {i}", "renderer": "x"})
+        for i, run_id in enumerate(runs):
+            store.record_run({"run_id": run_id, "machine_id": f"m{i % 2}", "started": float(i)})
+        batches = [synthetic_rows(rows // files + (f < rows % files), rng) for f in range(files)]
+        written = iter(range(files))
+
+        def append() -> None:
+            f = next(written)
+            store.append_rows(runs[f % len(runs)], batches[f], experiment="render_paths",
+                              table="table")
+
+        # every file is one timed call (at least 5 files: the median needs them)
+        bench.time("append_rows", append, warmup=0, repeat=files, rows_per_file=rows // files)
         for name, sql in QUERIES.items():
-            times = time_query(root, sql, args.repeat)
-            print(f"{name:7s} median {statistics.median(times):7.1f} ms   "
-                  f"min–max {min(times):7.1f}–{max(times):7.1f} ms   ({args.repeat} runs)")
+            bench.time(name, lambda sql=sql: ResultsStore(root).query(sql), stored_rows=rows,
+                       files=files)
     finally:
-        if args.keep is None:
-            shutil.rmtree(root, ignore_errors=True)
-
-
-if __name__ == "__main__":
-    main()
+        shutil.rmtree(root, ignore_errors=True)

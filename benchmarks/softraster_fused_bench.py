@@ -1,135 +1,73 @@
 """The fused, tile-parallel software rasterizer against the paper's per-step pipeline.
 
-The es2008 benchmark (:func:`~workbench.scene.generators.semicylinders`: 8 sheets of
-``--quads`` × ``--quads`` quads, 1 M triangles at 250, at ``--size`` pixels, seen from the
-front as in the reproduction ``table_software_raster``), drawn by the software path with per-
-pixel bands (``pixel_color``, 10 bands of ``distance``) and flat shading, by the steps
-(``RasterOptions(fused=False)``) and fused, with 1 and 2 threads; with ``--gl``, llvmpipe's
-position-only draw (the floor) on the EGL context as well. One draw of every configuration in
-turn, ``--repeat`` rounds after ``--warmup``, so that a slow change of the machine reaches all
-alike. Printed per configuration: the median wall ms, its spread (min, max, interquartile
-range), and the median of the per-round ratios: the steps over fused (same threads), 1 thread
-over 2 (same renderer), llvmpipe's floor over the draw; and whether the fused images equal the
-steps' (colour, depth, triangle index).
+The es2008 benchmark (:func:`~workbench.scene.generators.semicylinders`: 8 sheets of 250 ×
+250 quads, 1 M triangles, at 1000 × 1000; quick: 32 × 32 quads at 200 × 200), seen from the
+front as in the reproduction ``table_software_raster``, drawn by the software path with per-
+pixel bands (case ``pixel_color``: 10 bands of ``distance``) and flat shading (case
+``flat``), by the steps (``RasterOptions(fused=False)``) and fused, with 1 and 2 threads, and,
+where an OpenGL context can be made, the GL position-only draw (the floor: ``gl position``).
 
-Run: ``.venv/bin/python benchmarks/softraster_fused_bench.py [--repeat 15] [--quads 250]
-[--size 1000] [--paths pixel_color,flat] [--gl]``.
+Timed interleaved, one draw of every configuration per round (target cleared untimed), two
+warm-up rounds: each configuration's wall ms, with the per-round ratios steps over fused
+(same threads: ``over_fused_1t``/``over_fused_2t`` on the steps' rows), 1 thread over 2 (same
+renderer) and the GL floor over each software draw. Column ``differing_pixels``: pixels of
+the fused images that differ from the steps' (colour, depth or triangle index; 0 expected).
+
+Run: ``workbench bench softraster_fused_bench [--quick]``.
 """
 
 from __future__ import annotations
 
-import argparse
-import statistics
-import time
-from contextlib import ExitStack
+from workbench.measurement.bench import Case, benchmark, needs_gl
 
-from workbench.algo.softraster import RasterOptions
-from workbench.measurement.rows import default_camera, prepared
-from workbench.paths import SoftwareRasterizer, Style
-from workbench.scene.generators import semicylinders
-
-WHITE = (1.0, 1.0, 1.0, 1.0)
-STYLES = {"pixel_color": Style(field="distance", bands=10), "flat": Style()}
+SIZES = {"full": {"quads": 250, "size": 1000}, "quick": {"quads": 32, "size": 200}}
 
 
-def parse(argv=None) -> argparse.Namespace:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--repeat", type=int, default=15, help="timed rounds (default 15)")
-    p.add_argument("--warmup", type=int, default=2, help="untimed rounds first (default 2)")
-    p.add_argument("--quads", type=int, default=250, help="quads a side per sheet (250: 1 M "
-                   "triangles)")
-    p.add_argument("--size", type=int, default=1000, help="image width and height in pixels")
-    p.add_argument("--paths", default="pixel_color,flat",
-                   help=f"comma-separated, of {', '.join(STYLES)}")
-    p.add_argument("--gl", action="store_true", help="time llvmpipe's position-only draw too")
-    args = p.parse_args(argv)
-    paths = args.paths.split(",")
-    if any(name not in STYLES for name in paths) or args.repeat < 1 or args.warmup < 0 \
-            or args.quads < 1 or args.size < 1:
-        p.error(f"--paths from {', '.join(STYLES)}; --repeat, --quads and --size positive, "
-                f"--warmup not negative")
-    args.paths = paths
-    return args
+@benchmark("softraster_fused_bench", "the fused software rasterizer against the per-step "
+                                     "pipeline, 1 and 2 threads",
+           cases=[Case("pixel_color", SIZES["full"], SIZES["quick"]),
+                  Case("flat", SIZES["full"], SIZES["quick"])])
+def softraster_fused(bench, quads: int, size: int) -> None:
+    from contextlib import ExitStack
 
+    from workbench.algo.softraster import RasterOptions
+    from workbench.measurement.interleave import draw_clock
+    from workbench.measurement.rows import default_camera
+    from workbench.paths import SoftwareRasterizer, Style, prepared
+    from workbench.scene.generators import semicylinders
 
-def configurations(paths):
-    """(label, path name, renderer, threads): the steps and fused, 1 and 2 threads."""
-    for name in paths:
-        for renderer in ("steps", "fused"):
-            for threads in (1, 2):
-                yield f"{name} {renderer} {threads}t", name, renderer, threads
-
-
-def spread(ms: list[float]) -> str:
-    q1, _, q3 = statistics.quantiles(ms, n=4) if len(ms) > 1 else (ms[0], 0, ms[0])
-    return (f"{statistics.median(ms):8.1f} ms  (min {min(ms):6.1f}, max {max(ms):6.1f}, "
-            f"IQR {q3 - q1:5.1f})")
-
-
-def ratio(times: dict, a: str, b: str) -> str:
-    """Median of a_i / b_i over the rounds, with its range."""
-    r = [x / y for x, y in zip(times[a], times[b])]
-    return f"{statistics.median(r):5.2f}x  [{min(r):.2f}, {max(r):.2f}]"
-
-
-def main(argv=None) -> int:
-    args = parse(argv)
-    mesh = semicylinders(8, args.quads)
-    size = (args.size, args.size)
-    camera = default_camera(mesh, size, view=(0.0, 0.0), up="y")
-    print(f"{len(mesh.triangles)} triangles at {size[0]}x{size[1]}, {args.repeat} rounds "
-          f"after {args.warmup}")
+    name = bench.case.name
+    style = Style(field="distance", bands=10) if name == "pixel_color" else Style()
+    mesh = semicylinders(8, quads)
+    shape = (size, size)
+    camera = default_camera(mesh, shape, view=(0.0, 0.0), up="y")
     with ExitStack() as stack:
         ready = {}
-        for label, name, renderer, threads in configurations(args.paths):
-            options = RasterOptions(threads=threads, fused=renderer == "fused")
-            ready[label] = stack.enter_context(prepared(
-                SoftwareRasterizer(options), mesh, name, STYLES[name], camera, size))
-        if args.gl:
-            from workbench.gl import create_context, renderer
+        for renderer in ("steps", "fused"):
+            for threads in (1, 2):
+                options = RasterOptions(threads=threads, fused=renderer == "fused")
+                ready[f"{renderer} {threads}t"] = stack.enter_context(prepared(
+                    SoftwareRasterizer(options), mesh, name, style, camera, shape))
+        software = list(ready)
+        if needs_gl() is None:
+            from workbench.gl import create_context
 
             ctx = create_context()
-            ready["llvmpipe position"] = stack.enter_context(
-                prepared(ctx, mesh, "position", Style(), camera, size))
-            print(f"GL: {renderer(ctx)}")
-        times = {label: [] for label in ready}
-        for round_ in range(args.warmup + args.repeat):
-            for label, r in ready.items():
-                r.bind()
-                r.target.clear(WHITE)
-                r.backend.finish()
-                start = time.perf_counter()
-                r.path.draw()
-                r.backend.finish()
-                if round_ >= args.warmup:
-                    times[label].append((time.perf_counter() - start) * 1e3)
-        print("\nmedian wall time per draw")
-        for label, ms in times.items():
-            print(f"  {label:24s} {spread(ms)}")
-        print("\nsteps / fused (same threads), 1 thread / 2 threads (same renderer)")
-        for name in args.paths:
-            for threads in (1, 2):
-                print(f"  {name} {threads}t   steps / fused  "
-                      f"{ratio(times, f'{name} steps {threads}t', f'{name} fused {threads}t')}")
-            for renderer in ("steps", "fused"):
-                print(f"  {name} {renderer:5s} 1t / 2t       "
-                      f"{ratio(times, f'{name} {renderer} 1t', f'{name} {renderer} 2t')}")
-        if args.gl:
-            print("\nllvmpipe's position-only floor / software draw")
-            for label in times:
-                if label != "llvmpipe position":
-                    print(f"  {label:24s} {ratio(times, 'llvmpipe position', label)}")
-        print("\nfused images against the steps' (colour, depth, triangle index)")
-        for name in args.paths:
-            ref = ready[f"{name} steps 1t"].target.frame
-            for threads in (1, 2):
-                frame = ready[f"{name} fused {threads}t"].target.frame
-                diff = [int((getattr(frame, a) != getattr(ref, a)).any(axis=-1).sum()
-                            if a == "color" else (getattr(frame, a) != getattr(ref, a)).sum())
-                        for a in ("color", "depth", "triangle")]
-                print(f"  {name} fused {threads}t: differing pixels {diff}")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+            stack.callback(ctx.release)
+            ready["gl position"] = stack.enter_context(
+                prepared(ctx, mesh, "position", Style(), camera, shape))
+        ratios = [(f"steps {t}t", f"fused {t}t") for t in (1, 2)]
+        ratios += [(f"{r} 1t", f"{r} 2t") for r in ("steps", "fused")]
+        ratios += [("gl position", label) for label in software if "gl position" in ready]
+        differing = {}
+        for label in software:  # one draw each, then the fused images against the steps'
+            ready[label].bind()
+            ready[label].path.draw()
+        ref = ready["steps 1t"].target.frame
+        for label in software:
+            frame = ready[label].target.frame
+            differing[label] = {"differing_pixels": int(
+                ((frame.color != ref.color).any(axis=-1) | (frame.depth != ref.depth)
+                 | (frame.triangle != ref.triangle)).sum())}
+        bench.interleave({label: draw_clock(r) for label, r in ready.items()}, ratios,
+                         warmup=2, columns_of=differing, triangles=int(len(mesh.triangles)))

@@ -1,29 +1,28 @@
 """Boundary surface of large solid meshes: solid elements per second of ``boundary_surface``.
 
-Models (unit cells on a regular grid, node ids in grid order, LS-DYNA *ELEMENT_SOLID layout):
+Models (unit cells on a regular grid, node ids in grid order, LS-DYNA *ELEMENT_SOLID layout),
+one case each:
 
-* **hex**: an n x n x n block of hexahedra (default n = 100: 1 000 000 solids, 6 M faces);
-* **tet**: an m x m x m block of cells split into 6 Kuhn tetrahedra each
-  (default m = 56: 1 053 696 solids, 4.2 M faces);
-* **tet-shuffled**: the tet model with randomly permuted node ids and solid order (no locality).
+* **hex**: an n x n x n block of hexahedra (full n = 100: 1 000 000 solids, 6 M faces;
+  quick n = 20);
+* **tet**: an m x m x m block of cells split into 6 Kuhn tetrahedra each (full m = 56:
+  1 053 696 solids, 4.2 M faces; quick m = 12);
+* **tet-shuffled**: the tet model with randomly permuted node ids and solid order (no
+  locality).
 
-Each model: one warm-up call (numba kernels compile or load from cache), then ``--repeat`` timed
-calls (wall seconds, ``time.perf_counter``); the median is reported with solids per second.
-The boundary is checked: 6 n^2 quads for the hex block, 12 m^2 triangles for the tet block.
-Target: >= 2 M solids/s per model on the 2-core development machine.
+Timed: ``boundary_surface(solids, nodes)`` (one untimed warm-up call compiles or loads the
+numba kernels). The boundary is checked first: 6 n² quads for the hex block, 12 m² triangles
+for the tet block. Rows: ``solids``, ``faces`` and ``solids_per_s`` (of the median); the
+design target is >= 2 M solids/s per model on a 2-core machine.
 
-Run: ``.venv/bin/python benchmarks/solid_faces_bench.py [--hex 100] [--tet 56] [--repeat 5]``.
+Run: ``workbench bench solid_faces_bench [--quick]``.
 """
 
 from __future__ import annotations
 
-import argparse
-import statistics
-import time
-
 import numpy as np
 
-from workbench.scene.solids import boundary_surface
+from workbench.measurement.bench import Case, benchmark
 
 CORNERS = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
 KUHN = [[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]]
@@ -40,12 +39,14 @@ def grid(n: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def tet_model(m: int) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes and the Kuhn tetrahedra (degenerate 8-node solids) of an m x m x m block."""
     nodes, hexes = grid(m)
     t = hexes[:, KUHN].reshape(-1, 4)
     return nodes, np.concatenate([t, np.repeat(t[:, 3:], 4, axis=1)], axis=1)
 
 
 def shuffled(nodes: np.ndarray, solids: np.ndarray, seed: int = 0):
+    """The same model with node ids and solid order permuted at random."""
     rng = np.random.default_rng(seed)
     relabel = rng.permutation(len(nodes)).astype(np.int32)
     new_nodes = np.empty_like(nodes)
@@ -53,37 +54,24 @@ def shuffled(nodes: np.ndarray, solids: np.ndarray, seed: int = 0):
     return new_nodes, relabel[solids][rng.permutation(len(solids))]
 
 
-def bench(name: str, nodes: np.ndarray, solids: np.ndarray, expect: int, repeat: int) -> float:
-    elements, _, _ = boundary_surface(solids, nodes)  # warm-up
-    assert len(elements) == expect, (name, len(elements), expect)
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        boundary_surface(solids, nodes)
-        times.append(time.perf_counter() - t0)
-    med = statistics.median(times)
-    rate = len(solids) / med
-    print(f"{name:13s} {len(solids):>9,d} solids  {len(elements):>8,d} boundary faces  "
-          f"median {med:6.3f} s (min {min(times):.3f}, max {max(times):.3f})  "
-          f"{rate / 1e6:5.2f} M solids/s  {'ok' if rate >= 2e6 else 'BELOW 2 M/s'}")
-    return rate
+@benchmark("solid_faces_bench", "boundary surface of large solid meshes, solids per second",
+           cases=[Case("hex", {"cells": 100}, {"cells": 20}),
+                  Case("tet", {"cells": 56}, {"cells": 12}),
+                  Case("tet-shuffled", {"cells": 56}, {"cells": 12})])
+def solid_faces(bench, cells: int) -> None:
+    from workbench.scene.solids import boundary_surface
 
-
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--hex", type=int, default=100, help="hex block edge in cells")
-    ap.add_argument("--tet", type=int, default=56, help="tet block edge in cells (x 6 tets)")
-    ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--no-shuffled", action="store_true", help="skip the shuffled tet model")
-    args = ap.parse_args()
-    nodes, hexes = grid(args.hex)
-    bench("hex", nodes, hexes, 6 * args.hex**2, args.repeat)
-    del nodes, hexes
-    nodes, tets = tet_model(args.tet)
-    bench("tet", nodes, tets, 12 * args.tet**2, args.repeat)
-    if not args.no_shuffled:
-        bench("tet-shuffled", *shuffled(nodes, tets), 12 * args.tet**2, args.repeat)
-
-
-if __name__ == "__main__":
-    main()
+    if bench.case.name == "hex":
+        nodes, solids = grid(cells)
+        expect = 6 * cells**2
+    else:
+        nodes, solids = tet_model(cells)
+        expect = 12 * cells**2
+        if bench.case.name == "tet-shuffled":
+            nodes, solids = shuffled(nodes, solids)
+    elements, _, _ = boundary_surface(solids, nodes)
+    if len(elements) != expect:
+        raise ValueError(f"{bench.case.name}: {len(elements)} boundary faces, expected {expect}")
+    t = bench.time("boundary_surface", lambda: boundary_surface(solids, nodes),
+                   solids=len(solids), faces=len(elements))
+    bench.rows[-1]["solids_per_s"] = len(solids) / (t.wall_ms / 1e3)

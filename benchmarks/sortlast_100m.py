@@ -1,47 +1,41 @@
 """The es2008 scene at 100 M triangles, rendered sort-last on a LocalCluster of this machine's
 workers, each loading only its own domains from a chunked scene on disk.
 
-Steps: write ``--sheets`` sheets of ``--n``×``--n`` quads (default 8 × 2500²: 100 M triangles)
-as a chunked scene, one domain per sheet (:func:`workbench.distributed.bigscene.
-write_semicylinders_chunked`; the writer holds one sheet at a time); start a LocalCluster of
-``--workers`` worker processes (one thread each); render at ``--size`` with ``--method``
-compositing (default ``local``; :func:`~workbench.distributed.bigscene.run_chunked_sortlast`; a
-small scene of as many domains first, so that the workers' kernels are compiled), then render
-the reference in this process domain by domain and compare. Printed: triangles, write time, render
-and composite time, triangles/s, bytes moved, each worker's peak resident memory next to the
-largest domain's in-memory size and the memory of an idle worker (the fixed overhead), the
-reference time and whether the images are equal. Peak memory is each worker's high-water mark,
-reset after the warm-up (the idle memory then is the fixed overhead). The scene folder is removed
-at the end unless ``--keep`` (or ``--reuse``: render a scene already written to ``--folder``).
+Steps (untimed): write 8 sheets of ``n``×``n`` quads (full 2500: 100 M triangles; quick 64) as
+a chunked scene, one domain per sheet (:func:`workbench.distributed.bigscene.
+write_semicylinders_chunked`; the writer holds one sheet at a time); start a LocalCluster of 2
+worker processes (one thread each); render a small scene of as many domains first, so that
+the workers' kernels are compiled; render once with the one-process reference and check the
+images are equal (the benchmark stops otherwise). Timed: ``run_chunked_sortlast`` at
+1000 × 1000 with ``local`` compositing (the reference left out), the run's own clocks giving
+two rows, ``sortlast render`` and ``sortlast composite``. Columns: ``triangles``,
+``scene_gib`` on disk, ``domain_mib`` (the largest domain in memory), ``idle_mib`` (an idle
+worker, the fixed overhead), ``peak_mib`` (the largest worker's high-water mark in the
+checked run), ``bytes_moved`` and ``reference_s``.
 
-Run alone (it times): ``.venv/bin/python benchmarks/sortlast_100m.py [--n 2500] [--sheets 8]``.
+The full size needs about 48 GiB of memory (the scene's sheets, two workers and the
+one-process reference) and some 20 GB of disk; it is skipped on a smaller machine.
+
+Run: ``workbench bench sortlast_100m [--quick]`` (needs dask's distributed).
 """
 
 from __future__ import annotations
 
-import argparse
-import logging
-import shutil
-import tempfile
-import time
-from pathlib import Path
+from workbench.measurement.bench import Case, benchmark, needs_memory_gib, needs_module
+
+SHEETS, WORKERS, SIZE, METHOD, PATH = 8, 2, (1000, 1000), "local", "pixel_color"
+FULL_MEMORY_GIB = 48
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sheets", type=int, default=8)
-    parser.add_argument("--n", type=int, default=2500, help="quads per sheet edge (2500)")
-    parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--size", default="1000x1000")
-    parser.add_argument("--method", default="local",
-                        choices=("local", "tree", "swap", "active-tree", "active-swap", "radix"))
-    parser.add_argument("--path", default="pixel_color")
-    parser.add_argument("--folder", help="where to write the scene (default: a temporary one)")
-    parser.add_argument("--keep", action="store_true", help="keep the scene folder")
-    parser.add_argument("--reuse", action="store_true",
-                        help="render the scene already in --folder (written when absent); keeps it")
-    args = parser.parse_args(argv)
-    size = tuple(int(v) for v in args.size.lower().split("x"))
+@benchmark("sortlast_100m", "the es2008 scene at 100 M triangles rendered sort-last from a "
+                            "chunked scene on disk",
+           cases=[Case("chunked", {"n": 2500}, {"n": 64})],
+           requires=[needs_module("dask", "distributed")])
+def sortlast_100m(bench, n: int) -> None:
+    import logging
+    import shutil
+    import tempfile
+    from pathlib import Path
 
     import dask
     from distributed import Client, LocalCluster
@@ -49,57 +43,34 @@ def main(argv=None) -> int:
     from workbench.distributed.bigscene import run_chunked_sortlast, write_semicylinders_chunked
     from workbench.distributed.sortlast import reset_peak_memory
 
-    root = Path(args.folder) if args.folder else Path(tempfile.mkdtemp(prefix="sortlast-100m-"))
-    folder = root / "scene"
+    bench.require(not bench.quick and needs_memory_gib(FULL_MEMORY_GIB))
+    root = Path(tempfile.mkdtemp(prefix="sortlast-100m-"))
     try:
-        start = time.perf_counter()
-
-        def written(k: int) -> None:
-            print(f"  sheet {k} written ({time.perf_counter() - start:.0f} s)", flush=True)
-
-        if args.reuse and (folder / "scene.json").is_file():
-            print(f"  reusing the scene in {folder}")
-        else:
-            write_semicylinders_chunked(folder, args.sheets, args.n, path=args.path,
-                                        progress=written, replace=args.reuse)
-        write_s = time.perf_counter() - start
+        folder = write_semicylinders_chunked(root / "scene", SHEETS, n, path=PATH)
         disk = sum(f.stat().st_size for f in folder.rglob("*") if f.is_file())
         with dask.config.set({"distributed.worker.profile.enabled": False}):
-            cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+            cluster = LocalCluster(n_workers=WORKERS, threads_per_worker=1, processes=True,
                                    dashboard_address=None, silence_logs=logging.ERROR,
                                    memory_limit=0)
         with cluster, Client(cluster) as client:
-            client.wait_for_workers(args.workers, timeout=120)
-            # a small scene first: the workers compile their kernels, and their memory after
-            # it is the fixed overhead
-            write_semicylinders_chunked(root / "warm-up", args.sheets, 8, path=args.path,
-                                        replace=True)
-            run_chunked_sortlast(client, root / "warm-up", size, method=args.method,
-                                 reference=False)
+            client.wait_for_workers(WORKERS, timeout=120)
+            write_semicylinders_chunked(root / "warm-up", SHEETS, 8, path=PATH, replace=True)
+            run_chunked_sortlast(client, root / "warm-up", SIZE, method=METHOD, reference=False)
             idle = reset_peak_memory(client)
-            image, run = run_chunked_sortlast(client, folder, size, method=args.method)
-        overhead = max(idle.values())
-        print(f"| triangles | {run.triangles:,} |")
-        print(f"| domains / workers | {run.domains} / {run.workers} |")
-        print(f"| scene on disk | {disk / 2**30:.2f} GiB, written in {write_s:.1f} s |")
-        print(f"| render (cluster) | {run.render_s:.2f} s, {run.triangles_per_s / 1e6:.1f} M "
-              f"triangles/s |")
-        print(f"| composite ({run.method}) | {run.composite_s:.3f} s, "
-              f"{run.bytes_moved / 2**20:.1f} MiB moved |")
-        print(f"| largest domain in memory | {run.domain_mib:.0f} MiB |")
-        print(f"| idle worker (fixed overhead) | {overhead:.0f} MiB |")
-        for address, peak in sorted(run.peak_mib.items()):
-            share = run.share_mib[address]
-            print(f"| peak of worker {address} | {peak:.0f} MiB = overhead + "
-                  f"{(peak - overhead) / share:.2f} x its share of {share:.0f} MiB "
-                  f"({(peak - overhead) / run.domain_mib:.2f} x the largest domain) |")
-        print(f"| reference (one process, domain by domain) | {run.reference_s:.1f} s |")
-        print(f"| images equal | {run.equal} |")
+            _, checked = run_chunked_sortlast(client, folder, SIZE, method=METHOD)
+            if not checked.equal:
+                raise ValueError("the sort-last image differs from the one-process reference")
+
+            def run() -> dict[str, float]:
+                _, r = run_chunked_sortlast(client, folder, SIZE, method=METHOD,
+                                            reference=False)
+                return {"render": r.render_s, "composite": r.composite_s}
+
+            bench.time_reported("sortlast", run, warmup=0, triangles=checked.triangles,
+                                scene_gib=disk / 2**30, domain_mib=checked.domain_mib,
+                                idle_mib=max(idle.values()),
+                                peak_mib=max(checked.peak_mib.values()),
+                                bytes_moved=checked.bytes_moved,
+                                reference_s=checked.reference_s, method=METHOD)
     finally:
-        if not (args.keep or args.reuse):
-            shutil.rmtree(root if not args.folder else folder, ignore_errors=True)
-    return 0 if run.equal else 1
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+        shutil.rmtree(root, ignore_errors=True)

@@ -1,46 +1,52 @@
 """Sort-last compositing on a Dask LocalCluster: whole frames against drawn pixels only.
 
-The es2008 scene (1 M triangles, ``--n``² quads per sheet) is split into ``--domains`` spatial
-domains (default 8), rendered at ``--size`` (default 1000×1000) by the software rasterizer on
-``--workers`` worker processes (default 2, one thread each), and composited on the workers by
-every schedule of :func:`workbench.distributed.sortlast.render_sortlast`: ``tree`` and
-``swap`` (whole frames, as before), ``active-tree``, ``active-swap``, ``radix`` (direct
-send, and 2×4) and ``local`` (each worker's domains composited there, one piece sent per
-other worker). The client fetches the final colour (``color_only``, what a display needs) or
-the whole frame (colour, depth, triangle indices: the fetched column). The schedules are
-interleaved over ``--repeat`` rounds (default 5); per schedule the median composite time with
-its range, the bytes that moved between workers and the bytes the schedule sends, and whether
-the image equals the one-process frame. Then the same domains drawn by GL (each worker's own
-EGL context) and composited by ``local`` and ``active-swap``, against the image one context
-draws.
+Case ``software``: the es2008 scene (``n``² quads per sheet; full 250: 1 M triangles, at
+1000 × 1000; quick 16 at 200 × 200) is split into 8 spatial domains, rendered by the software
+rasterizer on 2 worker processes (one thread each), and composited on the workers by every
+schedule of :func:`workbench.distributed.sortlast.render_sortlast`: ``tree`` and ``swap``
+(whole frames), ``active-tree``, ``active-swap``, ``radix`` (direct send, and 2×4) and
+``local`` (each worker's domains composited there, one piece sent per other worker). The
+client fetches the final colour (``| colour``, what a display needs) or the whole frame
+(``| frame``). One warm-up round loads the scene and compiles the kernels; the schedules are
+then interleaved, the reported time being each run's ``composite_s``; every schedule carries
+``over_swap_frame`` (its time over whole-frame binary swap's) and the columns ``moved_bytes``
+(between workers), ``schedule_bytes`` (what the schedule sends) and ``equal`` (the image
+equals the one-process frame in every round).
 
-Run alone (it times): ``.venv/bin/python benchmarks/sortlast_composite_bench.py``.
+Case ``gl``: the same domains drawn by OpenGL (each worker's own EGL context), composited by
+``local`` and ``active-swap`` (colour only), ``equal`` against the image one context draws.
+
+Run: ``workbench bench sortlast_composite_bench [--quick]`` (needs dask's distributed; the gl
+case an OpenGL context).
 """
 
 from __future__ import annotations
 
-import argparse
-import logging
-import statistics
-
-import numpy as np
+from workbench.measurement.bench import Case, benchmark, needs_gl, needs_module
 
 SCHEDULES = (("tree", None, False), ("swap", None, False), ("tree", None, True),
              ("swap", None, True), ("active-tree", None, True), ("active-swap", None, True),
              ("radix", None, True), ("radix", (2, 4), True), ("local", None, True),
              ("local", None, False))
+SIZES = {"full": {"n": 250, "size": 1000}, "quick": {"n": 16, "size": 200}}
+DOMAINS, WORKERS = 8, 2
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--n", type=int, default=250)
-    parser.add_argument("--domains", type=int, default=8)
-    parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--size", type=int, default=1000)
-    parser.add_argument("--repeat", type=int, default=5)
-    args = parser.parse_args(argv)
+def label(method: str, factors, color_only: bool) -> str:
+    """``swap | frame``, ``radix 2x4 | colour`` …"""
+    return (method + ("" if factors is None else " " + "x".join(map(str, factors)))
+            + (" | colour" if color_only else " | frame"))
+
+
+@benchmark("sortlast_composite_bench", "sort-last compositing schedules on a Dask LocalCluster",
+           cases=[Case("software", SIZES["full"], SIZES["quick"]),
+                  Case("gl", SIZES["full"], SIZES["quick"])],
+           requires=[needs_module("dask", "distributed")])
+def sortlast_composite(bench, n: int, size: int) -> None:
+    import logging
 
     import dask
+    import numpy as np
     from distributed import Client, LocalCluster
 
     from workbench.distributed.domains import split_domains
@@ -49,59 +55,52 @@ def main(argv=None) -> int:
     from workbench.paths import Style
     from workbench.scene.builtin import fresh_scene
 
-    scene = f"semicylinders:{args.n}"
-    size = (args.size, args.size)
+    gl = bench.case.name == "gl"
+    bench.require(gl and needs_gl())
+    scene = f"semicylinders:{n}"
+    shape = (size, size)
     style = Style(field="distance", bands=10)
     mesh = fresh_scene(scene, False)
-    camera = default_camera(mesh, size, view=(0.0, 0.0), up="y")
-    software = SoftwareDomains(scene, "pixel_color", style, camera, size)
-    domains = split_domains(mesh, args.domains)
-    reference = software(np.arange(len(mesh.triangles)))
-    with dask.config.set({"distributed.worker.profile.enabled": False}):
-        cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR)
-    results: dict[str, list] = {}
-    with cluster, Client(cluster) as client:
-        client.wait_for_workers(args.workers, timeout=120)
-        for method, factors, color_only in SCHEDULES:  # load the scene, compile the kernels
-            render_sortlast(client, software, domains, method=method, factors=factors,
-                            color_only=color_only)
-        for _ in range(args.repeat):
-            for method, factors, color_only in SCHEDULES:
-                out, stats = render_sortlast(client, software, domains, method=method,
-                                             factors=factors, color_only=color_only)
-                name = (method + ("" if factors is None else " " + "x".join(map(str, factors)))
-                        + (" | colour" if color_only else " | frame"))
-                color = out if color_only else out.color
-                equal = np.array_equal(color, reference.color) and (
-                    color_only or (np.array_equal(out.triangle, reference.triangle)
-                                   and np.array_equal(out.depth, reference.depth)))
-                results.setdefault(name, []).append((stats.composite_s, stats.bytes_moved,
-                                                     stats.schedule_bytes, equal))
-        base = statistics.median(r[1] for r in results["swap | frame"])
-        print("| schedule | fetched | composite s, median [min, max] | moved MiB | of swap's | "
-              "schedule MiB | equal |\n|---|---|---|---:|---:|---:|---|")
-        for name, rows in results.items():
-            times = [r[0] for r in rows]
-            moved = statistics.median(r[1] for r in rows)
-            print(f"| {name} | {statistics.median(times):.3f} [{min(times):.3f}, "
-                  f"{max(times):.3f}] | {moved / 2**20:.1f} | {moved / base:.0%} | "
-                  f"{statistics.median(r[2] for r in rows) / 2**20:.1f} | "
-                  f"{all(r[3] for r in rows)} |")
-        gl = GLDomains(scene, "pixel_color", style, camera, size)
-        _, path, target, _ = gl.prepared()
+    camera = default_camera(mesh, shape, view=(0.0, 0.0), up="y")
+    domains = split_domains(mesh, DOMAINS)
+    if gl:
+        render = GLDomains(scene, "pixel_color", style, camera, shape)
+        _, path, target, _ = render.prepared()
         target.use()
         target.clear()
         path.draw()
-        one_context = target.read()
-        render_sortlast(client, gl, domains, method="local")  # every worker opens its context
-        for method in ("local", "active-swap", "local", "active-swap"):
-            color, stats = render_sortlast(client, gl, domains, method=method, color_only=True)
-            print(f"GL domains, {method}: {stats.composite_s:.3f} s, "
-                  f"{stats.bytes_moved / 2**20:.1f} MiB moved, image equal to one context: "
-                  f"{np.array_equal(color, one_context)}")
-    return 0
+        reference = target.read()
+        schedules = (("local", None, True), ("active-swap", None, True))
+    else:
+        render = SoftwareDomains(scene, "pixel_color", style, camera, shape)
+        reference = render(np.arange(len(mesh.triangles)))
+        schedules = SCHEDULES
+    with dask.config.set({"distributed.worker.profile.enabled": False}):
+        cluster = LocalCluster(n_workers=WORKERS, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.ERROR)
+    seen: dict[str, dict] = {}
+    with cluster, Client(cluster) as client:
+        client.wait_for_workers(WORKERS, timeout=120)
 
+        def clock(method, factors, color_only):
+            def run() -> float:
+                out, stats = render_sortlast(client, render, domains, method=method,
+                                             factors=factors, color_only=color_only)
+                if gl:
+                    equal = bool(np.array_equal(out, reference))
+                else:
+                    color = out if color_only else out.color
+                    equal = np.array_equal(color, reference.color) and (
+                        color_only or (np.array_equal(out.triangle, reference.triangle)
+                                       and np.array_equal(out.depth, reference.depth)))
+                row = seen.setdefault(label(method, factors, color_only), {"equal": True})
+                row.update(moved_bytes=stats.bytes_moved, schedule_bytes=stats.schedule_bytes,
+                           equal=row["equal"] and bool(equal))
+                return stats.composite_s
+            return run
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+        clocks = {label(*s): clock(*s) for s in schedules}
+        base = "swap | frame" if not gl else "local | colour"
+        bench.interleave(clocks, [(name, base) for name in clocks if name != base],
+                         reported=True, columns_of=seen, domains=DOMAINS, workers=WORKERS,
+                         triangles=int(len(mesh.triangles)))

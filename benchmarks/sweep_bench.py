@@ -1,27 +1,31 @@
 """Sweep benchmarks: what a cached point costs, what a second worker gives, kill and resume.
 
-1. **skip**: a 1 000-point grid of cheap untimed points is run once, then again; the second
-   run computes nothing, and the median time per point to compute its key and read its
-   stored row (``SweepResult.skip_ms``) is reported (target: < 5 ms).
-2. **scaling**: a grid of error-only points (``timed = false``: drawn once, compared with the
-   reference path's image) on a LocalCluster of 1 and of 2 workers; points per second of the
-   compute phase (``SweepResult.compute_s``: submitting to storing the last, cluster start-up
-   excluded) and their ratio (target on 2 cores: >= 1.6).
-3. **resume**: ``workbench sweep sweeps/bands_vertex_pixel.toml --quick`` killed with SIGKILL at
-   random moments ``--kills`` times (during start-up, or once 1 to 3 more points are stored,
-   plus a random delay of up to 0.5 s), then run to the end; after every run no point file
-   written before it may have been rewritten (same inode and mtime), and the final table must
-   equal a clean run's in every column but times and run ids.
+Cases:
 
-Run: ``.venv/bin/python benchmarks/sweep_bench.py [--only skip,scaling,resume] [--kills 5]
-[--seed 0] [--keep DIR]``.
+1. **skip**: a grid of cheap untimed points (full 1 000, quick 40) is run once (every point
+   computed, untimed), then again and again; a rerun computes nothing, and the reported
+   time is the median per point to compute its key and read its stored row
+   (``SweepResult.skip_ms``; target < 5 ms), row ``cached point``.
+2. **scaling**: a grid of error-only points (``timed = false``: drawn once, compared with the
+   reference path's image; full 60 at 400 × 400, quick 12 at 100 × 100) on a LocalCluster of
+   1 and of 2 workers (each run its own cluster), interleaved without a warm-up round; the
+   reported time is the compute phase (``SweepResult.compute_s``: submitting to storing the
+   last, cluster start-up excluded);
+   ``1 worker`` carries ``over_2_workers`` (the speed-up; target on 2 cores >= 1.6) and the
+   column ``machine_scaling`` (what 2 processes give pure-Python work at that moment).
+3. **resume**: ``workbench sweep sweeps/bands_vertex_pixel.toml --quick`` killed with SIGKILL
+   at random moments (full 5 times, quick once; during start-up, or once 1 to 3 more points
+   are stored, plus a random delay of up to 0.5 s), then run to the end; after every run no
+   point file written before it may have been rewritten (same inode and mtime), and the final
+   table must equal a clean run's in every column but times and run ids. Row ``resume``
+   (``recomputed_finished``, ``table_matches_clean``, ``kills``) and the timed clean run.
+
+Run: ``workbench bench sweep_bench [--quick]`` (scaling and resume need an OpenGL context).
 """
 
 from __future__ import annotations
 
-import argparse
 import random
-import shutil
 import signal
 import statistics
 import subprocess
@@ -31,11 +35,13 @@ import textwrap
 import time
 from pathlib import Path
 
+from workbench.measurement.bench import Case, benchmark, needs_gl
+
 ROOT = Path(__file__).resolve().parents[1]
 SWEEP = [sys.executable, "-m", "workbench.cli.sweep"]
 
 SKIP_GRID = """
-    name = "skip_1000"
+    name = "skip"
     timed = false
     [grid]
     scene = "semicylinders:2"
@@ -54,7 +60,7 @@ SCALING_GRID = """
     path = ["vertex_color", "pixel_color", "gouraud", "flat"]
     bands = [{bands}]
     field = "distance"
-    size = "400x400"
+    size = "{size}"
 """
 
 
@@ -62,27 +68,6 @@ def _config(folder: Path, text: str, name: str) -> Path:
     path = folder / f"{name}.toml"
     path.write_text(textwrap.dedent(text))
     return path
-
-
-def bench_skip(folder: Path) -> dict:
-    """Median ms to skip a cached point, over a 1 000-point sweep run twice."""
-    from workbench.sweep import load_config, run_sweep
-
-    config = load_config(_config(folder, SKIP_GRID.format(bands=", ".join(map(str, range(250)))),
-                                 "skip"))
-    out = folder / "skip"
-    start = time.perf_counter()
-    first = run_sweep(config, out, progress=False)
-    first_s = time.perf_counter() - start
-    start = time.perf_counter()
-    second = run_sweep(config, out, progress=False)
-    second_s = time.perf_counter() - start
-    assert first.computed == 1000 and second.computed == 0 and second.cached == 1000
-    skips = sorted(second.skip_ms)
-    return dict(points=len(second.rows), first_run_s=first_s, first_failed=first.failed,
-                second_run_s=second_s, skip_median_ms=statistics.median(skips),
-                skip_p95_ms=skips[int(0.95 * (len(skips) - 1))], skip_max_ms=skips[-1],
-                skip_total_s=sum(skips) / 1e3)
 
 
 def _spin(_) -> float:
@@ -107,25 +92,6 @@ def machine_scaling() -> float:
         start = time.perf_counter()
         list(pool.map(_spin, range(2)))
         return one / (time.perf_counter() - start)
-
-
-def bench_scaling(folder: Path, bands: int = 15, rounds: int = 2) -> dict:
-    """Points per second of error-only points on 1 and on 2 workers, the best of ``rounds``
-    alternating runs each (other programs on the machine only ever slow a run down)."""
-    from workbench.sweep import load_config, run_sweep
-
-    config = load_config(_config(
-        folder, SCALING_GRID.format(bands=", ".join(map(str, range(bands)))), "scaling"))
-    best = {1: 0.0, 2: 0.0}
-    for round_ in range(rounds):
-        for workers in (1, 2):
-            result = run_sweep(config, folder / f"scaling_{workers}_{round_}", workers=workers,
-                               progress=False)
-            assert result.computed == len(result.rows) and result.failed == 0
-            best[workers] = max(best[workers], result.computed / result.compute_s)
-    return dict(points=len(result.rows), points_per_s_1=best[1], points_per_s_2=best[2],
-                speedup=best[2] / best[1], machine_scaling=machine_scaling(),
-                load=Path("/proc/loadavg").read_text().split()[0])
 
 
 def _stamps(points: Path) -> dict[str, tuple[int, int]]:
@@ -190,53 +156,50 @@ def bench_resume(folder: Path, kills: int = 5, seed: int = 0) -> dict:
                 final_summary=summary, table_matches_clean=_stable(out) == _stable(clean))
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", default="skip,scaling,resume",
-                        help="comma-separated benchmarks to run (default all)")
-    parser.add_argument("--kills", type=int, default=5)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--keep", metavar="DIR", help="work in DIR and keep it")
-    args = parser.parse_args(argv)
-    folder = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="sweep_bench_"))
-    folder.mkdir(parents=True, exist_ok=True)
-    chosen = args.only.split(",")
-    ok = True
-    try:
-        if "skip" in chosen:
-            r = bench_skip(folder)
-            ok &= r["skip_median_ms"] < 5
-            print(f"skip: {r['points']} cached points, median {r['skip_median_ms']:.3f} ms per "
-                  f"point (p95 {r['skip_p95_ms']:.3f}, max {r['skip_max_ms']:.3f}, "
-                  f"{r['skip_total_s']:.2f} s in all); whole rerun {r['second_run_s']:.1f} s "
-                  f"(first run {r['first_run_s']:.1f} s, {r['first_failed']} failed)", flush=True)
-        if "scaling" in chosen:
-            r = bench_scaling(folder)
-            ok &= r["speedup"] >= 1.6
-            print(f"scaling: {r['points']} error-only points, 1 worker "
-                  f"{r['points_per_s_1']:.2f} points/s, 2 workers {r['points_per_s_2']:.2f} "
-                  f"points/s: {r['speedup']:.2f}x (the machine gives {r['machine_scaling']:.2f}x "
-                  f"to pure-Python work right now; load average {r['load']})", flush=True)
-        if "resume" in chosen:
-            r = bench_resume(folder, args.kills, args.seed)
-            ok &= r["recomputed_finished_total"] == 0 and r["table_matches_clean"]
-            for i, run in enumerate(r["runs"]):
-                when = "to the end" if run["kill_after_s"] is None else (
-                    f"SIGKILL after {run['kill_after_s']:.1f} s "
-                    + (f"({run['waited_for_points']} new points, then up to 0.5 s)"
-                       if run["waited_for_points"] else "(during start-up)")
-                    + ("" if run["killed"] else ", but it had already ended"))
-                print(f"resume run {i + 1}: {when}: {run['finished_before']} -> "
-                      f"{run['finished_after']} points stored, {run['recomputed_finished']} "
-                      f"finished points recomputed", flush=True)
-            print(f"resume: clean run {r['clean_run_s']:.1f} s; recomputed finished points "
-                  f"{r['recomputed_finished_total']}; final table matches the clean run: "
-                  f"{r['table_matches_clean']}; {r['final_summary']}", flush=True)
-    finally:
-        if not args.keep:
-            shutil.rmtree(folder, ignore_errors=True)
-    return 0 if ok else 1
+@benchmark("sweep_bench", "sweeps: a cached point's cost, 1 against 2 workers, kill and resume",
+           cases=[Case("skip", {"bands": 250}, {"bands": 10}),
+                  Case("scaling", {"bands": 15, "size": "400x400"},
+                       {"bands": 3, "size": "100x100"}),
+                  Case("resume", {"kills": 5}, {"kills": 1})])
+def sweep_bench(bench, bands: int = 0, size: str = "", kills: int = 0) -> None:
+    from workbench.sweep import load_config, run_sweep
 
+    with tempfile.TemporaryDirectory(prefix="sweep_bench_") as name:
+        folder = Path(name)
+        if bench.case.name == "skip":
+            config = load_config(_config(
+                folder, SKIP_GRID.format(bands=", ".join(map(str, range(bands)))), "skip"))
+            out = folder / "skip"
+            first = run_sweep(config, out, progress=False)  # computes every point, untimed
+            bench.time_reported(
+                "cached point",
+                lambda: statistics.median(run_sweep(config, out, progress=False).skip_ms) / 1e3,
+                points=4 * bands, first_run_failed=first.failed)
+            return
+        bench.require(needs_gl())
+        if bench.case.name == "scaling":
+            config = load_config(_config(folder, SCALING_GRID.format(
+                bands=", ".join(map(str, range(bands))), size=size), "scaling"))
+            runs = iter(range(10**6))
 
-if __name__ == "__main__":
-    sys.exit(main())
+            def clock(workers: int):
+                def run() -> float:
+                    result = run_sweep(config, folder / f"scaling_{next(runs)}",
+                                       workers=workers, progress=False)
+                    if result.failed or result.computed != len(result.rows):
+                        raise ValueError(f"scaling sweep: {result.failed} points failed")
+                    return result.compute_s
+                return run
+
+            bench.interleave({"1 worker": clock(1), "2 workers": clock(2)},
+                             [("1 worker", "2 workers")], warmup=0, reported=True,
+                             points=4 * bands, machine_scaling=machine_scaling())
+            return
+        r = bench_resume(folder, kills, seed=0)
+        bench.record("resume", kills=kills, recomputed_finished=r["recomputed_finished_total"],
+                     table_matches_clean=r["table_matches_clean"], clean_run_s=r["clean_run_s"],
+                     final_summary=r["final_summary"])
+        if r["recomputed_finished_total"] or not r["table_matches_clean"]:
+            raise ValueError(f"resume: {r['recomputed_finished_total']} finished points "
+                             f"recomputed, table matches the clean run: "
+                             f"{r['table_matches_clean']}")

@@ -8,4 +8,6 @@
 ``interleave``   ratios measured A B A B … in one process, with an interval
 ``stats``        confidence intervals, paired ratios and the stopping rule
 ``images``       image error against a reference: max / mean difference, PSNR, SSIM
+``bench``        the benchmark harness: cases, timed functions, the registry of
+                 ``benchmarks/`` (run and stored by ``workbench bench``)
 ===============  ======================================================================"""

@@ -20,8 +20,10 @@ measured in that stretch moves with it (measured on a 2-core llvmpipe machine: w
 other). Times are therefore compared relative to their group's drift: the median B / A ratio
 of the times of one experiment, table and scene. A line's ``drift`` is that median and
 ``relative`` its ratio divided by it (its interval too). The drift is reported, not flagged: it
-is the machine's speed as much as the code's. Ratios that carry their own interval (measured
-interleaved in one run) are already free of drift and are compared as they are.
+is the machine's speed as much as the code's. A group of fewer than three times (a benchmark
+case timing one function) has no drift: its times are compared as they are. Ratios that carry
+their own interval (measured interleaved in one run) are already free of drift and are
+compared as they are.
 
 A line is *flagged* as changed only when its whole (relative) interval lies beyond the
 threshold band ``[1 / (1 + threshold), 1 + threshold]`` (default 10 %): the change is larger
@@ -44,6 +46,7 @@ if TYPE_CHECKING:
     from .store import ResultsStore
 
 THRESHOLD = 0.10
+MIN_DRIFT_TIMES = 3  # times a group needs for its drift: with one, the drift is its own ratio
 # columns that are not the measurement's parameters: who ran it, and where
 RUN_COLUMNS = {"run_id", "row_index", "renderer", "experiment", "table", "experiment_size",
                "error"}
@@ -177,12 +180,15 @@ def compare_runs(store: ResultsStore, a: str, b: str, threshold: float = THRESHO
 
 
 def _drifts(lines: list[dict[str, Any]]) -> dict[tuple, float]:
-    """The median ratio of the times (quantities with samples) of each group."""
+    """The median ratio of the times (quantities with samples) of each group that has
+    :data:`MIN_DRIFT_TIMES` or more; a smaller group has no drift estimate (its own change
+    would be taken for the machine's) and is compared as it is."""
     ratios: dict[tuple, list[float]] = defaultdict(list)
     for line in lines:
         if line["timed"]:
             ratios[line["group"]].append(line["ratio"])
-    return {group: statistics.median(values) for group, values in ratios.items()}
+    return {group: statistics.median(values) for group, values in ratios.items()
+            if len(values) >= MIN_DRIFT_TIMES}
 
 
 def summary(lines: list[dict[str, Any]]) -> str:
