@@ -22,7 +22,7 @@ import time
 from workbench.measurement.bench import Case, benchmark, needs_module
 
 
-@benchmark("probe", "a nap of known length", cases=[Case("nap", {"ms": 20}, {"ms": 8})])
+@benchmark("probe", "a nap of known length", cases=[Case("nap", {"ms": 60}, {"ms": 30})])
 def probe(bench, ms):
     slowdown = float(os.environ.get("PROBE_SLOWDOWN", "1"))  # the injected fault
     bench.time("sleep", lambda: time.sleep(ms * slowdown / 1e3), requested_ms=ms)
@@ -63,7 +63,7 @@ def test_quick_bench_stores_rows_with_provenance(capsys, folder, tmp_path):
             row["case"]) == (run, "bench:probe", "nap", "quick", "nap")
     assert len(row["wall_samples_ms"]) == row["repeats"] == 5
     assert row["wall_ms_lo"] <= row["wall_ms"] <= row["wall_ms_hi"]
-    assert row["wall_ms"] >= 8.0 and row["requested_ms"] == 8  # the quick size, timed
+    assert row["wall_ms"] >= 30.0 and row["requested_ms"] == 30  # the quick size, timed
     (record,) = store.query(f"SELECT * FROM runs WHERE run_id = '{run}'").to_pylist()
     assert record["command"] == "bench probe --quick" and record["size"] == "quick"
     assert record["machine_id"] and "commit" in record and record["libraries"]
@@ -74,10 +74,11 @@ def test_quick_bench_stores_rows_with_provenance(capsys, folder, tmp_path):
 
 def test_compare_flags_a_slowed_benchmark_not_a_rerun(capsys, folder, tmp_path, monkeypatch):
     store_root = tmp_path / "store"
-    first = bench_run(capsys, folder, store_root)
-    again = bench_run(capsys, folder, store_root)
+    # 30 ms naps, 9 of each: jitter of a few ms cannot move a median by 2x
+    first = bench_run(capsys, folder, store_root, "--repeat", "9")
+    again = bench_run(capsys, folder, store_root, "--repeat", "9")
     monkeypatch.setenv("PROBE_SLOWDOWN", "3")
-    slowed = bench_run(capsys, folder, store_root)
+    slowed = bench_run(capsys, folder, store_root, "--repeat", "9")
     store = ResultsStore(store_root)
     # a deliberately wide band (flag only beyond 2x) so that a noisy machine cannot flake
     same = compare_runs(store, first, again, threshold=1.0)
@@ -139,3 +140,12 @@ def test_interleaved_functions_carry_their_ratio():
     with pytest.raises(ValueError, match="Case"):
         benchmark("dup", "x", cases=[Case("a"), Case("a")])
     assert "dup" not in BENCHMARKS
+
+
+def test_a_converted_benchmark_runs_at_its_quick_size():
+    discover()
+    result = run_benchmark("solid_faces_bench", "quick")
+    assert [r["case"] for r in result.rows] == ["hex", "tet", "tet-shuffled"]
+    hexes = result.rows[0]
+    assert (hexes["solids"], hexes["faces"]) == (20**3, 6 * 20**2)  # the quick size
+    assert all(r["repeats"] == 5 and r["solids_per_s"] > 0 for r in result.rows)
