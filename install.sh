@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Install workbench on a fresh Debian/Ubuntu machine: the system libraries for headless OpenGL
 # (EGL + Mesa) and open3d (libusb-1.0), then a virtual environment in .venv with the package
-# and its test and notebook tools. Safe to run again.
+# and its test, notebook and docs tools. Safe to run again.
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -17,5 +17,5 @@ fi
 python=${PYTHON:-python3}
 [ -x .venv/bin/python ] || "$python" -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
-.venv/bin/python -m pip install -q -e '.[test,notebook]'
+.venv/bin/python -m pip install -q -e '.[test,notebook,docs]'
 echo "workbench installed in .venv ($(.venv/bin/workbench --version))"
