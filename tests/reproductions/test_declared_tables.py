@@ -11,7 +11,9 @@ from declared import assert_declared_tables, declaration
 
 from workbench.experiment.declare import DeclarationError
 from workbench.experiment.registry import EXPERIMENTS, discover, run_experiment
-from workbench.output.tables import read_table
+from workbench.measurement.timing import TIMING_COLUMNS
+from workbench.output.tables import STORE_ONLY_SUFFIX, read_table
+from workbench.reproductions._declared.common import timing
 
 discover()
 NAMES = sorted(name for name, exp in EXPERIMENTS.items()
@@ -27,6 +29,11 @@ def test_every_reproduction_is_declared_with_tables_and_claims():
         for table in declared.tables:
             for column in table.columns:
                 assert column.legend.strip() and column.unit is not None, (name, column)
+
+
+def test_the_shared_timing_columns_are_the_timing_rows():
+    assert [c.name for c in timing()] == [c for c in TIMING_COLUMNS
+                                          if not c.endswith(STORE_ONLY_SUFFIX)]
 
 
 @pytest.mark.parametrize("name", NAMES)
