@@ -32,6 +32,28 @@ source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 templates_path = ["_templates"]
 exclude_patterns = ["_build", "api/generated", "*.ipynb", "Thumbs.db", ".DS_Store"]
 
+
+def _drop_stale_pages(folder: str = "api") -> None:
+    """Delete the generated page of every module that no longer exists (a module moved or
+    removed since the last build), which autosummary would otherwise leave to fail its import."""
+    import importlib.util
+
+    if not os.path.isdir(folder):
+        return
+    for page in os.listdir(folder):
+        name, ext = os.path.splitext(page)
+        if ext != ".rst":
+            continue
+        try:
+            found = importlib.util.find_spec(name) is not None
+        except (ImportError, ValueError):
+            found = False
+        if not found:
+            os.remove(os.path.join(folder, page))
+
+
+_drop_stale_pages()
+
 # the API reference: every module of the package, one page each, written at build time
 autosummary_generate = True
 autosummary_ignore_module_all = True

@@ -110,3 +110,15 @@ def test_the_readme_is_short_and_keeps_its_markers_and_two_commands():
         assert f"(docs/{page}.md)" in text, page
     for image in re.findall(r"!\[[^]]*\]\(([^)]+)\)", text):
         assert (ROOT / image).is_file() and (ROOT / image).stat().st_size < 200_000, image
+
+
+def test_the_files_the_pages_name_exist():
+    pages = [ROOT / "README.md", *(DOCS / f"{p}.md" for p in
+                                   ("cli", "python", "extending", "architecture"))]
+    named = re.compile(r"`((?:workbench|tests|benchmarks|sweeps|docs)/[\w/.-]*"
+                       r"\.(?:py|toml|md|ipynb))`")
+    missing = [(page.name, path) for page in pages
+               for path in named.findall(page.read_text(encoding="utf-8"))
+               if not (ROOT / path).exists()]
+    assert not missing
+    assert sum(len(named.findall(page.read_text(encoding="utf-8"))) for page in pages) > 20
