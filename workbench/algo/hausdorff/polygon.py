@@ -109,7 +109,8 @@ def _polygon_bounds(tri, start_upper, target, max_splits, eps, best_point, corne
     without the nearest faces overstates distances) and must be ignored.
     """
     full = len(fixed) == 0
-    depth, ref_tri = tree.depth, tree.ref_tri
+    depth = tree.depth
+    ref_tri = tree.ref_tri
     size = max_splits + 4
     poly, count_v, depth_v, kind, bound, parent_start, parent_n = _piece_stack(size)
     tmp = np.empty(3)

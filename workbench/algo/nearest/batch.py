@@ -416,13 +416,26 @@ def _search_groups(ga, gb, groups, s0, s1, set_parts, best0, tree, found, stats,
     ``set_parts[s0:s1]``, into ``found`` (see the module notes; ``scratch`` a
     :class:`~workbench.algo.nearest.state.GroupScratch`). Returns gb, or the group at which
     ``scratch.cand`` ran out of room (that group is to be searched again with more)."""
-    box, child, part, leaf_first, leaf_count, leaf_part, ref_tri, ref_part, ref_box, \
-        corners = tree.box, tree.child, tree.part, tree.leaf_first, tree.leaf_count, \
-        tree.leaf_part, tree.ref_tri, tree.ref_part, tree.ref_box, tree.ref_corners
-    spts, order, g_start = groups.spts, groups.order, groups.g_start
-    out_d2, out_tri = found.d2, found.tri
-    stack, cand, cbox, g, tmp = scratch.stack, scratch.cand, scratch.cbox, scratch.g, \
-        scratch.tmp
+    box = tree.box
+    child = tree.child
+    part = tree.part
+    leaf_first = tree.leaf_first
+    leaf_count = tree.leaf_count
+    leaf_part = tree.leaf_part
+    ref_tri = tree.ref_tri
+    ref_part = tree.ref_part
+    ref_box = tree.ref_box
+    corners = tree.ref_corners
+    spts = groups.spts
+    order = groups.order
+    g_start = groups.g_start
+    out_d2 = found.d2
+    out_tri = found.tri
+    stack = scratch.stack
+    cand = scratch.cand
+    cbox = scratch.cbox
+    g = scratch.g
+    tmp = scratch.tmp
     bound = best0 * _SLACK  # a box is pruned when its squared distance is >= this
     for grp in range(ga, gb):
         b0, b1 = g_start[grp], g_start[grp + 1]
@@ -503,10 +516,15 @@ def _points_box(spts, b0, b1, g):
 def _search_bucket(buckets, b, batch, tree, found):
     """Bucket b's points: sorted along the curve (radix, _RADIX bits a pass, in cache),
     grouped, searched. Returns (box tests, triangle tests, groups)."""
-    vals, index_bits, bits, below = buckets.vals, buckets.index_bits, buckets.bits, \
-        buckets.below
+    vals = buckets.vals
+    index_bits = buckets.index_bits
+    bits = buckets.bits
+    below = buckets.below
     b0, b1 = buckets.starts[b], buckets.starts[b + 1]
-    points, set_ptr, set_parts, best0 = batch.points, batch.set_ptr, batch.set_parts, batch.best0
+    points = batch.points
+    set_ptr = batch.set_ptr
+    set_parts = batch.set_parts
+    best0 = batch.best0
     m = b1 - b0
     v = vals[b0:b1].copy()
     v2 = np.empty(m, np.int64)

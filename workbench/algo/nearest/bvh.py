@@ -332,11 +332,17 @@ def nearest_one(p, start, bound_sq, tree, search):
     :class:`~workbench.algo.nearest.state.Search`) holds the scratch: ``stack``/``stack_d`` of
     ``depth + 2`` entries, ``tmp`` (3,).
     """
-    box_lo, box_hi, child, first, count = tree.box_lo, tree.box_hi, tree.child, tree.first, \
-        tree.count
-    ref_tri, corners = tree.ref_tri, tree.corners
-    stack, stack_d, tmp, best_point = search.stack, search.stack_d, search.tmp, \
-        search.best_point
+    box_lo = tree.box_lo
+    box_hi = tree.box_hi
+    child = tree.child
+    first = tree.first
+    count = tree.count
+    ref_tri = tree.ref_tri
+    corners = tree.corners
+    stack = search.stack
+    stack_d = search.stack_d
+    tmp = search.tmp
+    best_point = search.best_point
     best = bound_sq
     best_tri = -1
     if start >= 0:
@@ -423,9 +429,13 @@ def within(p, radius_sq, tree, out, limit=-1):
     """Sorted indices of the triangles of ``tree`` (a :class:`~workbench.algo.nearest.state.Tree`)
     at squared distance <= ``radius_sq`` from p, written to ``out`` (room for every reference);
     returns how many, or -1 as soon as more than ``limit`` (when >= 0) references are found."""
-    box_lo, box_hi, child, first, count = tree.box_lo, tree.box_hi, tree.child, tree.first, \
-        tree.count
-    ref_tri, corners = tree.ref_tri, tree.corners
+    box_lo = tree.box_lo
+    box_hi = tree.box_hi
+    child = tree.child
+    first = tree.first
+    count = tree.count
+    ref_tri = tree.ref_tri
+    corners = tree.corners
     stack = np.empty(tree.depth + 2, np.int64)
     tmp = np.empty(3)
     n = 0

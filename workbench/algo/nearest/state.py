@@ -1,10 +1,12 @@
 """The arrays the nearest-point kernels share, grouped by what they hold.
 
-Each group is a NamedTuple, which numba passes to a compiled function as one argument and
-reads field by field at no cost; a kernel unpacks the fields it needs before its loops. Every
-field keeps one type from call to call (the arrays their dtype and C order, the counts int),
-so that one compiled version serves every call. Lengths are in the units of the triangles'
-corners.
+Each group is a NamedTuple, which numba passes to a compiled function as one argument and reads
+field by field at no cost; a kernel takes the fields it needs before its loops, one assignment
+each (``stack = search.stack``), never by unpacking a tuple of them: numba's dead-code pass
+keeps the writes to an array read from an argument's field, but may drop those to one unpacked
+from a tuple (a parallel kernel lost the last write of its loop body that way). Every field
+keeps one type from call to call (the arrays their dtype and C order, the counts int), so that
+one compiled version serves every call. Lengths are in the units of the triangles' corners.
 
 * :class:`Tree` -- the flat :class:`~workbench.algo.nearest.bvh.TriangleBVH` (what
   :meth:`~workbench.algo.nearest.bvh.TriangleBVH.arrays` returns);

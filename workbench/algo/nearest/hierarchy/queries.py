@@ -77,11 +77,21 @@ def _nearest_one(p, best, root, own, o0, o1, forest, elements, plane_test, searc
     own[o0:o1]. Adds to counts: bv tests, element tests, plane skips, leaf elements.
     ``search`` (a :class:`~.state.LeafSearch`): ``stack``/``stack_d`` scratch of depth + 2
     entries, ``tmp`` (3,), ``leaf_g``/``leaf_j`` scratch of the largest leaf's size."""
-    bv, obb, left, right, start, end, node_part = forest.bv, forest.obb, forest.left, \
-        forest.right, forest.start, forest.end, forest.node_part
-    corners, n_tri, slab = elements.corners, elements.n_tri, elements.slab
-    stack, stack_d, tmp, leaf_g, leaf_j = search.stack, search.stack_d, search.tmp, \
-        search.leaf_g, search.leaf_j
+    bv = forest.bv
+    obb = forest.obb
+    left = forest.left
+    right = forest.right
+    start = forest.start
+    end = forest.end
+    node_part = forest.node_part
+    corners = elements.corners
+    n_tri = elements.n_tri
+    slab = elements.slab
+    stack = search.stack
+    stack_d = search.stack_d
+    tmp = search.tmp
+    leaf_g = search.leaf_g
+    leaf_j = search.leaf_j
     best_e = -1
     p0, p1, p2 = p[0], p[1], p[2]
     if node_part[root] >= 0 and _is_excluded(root, node_part, own, o0, o1):
@@ -175,8 +185,11 @@ def _nearest_many(points, active, exclusion, best0, forest, elements, plane_test
     nearer than ``best0`` and not of a part ``exclusion`` (an :class:`~.state.Exclusion`)
     lists for it: squared distance into ``out_d2``, tree-order index into ``out_elem`` (inf,
     -1 where none or inactive), its tests into ``counts[i]``."""
-    ptr, own = exclusion.ptr, exclusion.own
-    root, depth, max_leaf = forest.root, forest.depth, forest.max_leaf
+    ptr = exclusion.ptr
+    own = exclusion.own
+    root = forest.root
+    depth = forest.depth
+    max_leaf = forest.max_leaf
     n = len(points)
     n_chunks = (n + _CHUNK - 1) // _CHUNK
     for chunk in numba.prange(n_chunks):
@@ -200,10 +213,16 @@ def _per_part_many(points, active, exclusion, best0, forest, elements, offsets, 
     (not excluded by ``exclusion``) and search that part for its nearest element. First pass
     (fill False) counts the parts found per point into ``counts``; the second writes (part
     index, squared distance) at ``offsets``."""
-    ptr, own = exclusion.ptr, exclusion.own
-    bv, obb, left, right, node_part = forest.bv, forest.obb, forest.left, forest.right, \
-        forest.node_part
-    root, depth, max_leaf = forest.root, forest.depth, forest.max_leaf
+    ptr = exclusion.ptr
+    own = exclusion.own
+    bv = forest.bv
+    obb = forest.obb
+    left = forest.left
+    right = forest.right
+    node_part = forest.node_part
+    root = forest.root
+    depth = forest.depth
+    max_leaf = forest.max_leaf
     n = len(points)
     n_chunks = (n + _CHUNK - 1) // _CHUNK
     for chunk in numba.prange(n_chunks):
@@ -244,8 +263,12 @@ def _per_part_many(points, active, exclusion, best0, forest, elements, offsets, 
 def _cut(ql, unit, tol, q, nrm, forest, element_nodes, coords, out):
     """Tree-order indices of the elements of ``forest`` (a :class:`~.state.Forest`) cut by the
     plane (see cut_by_plane) into ``out``; returns how many."""
-    bv, obb, left, right, start, end = forest.bv, forest.obb, forest.left, forest.right, \
-        forest.start, forest.end
+    bv = forest.bv
+    obb = forest.obb
+    left = forest.left
+    right = forest.right
+    start = forest.start
+    end = forest.end
     stack = np.empty(2 * forest.depth + 4, np.int64)
     stack[0] = forest.root
     top = 1

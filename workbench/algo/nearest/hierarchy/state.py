@@ -1,9 +1,10 @@
 """The arrays the element hierarchy's kernels (:mod:`.queries`) share, grouped by what they hold.
 
-Each group is a NamedTuple, which numba passes to a compiled function as one argument and
-reads field by field at no cost; a kernel unpacks the fields it needs before its loops. Every
-field keeps one type from call to call, so that one compiled version serves every call.
-Coordinates are the hierarchy's local ones (the mesh's less its origin), in the mesh's units.
+Each group is a NamedTuple, which numba passes to a compiled function as one argument and reads
+field by field at no cost; a kernel takes the fields it needs before its loops, one assignment
+each (never by unpacking a tuple of them, see :mod:`workbench.algo.nearest.state`). Every field
+keeps one type from call to call, so that one compiled version serves every call. Coordinates
+are the hierarchy's local ones (the mesh's less its origin), in the mesh's units.
 """
 
 from __future__ import annotations
