@@ -168,6 +168,11 @@ def build_model(elements, coords, params="A", *, wire_encoding: str = "corners",
     (the atlas size is a multiple of it; default 2). The
     paper's rule is :data:`PAPER_TEXTURE_RULE`. Refuses empty meshes, non-finite coordinates
     and an unknown encoding.
+
+    Takes more than 12 arguments because every stage's rule is a keyword-only option with the
+    paper's or the measured default, which a caller names only to change it (the experiments
+    pass :data:`PAPER_DISTANCE_RULE` and :data:`PAPER_TEXTURE_RULE` as ``**`` keywords); it is
+    plain Python that calls the stages, no compiled kernel.
     """
     from . import wiretex
 

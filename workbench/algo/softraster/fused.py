@@ -52,6 +52,7 @@ from numba import prange
 
 from . import kernels
 from .kernels import CONSTANT, ELEMENT_COLOR, FLAT, GOURAUD, VERTEX_COLOR, _flat_light
+from .state import Bins, Screen, Target
 
 DROPPED, SEVERAL = -1, -2  # tile codes of a triangle: drawn nowhere, in more than one tile
 BOX_PIXEL_WORK = 1  # work estimate of a tile: per box pixel tested …
@@ -77,13 +78,23 @@ def _box(tris, k, fx, fy, bits, width, height):
 
 
 @numba.njit(cache=True, parallel=True)
-def classify(tris, fx, fy, fz, ok, clipd, width, height, bits, shift, tiles_x, chunks, code,
-             count, work):
-    """The clip pass, over ``chunks`` consecutive runs of triangles in parallel: ``code[k]``
-    the one tile (of ``2^shift`` pixels a side) triangle ``k`` meets, :data:`SEVERAL` or
-    :data:`DROPPED` (by the clip test of :func:`.kernels.clip_triangles`); ``count[c, t]`` and
-    ``work[c, t]`` the triangles of run c in tile t and their estimated work. Returns the
-    triangles kept."""
+def classify(tris, lit, screen, chunks, code, count, work):
+    """The clip pass, over ``chunks`` consecutive runs of triangles in parallel (their window
+    positions and clip distances from ``lit``, a :class:`~.state.Lit`; the image and its tiles
+    ``screen``, a :class:`~.state.Screen`): ``code[k]`` the one tile (of ``2^shift`` pixels a
+    side) triangle ``k`` meets, :data:`SEVERAL` or :data:`DROPPED` (by the clip test of
+    :func:`.kernels.clip_triangles`); ``count[c, t]`` and ``work[c, t]`` the triangles of run c
+    in tile t and their estimated work. Returns the triangles kept."""
+    fx = lit.fx
+    fy = lit.fy
+    fz = lit.fz
+    ok = lit.ok
+    clipd = lit.clipd
+    width = screen.width
+    height = screen.height
+    bits = screen.bits
+    shift = screen.shift
+    tiles_x = screen.tiles_x
     n = tris.shape[0]
     wmax = (width - 1) << bits
     hmax = (height - 1) << bits
@@ -172,11 +183,22 @@ def _record(tris, k, fx, fy, fz, slot, members, mxy, mz):
 
 
 @numba.njit(cache=True, parallel=True)
-def place(tris, fx, fy, fz, bits, width, height, shift, tiles_x, code, fill, members, mxy, mz):
+def place(tris, lit, screen, code, fill, bins):
     """The bin pass, by the runs of :func:`classify`: every kept triangle into the slots of
-    its tiles (``fill`` from :func:`deal`, advanced): ``members`` its index, ``mxy`` (·, 6)
-    int32 its fixed-point vertices, ``mz`` (·, 3) float32 their depths, in the order of
-    ``tris``."""
+    its tiles (``fill`` from :func:`layout`, advanced) in ``bins`` (a :class:`~.state.Bins`):
+    ``members`` its index, ``mxy`` (·, 6) int32 its fixed-point vertices, ``mz`` (·, 3)
+    float32 their depths, in the order of ``tris``."""
+    fx = lit.fx
+    fy = lit.fy
+    fz = lit.fz
+    width = screen.width
+    height = screen.height
+    bits = screen.bits
+    shift = screen.shift
+    tiles_x = screen.tiles_x
+    members = bins.members
+    mxy = bins.mxy
+    mz = bins.mz
     chunks = fill.shape[0]
     n = code.shape[0]
     for ch in prange(chunks):
@@ -257,18 +279,43 @@ def _block_max(depth, bmax, nmax, b, i0, j0, block):
 
 
 @numba.njit(cache=True, parallel=True)
-def draw_tiles(order, start, members, mxy, mz, tris, ids, fx, fy, attr, clipd,
-               pos32, view32, tri_s, tri_missing, any_missing, kind, base, missing, texels,
-               texf, linear, alpha_test, early, shift, tiles_x, bits, depth, color, triangle,
-               covered):
-    """Every tile of ``order`` (:func:`layout`), each by one thread, drawn into ``depth``,
-    ``color`` (packed RGBA8) and ``triangle``: its triangles (``members``) in index order, each
-    set up, its box within the tile tested against the edge functions, each covered fragment
-    depth tested, clipped, coloured and written; a triangle flagged in ``tri_missing`` (read
-    where ``any_missing``) in the ``missing`` colour. With ``early``, the depth test comes first,
-    and a triangle whose depth plane lies behind the largest depth of the blocks its box meets
-    is skipped before its coverage. ``covered[t]``: the fragments tile t generated (pixel
+def draw_tiles(order, start, bins, tris, ids, lit, look, early, screen, target, covered):
+    """Every tile of ``order`` (:func:`layout`), each by one thread, drawn into ``target`` (a
+    :class:`~.state.Target`: ``depth``, ``color`` packed RGBA8, ``triangle``): its triangles
+    (``bins``, a :class:`~.state.Bins`, from ``start[t]``) in index order, each set up, its box
+    within the tile tested against the edge functions, each covered fragment depth tested,
+    clipped, coloured (``look``, a :class:`~.state.Look`; the vertices' attributes, clip
+    distances and the triangles' texture coordinates from ``lit``, a :class:`~.state.Lit` of
+    this session's triangles) and written; a triangle flagged in ``lit.tri_missing`` (read
+    where ``any_missing``) in the ``missing`` colour. With ``early``, the depth test comes
+    first, and a triangle whose depth plane lies behind the largest depth of the blocks its box
+    meets is skipped before its coverage. ``covered[t]``: the fragments tile t generated (pixel
     centres covered by triangles not skipped)."""
+    members = bins.members
+    mxy = bins.mxy
+    mz = bins.mz
+    fx = lit.fx
+    fy = lit.fy
+    attr = lit.attr
+    clipd = lit.clipd
+    pos32 = lit.pos32
+    view32 = lit.view32
+    tri_s = lit.tri_s
+    tri_missing = lit.tri_missing
+    any_missing = lit.any_missing
+    kind = look.code
+    base = look.base
+    missing = look.missing
+    texels = look.texels
+    texf = look.texf
+    linear = look.linear
+    alpha_test = look.alpha_test
+    shift = screen.shift
+    tiles_x = screen.tiles_x
+    bits = screen.bits
+    depth = target.depth
+    color = target.color
+    triangle = target.triangle
     height, width = depth.shape
     n_attr = attr.shape[1]
     n_clip = clipd.shape[1]
@@ -442,25 +489,28 @@ def _lend(workspace, name, n, dtype, columns=0):
     return held[:n]
 
 
-def draw(tris, ids, lit, frame, color32, options, look, shading, threads, stats, clock,
+def draw(tris, ids, lit, frame, color32, options, look, threads, stats, clock,
          vectorized=True, workspace=None) -> None:
     """Draw ``tris`` (K, 3) into ``frame`` (``color32`` its colour as one uint32 per pixel)
-    from the transform and light step's ``lit`` (:class:`~.pipeline._Lit`) with the shading
-    ``look`` (:class:`~.pipeline._Look`) of ``shading`` and ``options``, on ``threads``
-    workers; counts go to ``stats``, seconds to ``clock`` (see the module). ``vectorized=False``
-    runs the kernels as plain Python; ``workspace`` lends the bin arrays from draw to draw."""
+    from the transform and light step's ``lit`` (:class:`~.state.Lit`) with the shading
+    ``look`` (:class:`~.state.Look`) and ``options``, on ``threads`` workers; counts go to
+    ``stats``, seconds to ``clock`` (see the module). ``vectorized=False`` runs the kernels as
+    plain Python; ``workspace`` lends the bin arrays from draw to draw."""
     with _plain(vectorized):
-        _draw(tris, ids, lit, frame, color32, options, look, shading, threads, stats, clock,
+        _draw(tris, ids, lit, frame, color32, options, look, threads, stats, clock,
               (lambda fn: fn) if vectorized else (lambda fn: fn.py_func), workspace)
 
 
-def _draw(tris, ids, lit, frame, color32, options, look, shading, threads, stats, clock, kernel,
+def _draw(tris, ids, lit, frame, color32, options, look, threads, stats, clock, kernel,
           workspace) -> None:
     width, height = frame.size
-    bits, tile = options.subpixel_bits, options.tile
+    bits = options.subpixel_bits
+    tile = options.tile
     shift = tile.bit_length() - 1
     tiles_x = -(-width // tile)
     n_tiles = tiles_x * (-(-height // tile))
+    screen = Screen(int(width), int(height), int(bits), int(shift), int(tiles_x))
+    target = Target(frame.depth, color32, frame.triangle)
     for k0 in range(0, len(tris), SESSION):
         k1 = min(k0 + SESSION, len(tris))
         tri_s = lit.tri_s[k0:k1] if len(lit.tri_s) == len(tris) else lit.tri_s
@@ -471,9 +521,7 @@ def _draw(tris, ids, lit, frame, color32, options, look, shading, threads, stats
         count = np.zeros((runs, n_tiles), np.int64)
         work = np.zeros((runs, n_tiles), np.int64)
         with numba.parallel_chunksize(1):
-            kept = int(kernel(classify)(tris[k0:k1], lit.fx, lit.fy, lit.fz, lit.ok, lit.clipd,
-                                        width, height, bits, shift, tiles_x, runs, code, count,
-                                        work))
+            kept = int(kernel(classify)(tris[k0:k1], lit, screen, runs, code, count, work))
         stats.kept += kept
         clock.lap("clip triangle")
         if kept == 0:
@@ -483,17 +531,14 @@ def _draw(tris, ids, lit, frame, color32, options, look, shading, threads, stats
         members = _lend(workspace, "fused_members", slots, np.int32)
         mxy = _lend(workspace, "fused_xy", slots, np.int32, 6)
         mz = _lend(workspace, "fused_z", slots, np.float32, 3)
+        bins = Bins(members, mxy, mz)
         with numba.parallel_chunksize(1):
-            kernel(place)(tris[k0:k1], lit.fx, lit.fy, lit.fz, bits, width, height, shift,
-                          tiles_x, code, fill, members, mxy, mz)
+            kernel(place)(tris[k0:k1], lit, screen, code, fill, bins)
         clock.lap("bin")
         covered = np.zeros(n_tiles, np.int64)
         with numba.parallel_chunksize(1):  # a thread takes the next tile when it is done
-            kernel(draw_tiles)(order, start, members, mxy, mz, tris[k0:k1], ids[k0:k1], lit.fx,
-                               lit.fy, lit.attr, lit.clipd, lit.pos32, lit.view32, tri_s,
-                               tri_missing, lit.any_missing, look.code, look.base,
-                               look.missing, look.texels, look.texf,
-                               shading.linear, shading.alpha_test, options.early_depth, shift,
-                               tiles_x, bits, frame.depth, color32, frame.triangle, covered)
+            kernel(draw_tiles)(order, start, bins, tris[k0:k1], ids[k0:k1],
+                               lit._replace(tri_s=tri_s, tri_missing=tri_missing), look,
+                               options.early_depth, screen, target, covered)
         stats.fragments += int(covered.sum())
         clock.lap("generate fragment")

@@ -1,11 +1,12 @@
 """The compiled steps of the software rasterizer, one kernel per step of es2008's Table 2.
 
-Every kernel is a numba function over flat arrays; :mod:`.pipeline` calls them in order and
-times each. The same source runs interpreted by Python (``kernel.py_func``) for the table's
-"vectorisation off" column. Per-element steps run in parallel (``prange`` over vertices,
-triangles or screen tiles); the two steps the paper leaves scalar — fragment generation and
-the depth-tested write — run tile by tile, each tile owned by one thread and visited in
-triangle order, so the image is the same for any number of threads.
+Every kernel is a numba function over flat arrays, those that travel together grouped in the
+NamedTuples of :mod:`.state`; :mod:`.pipeline` calls them in order and times each. The same
+source runs interpreted by Python (``kernel.py_func``) for the table's "vectorisation off"
+column. Per-element steps run in parallel (``prange`` over vertices, triangles or screen
+tiles); the two steps the paper leaves scalar — fragment generation and the depth-tested
+write — run tile by tile, each tile owned by one thread and visited in triangle order, so the
+image is the same for any number of threads.
 
 Arithmetic follows what a GL driver does where it decides pixels: vertex placement in float32
 (``mvp · (p − origin)`` as the vertex shader computes it, the perspective divide and the
@@ -354,15 +355,28 @@ def _edge_at(dx, dy, x, y, px, py, bias):
 
 
 @numba.njit(cache=True, parallel=True)
-def generate_fragments(start, members, frag_start, verts, box, fit, lo_table, hi_table, size,
-                       tile, tiles_x, bits, early, zplane, depth, frag_tri, frag_i, frag_j,
-                       frag_count):
-    """The fragments of each tile's triangles, in triangle order, into the tile's slots:
-    table-fit triangles from the span table (``lo_table``/``hi_table`` flattened,
+def generate_fragments(start, members, frags, setup, table, tile, tiles_x, bits, early, depth):
+    """The fragments of each tile's triangles (``members[start[t]:start[t + 1]]``, set up in
+    ``setup``, a :class:`~.state.Setup`), in triangle order, into the tile's slots of
+    ``frags`` (a :class:`~.state.Fragments`: reads ``start``, writes ``tri``, ``i``, ``j``,
+    ``count``): table-fit triangles from the span table ``table`` (a :class:`~.state.Span`,
     :mod:`.spantable`), the others by testing every pixel centre of their box against the
-    three edge functions (the binned half-space rasterizer). With ``early``, a fragment farther
-    than what ``depth`` already holds is not generated: the depth buffer only decreases, so
-    the write would reject it anyway (the image is the same)."""
+    three edge functions (the binned half-space rasterizer); tiles of ``tile`` pixels a side,
+    ``tiles_x`` a row, ``bits`` sub-pixel bits. With ``early``, a fragment farther than what
+    ``depth`` already holds is not generated: the depth buffer only decreases, so the write
+    would reject it anyway (the image is the same)."""
+    frag_start = frags.start
+    frag_count = frags.count
+    frag_tri = frags.tri
+    frag_i = frags.i
+    frag_j = frags.j
+    verts = setup.verts
+    box = setup.box
+    fit = setup.fit
+    zplane = setup.zplane
+    lo_table = table.lo
+    hi_table = table.hi
+    size = table.size
     span = 2 * size
     for t in prange(start.shape[0] - 1):
         ti0 = (t % tiles_x) * tile
@@ -418,10 +432,15 @@ def generate_fragments(start, members, frag_start, verts, box, fit, lo_table, hi
 
 # ----------------------------------------------------------------------------- fragment calculation
 @numba.njit(cache=True, parallel=True)
-def interpolate_z(frag_start, frag_count, frag_tri, frag_i, frag_j, zplane, planes, n_attr,
-                  frag_z):
-    """Window depth of every fragment (float32), and the fragment-wise clipping: depth outside
-    [0, 1] or a clip distance below 0 rejects it (depth set to +inf, which never passes)."""
+def interpolate_z(frags, zplane, planes, n_attr, frag_z):
+    """Window depth of every fragment of ``frags`` (a :class:`~.state.Fragments`; float32), and
+    the fragment-wise clipping: depth outside [0, 1] or a clip distance below 0 rejects it
+    (depth set to +inf, which never passes)."""
+    frag_start = frags.start
+    frag_count = frags.count
+    frag_tri = frags.tri
+    frag_i = frags.i
+    frag_j = frags.j
     n_planes = planes.shape[1] - n_attr
     for t in prange(frag_count.shape[0]):
         for f in range(frag_start[t], frag_start[t] + frag_count[t]):
@@ -436,15 +455,31 @@ def interpolate_z(frag_start, frag_count, frag_tri, frag_i, frag_j, zplane, plan
 
 
 @numba.njit(cache=True, parallel=True)
-def interpolate_color(kind, frag_start, frag_count, frag_tri, frag_i, frag_j, planes, kept,
-                      tri_light, tri_s, tri_missing, any_missing, base, missing, texels, texf,
-                      linear, alpha_test, frag_z, frag_rgba):
-    """Packed RGBA8 of every fragment not yet rejected, as the mesh path of ``kind`` shades it;
-    a fragment whose colour fails the alpha test (α < ½, with ``alpha_test``) is rejected. A
-    fragment of a triangle flagged in ``tri_missing`` (read where ``any_missing``) takes the
-    ``missing`` colour times its light, never alpha tested (the no-result rule).
-    The kinds whose colour is one per triangle (constant, flat, element colour) compute it
-    once per run of the triangle's fragments."""
+def interpolate_color(frags, planes, kept, lit, look, frag_z, frag_rgba):
+    """Packed RGBA8 of every fragment of ``frags`` (a :class:`~.state.Fragments`) not yet
+    rejected, as the mesh path of ``look.code`` shades it (``look`` a :class:`~.state.Look`,
+    the per-triangle light, texture coordinate and missing flags from ``lit``, a
+    :class:`~.state.Lit`); a fragment whose colour fails the alpha test (α < ½, with
+    ``alpha_test``) is rejected. A fragment of a triangle flagged in ``tri_missing`` (read
+    where ``any_missing``) takes the ``missing`` colour times its light, never alpha tested
+    (the no-result rule). The kinds whose colour is one per triangle (constant, flat, element
+    colour) compute it once per run of the triangle's fragments."""
+    frag_start = frags.start
+    frag_count = frags.count
+    frag_tri = frags.tri
+    frag_i = frags.i
+    frag_j = frags.j
+    tri_light = lit.tri_light
+    tri_s = lit.tri_s
+    tri_missing = lit.tri_missing
+    any_missing = lit.any_missing
+    kind = look.code
+    base = look.base
+    missing = look.missing
+    texels = look.texels
+    texf = look.texf
+    linear = look.linear
+    alpha_test = look.alpha_test
     per_triangle = kind == CONSTANT or kind == FLAT or kind == ELEMENT_COLOR
     for t in prange(frag_count.shape[0]):
         last = -1
@@ -505,12 +540,20 @@ def interpolate_color(kind, frag_start, frag_count, frag_tri, frag_i, frag_j, pl
 
 # ----------------------------------------------------------------------------- write fragment
 @numba.njit(cache=True, parallel=True)
-def write_fragments(frag_start, frag_count, frag_tri, frag_i, frag_j, frag_z, frag_rgba, kept,
-                    ids, depth, color, triangle):
-    """The depth-tested write, tile by tile: a fragment replaces the pixel when it is nearer,
+def write_fragments(frags, frag_z, frag_rgba, kept, ids, target):
+    """The depth-tested write of ``frags`` (a :class:`~.state.Fragments`) into ``target`` (a
+    :class:`~.state.Target`), tile by tile: a fragment replaces the pixel when it is nearer,
     or as near and of a lower triangle index (an empty pixel, index −1, keeps its clear
     depth). Drawn in index order this is GL's ``LESS`` test (the first of equal depths
     stays); in any order it gives the same image."""
+    frag_start = frags.start
+    frag_count = frags.count
+    frag_tri = frags.tri
+    frag_i = frags.i
+    frag_j = frags.j
+    depth = target.depth
+    color = target.color
+    triangle = target.triangle
     for t in prange(frag_count.shape[0]):
         for f in range(frag_start[t], frag_start[t] + frag_count[t]):
             z = frag_z[f]

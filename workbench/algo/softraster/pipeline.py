@@ -51,6 +51,7 @@ import numpy as np
 from . import fused, kernels
 from .frame import Frame
 from .rule import GL_SUBPIXEL_BITS, check_bits
+from .state import Camera, Fragments, Geometry, Lit, Look, Setup, Span, Target
 
 SHADINGS = ("constant", "flat", "gouraud", "vertex_color", "pixel_color", "element_color")
 GENERATORS = ("halfspace", "table")
@@ -252,6 +253,12 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
     dict kept by the caller, lends the per-vertex arrays from one draw to the next (no fresh
     pages for every frame of a large model). Degenerate, non-finite and wholly clipped
     triangles draw nothing.
+
+    Takes more than 12 arguments because it is the public draw call: the geometry, the
+    camera, the shading and the options are the positional ones, and every optional array
+    (``ids``, ``normals``, ``values``, ``triangle_values``, ``clip_planes``) and draw setting
+    is a keyword that a caller names or leaves out, as a GL draw's state; the kernels take them
+    grouped (:mod:`.state`).
     """
     pos, tris, ids = _checked(positions, triangles, ids, normals, values, triangle_values, shading)
     proj = check_orthographic(projection)
@@ -268,22 +275,23 @@ def render(positions, triangles, view, projection, size: tuple[int, int],
     stats = RenderStats(triangles=len(tris))
     table = _fragment_table(options)
     stats.table_bytes = table.nbytes
-    look = _Look.of(shading)
+    look = _look_of(shading)
     with _threads(options.threads if vectorized else 1) as threads, \
             (_interpreted() if not vectorized else _null(_compiled())) as k:
         stats.threads = threads
         clock = _Clock(stats.seconds)
         fuse = options.fused and options.generator == "halfspace"
-        lit = _transform_and_light(k, pos, tris, view, proj, (width, height), options.subpixel_bits,
-                                   shading, look, normals, values, triangle_values, planes,
-                                   workspace, flat_light=not fuse)
+        lit = _transform_and_light(
+            k, Geometry(pos, tris, normals, values, triangle_values, planes),
+            Camera(view, proj, (width, height), options.subpixel_bits), shading, look,
+            workspace, flat_light=not fuse)
         clock.lap("transform and light")
         if fuse:
-            fused.draw(tris, ids, lit, frame, color32, options, look, shading, threads, stats,
-                       clock, vectorized, workspace)
+            fused.draw(tris, ids, lit, frame, color32, options, look, threads, stats, clock,
+                       vectorized, workspace)
             return frame, stats
-        sessions = _Sessions(k, tris, ids, lit, frame, color32, options, table, shading, look,
-                             threads, stats, clock)
+        sessions = _Sessions(k, tris, ids, lit, frame, color32, options, table, look, threads,
+                             stats, clock)
         for k0 in range(0, len(tris), options.session):
             sessions.draw(k0, min(k0 + options.session, len(tris)))
     return frame, stats
@@ -328,60 +336,26 @@ def _fragment_table(options: RasterOptions) -> _Table:
     return _Table(False, none, none, options.table_size, 0)
 
 
-@dataclass(frozen=True)
-class _Look:
-    """The shading as the kernels take it: ``code`` (index in :data:`SHADINGS`), ``texels``
-    (n, 4) uint8 and ``texf`` the same in [0, 1] float32 (one zero texel without a texture),
-    ``base`` and ``missing`` colours float32."""
-
-    code: int
-    texels: np.ndarray
-    texf: np.ndarray
-    base: np.ndarray
-    missing: np.ndarray
-
-    @classmethod
-    def of(cls, shading: Shading) -> _Look:
-        texels = np.ascontiguousarray(shading.texels if shading.texels is not None
-                                      else np.zeros((1, 4)), np.uint8)
-        return cls(code=SHADINGS.index(shading.kind), texels=texels,
-                   texf=texels.astype(np.float32) / np.float32(255.0),
-                   base=np.asarray(shading.base_color, np.float32),
-                   missing=np.asarray(shading.missing_color, np.float32))
+def _look_of(shading: Shading) -> Look:
+    """The :class:`~.state.Look` of ``shading``: its kind's index in :data:`SHADINGS`, the
+    texture (one zero texel without one) as uint8 and float32 in [0, 1], the colours float32,
+    the filter and the alpha test as bools."""
+    texels = np.ascontiguousarray(shading.texels if shading.texels is not None
+                                  else np.zeros((1, 4)), np.uint8)
+    return Look(code=SHADINGS.index(shading.kind), texels=texels,
+                texf=texels.astype(np.float32) / np.float32(255.0),
+                base=np.asarray(shading.base_color, np.float32),
+                missing=np.asarray(shading.missing_color, np.float32),
+                linear=bool(shading.linear), alpha_test=bool(shading.alpha_test))
 
 
-@dataclass(frozen=True)
-class _Lit:
-    """The transform-and-light step's output. Per vertex: window positions ``fx``, ``fy``
-    (fixed point) and depth ``fz``, ``ok`` (placed), ``attr`` (V, n_attr) the shading
-    attributes, ``clipd`` (V, P) the clip distances. Per triangle where the shading uses them
-    (else one entry): ``tri_light`` the flat light (one entry where it is left to the fused
-    draw), ``tri_s`` the texture coordinate; ``tri_missing`` (K,) uint8, 1 for a triangle
-    drawn in the missing colour (one 0 entry where ``any_missing`` is False: none is).
-    ``pos32`` and ``view32``: the float32 vertices and view the flat light is computed from."""
-
-    fx: np.ndarray
-    fy: np.ndarray
-    fz: np.ndarray
-    ok: np.ndarray
-    attr: np.ndarray
-    n_attr: int
-    clipd: np.ndarray
-    tri_light: np.ndarray
-    tri_s: np.ndarray
-    tri_missing: np.ndarray
-    any_missing: bool
-    pos32: np.ndarray
-    view32: np.ndarray
-
-
-def _transform_and_light(k, pos, tris, view, proj, size, bits: int, shading: Shading,
-                         look: _Look, normals, values, triangle_values, planes,
-                         workspace, flat_light: bool = True) -> _Lit:
+def _transform_and_light(k, geometry: Geometry, camera: Camera, shading: Shading, look: Look,
+                         workspace, flat_light: bool = True) -> Lit:
     """The first step, all vertices once: float32 placement and snapping, per-vertex or flat
     lighting (unless not ``flat_light``) and colour look-up, the clip distances (see
-    :func:`render` for the arguments)."""
-    width, height = size
+    :func:`render` for what ``geometry`` and ``camera`` hold)."""
+    pos, tris, normals, values, triangle_values, planes = geometry
+    view, proj, (width, height), bits = camera
     kind, code = shading.kind, look.code
     rel32 = pos if pos.dtype == np.float32 else pos.astype(np.float32)
     mvp32 = (proj @ view).astype(np.float32)
@@ -417,7 +391,7 @@ def _transform_and_light(k, pos, tris, view, proj, size, bits: int, shading: Sha
         if normals32.dtype != np.float32:
             normals32 = normals32.astype(np.float32)
         k.light_vertices(code, np.ascontiguousarray(view[:3, :3], np.float32), normals32,
-                         s, look.texels, look.texf, shading.linear, attr)
+                         s, look.texels, look.texf, look.linear, attr)
     flat = flat_light and kind in ("flat", "element_color")
     tri_light = np.zeros(len(tris) if flat else 1, np.float32)
     view32 = view.astype(np.float32)
@@ -430,9 +404,9 @@ def _transform_and_light(k, pos, tris, view, proj, size, bits: int, shading: Sha
     if len(planes):
         p32, w32 = planes[:, :3].astype(np.float32), planes[:, 3].astype(np.float32)
         clipd = np.ascontiguousarray((rel32 @ p32.T) + w32, np.float32)
-    return _Lit(fx=fx, fy=fy, fz=fz, ok=ok, attr=attr, n_attr=n_attr, clipd=clipd,
-                tri_light=tri_light, tri_s=tri_s, tri_missing=tri_missing,
-                any_missing=any_missing, pos32=rel32, view32=view32)
+    return Lit(fx=fx, fy=fy, fz=fz, ok=ok, attr=attr, n_attr=n_attr, clipd=clipd,
+               tri_light=tri_light, tri_s=tri_s, tri_missing=tri_missing,
+               any_missing=any_missing, pos32=rel32, view32=view32)
 
 
 @dataclass
@@ -444,13 +418,12 @@ class _Sessions:
     k: SimpleNamespace
     tris: np.ndarray
     ids: np.ndarray
-    lit: _Lit
+    lit: Lit
     frame: Frame
     color32: np.ndarray
     options: RasterOptions
     table: _Table
-    shading: Shading
-    look: _Look
+    look: Look
     threads: int
     stats: RenderStats
     clock: _Clock
@@ -459,7 +432,7 @@ class _Sessions:
         """Draw triangles ``k0`` .. ``k1 - 1``."""
         k, tris, lit, frame, options, table = (self.k, self.tris, self.lit, self.frame,
                                                self.options, self.table)
-        stats, clock, look, shading = self.stats, self.clock, self.look, self.shading
+        stats, clock, look = self.stats, self.clock, self.look
         width, height = frame.size
         bits = options.subpixel_bits
         n_attr = lit.n_attr
@@ -496,25 +469,21 @@ class _Sessions:
         frag_tri = np.empty(slots, np.int32)
         frag_i, frag_j = np.empty(slots, np.int32), np.empty(slots, np.int32)
         frag_count = np.zeros(n_tiles, np.int64)
+        frags = Fragments(frag_start, frag_count, frag_tri, frag_i, frag_j)
         clock.lap("bin")
-        k.generate_fragments(start, members, frag_start, verts, box, fit, table.lo, table.hi,
-                             table.size, options.tile, tiles_x, bits, options.early_depth,
-                             zplane, frame.depth, frag_tri, frag_i, frag_j, frag_count)
+        k.generate_fragments(start, members, frags, Setup(verts, box, fit, zplane),
+                             Span(table.lo, table.hi, int(table.size)), options.tile, tiles_x,
+                             bits, options.early_depth, frame.depth)
         stats.fragments += int(frag_count.sum())
         clock.lap("generate fragment")
         frag_z = np.empty(slots, np.float32)
-        k.interpolate_z(frag_start, frag_count, frag_tri, frag_i, frag_j, zplane, planes_m,
-                        n_attr, frag_z)
+        k.interpolate_z(frags, zplane, planes_m, n_attr, frag_z)
         clock.lap("interpolate z")
         frag_rgba = np.empty(slots, np.uint32)
-        k.interpolate_color(look.code, frag_start, frag_count, frag_tri, frag_i, frag_j,
-                            planes_m, kept, lit.tri_light, lit.tri_s, lit.tri_missing,
-                            lit.any_missing, look.base, look.missing,
-                            look.texels, look.texf, shading.linear, shading.alpha_test, frag_z,
-                            frag_rgba)
+        k.interpolate_color(frags, planes_m, kept, lit, look, frag_z, frag_rgba)
         clock.lap("interpolate color")
-        k.write_fragments(frag_start, frag_count, frag_tri, frag_i, frag_j, frag_z, frag_rgba,
-                          kept, self.ids, frame.depth, self.color32, frame.triangle)
+        k.write_fragments(frags, frag_z, frag_rgba, kept, self.ids,
+                          Target(frame.depth, self.color32, frame.triangle))
         clock.lap("write fragment")
         stats.fragment_bytes = max(stats.fragment_bytes, slots * 20)
 

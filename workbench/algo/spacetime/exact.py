@@ -47,6 +47,12 @@ def exact_image(corners, element, coeffs, centre, extent, material, grid: PixelG
     ``t`` is the slice time in µs (corners in (x, y) mm), or None for the spacetime triangles
     of a 1-D bar (corners in (x, t), drawn without lighting). The solution is given as
     :func:`workbench.algo.spacetime.poly.evaluate` takes it; ``table`` is the colour ramp.
+
+    Takes more than 12 arguments because it mirrors its two halves' own signatures: the
+    polygons and the solution are passed on as :func:`~workbench.algo.spacetime.poly.evaluate`
+    takes them, the shading settings (``U_max``, ``table``, ``height_scale``, ``lighting``) as
+    :func:`~workbench.algo.spacetime.shading.shade` takes them, all keyword-only; it is plain
+    Python over numpy, no compiled kernel.
     """
     polygon = locate_pixels(corners, grid)
     covered = polygon >= 0

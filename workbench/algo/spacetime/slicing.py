@@ -28,6 +28,7 @@ import numba
 import numpy as np
 
 from .mesh import SpacetimeMesh
+from .state import CutCases, Points, Polygons
 
 __all__ = ["Slice", "slice_at", "TimeSlicer", "quadrisect", "polygon_areas"]
 
@@ -114,13 +115,29 @@ _TB, _TA, _NB, _OPP = _case_tables()
 # corner orders that turn a clockwise polygon counter-clockwise, and where its edges go
 _QUAD_FLIP, _QUAD_FLIP_EDGES = np.array([0, 3, 2, 1]), np.array([3, 2, 1, 0])
 _TRI_FLIP, _TRI_FLIP_EDGES = np.array([0, 2, 1, 1]), np.array([3, 1, 2, 0])
+_CASES = CutCases(_TB, _TA, _NB, _OPP, _QUAD_FLIP, _TRI_FLIP, _QUAD_FLIP_EDGES, _TRI_FLIP_EDGES)
 
 
 @numba.njit(cache=True)
-def _cut_kernel(simplices, x, y, tv, elements, t, tb_col, ta_col, n_below, opp_col, shared,
-                quad_flip, tri_flip, quad_flip_edges, tri_flip_edges, corners, is_quad, outer):
-    """One pass over the cut tetrahedra: corners, quad flag, outer edges (when ``shared`` has
-    rows), counter-clockwise order. The arithmetic is the module docstring's, term by term."""
+def _cut_kernel(simplices, points, elements, t, shared, cases, out):
+    """One pass over the cut tetrahedra ``elements`` of ``simplices`` (coordinates ``points``, a
+    :class:`~.state.Points`; case tables ``cases``, a :class:`~.state.CutCases`) into ``out``
+    (a :class:`~.state.Polygons`): corners, quad flag, outer edges (when ``shared`` has rows),
+    counter-clockwise order. The arithmetic is the module docstring's, term by term."""
+    x = points.x
+    y = points.y
+    tv = points.tv
+    tb_col = cases.tb
+    ta_col = cases.ta
+    n_below = cases.n_below
+    opp_col = cases.opp
+    quad_flip = cases.quad_flip
+    tri_flip = cases.tri_flip
+    quad_flip_edges = cases.quad_flip_edges
+    tri_flip_edges = cases.tri_flip_edges
+    corners = out.corners
+    is_quad = out.is_quad
+    outer = out.outer
     want_outer = shared.shape[0] > 0
     c = np.empty((4, 2))
     o = np.zeros(4, np.bool_)
@@ -165,10 +182,9 @@ def _cut(simplices: np.ndarray, x: np.ndarray, y: np.ndarray, tv: np.ndarray,
     corners = np.empty((P, 4, 2))
     is_quad = np.empty(P, dtype=bool)
     outer = np.empty((P, 4), dtype=bool) if shared is not None else np.empty((0, 4), dtype=bool)
-    _cut_kernel(simplices, x, y, tv, elements, float(t), _TB, _TA, _NB, _OPP,
-                shared if shared is not None else np.empty((0, 4), dtype=bool),
-                _QUAD_FLIP, _TRI_FLIP, _QUAD_FLIP_EDGES, _TRI_FLIP_EDGES,
-                corners, is_quad, outer)
+    _cut_kernel(simplices, Points(x, y, tv), elements, float(t),
+                shared if shared is not None else np.empty((0, 4), dtype=bool), _CASES,
+                Polygons(corners, is_quad, outer))
     return Slice(t=t, corners=corners, element=elements, is_quad=is_quad,
                  outer=outer if shared is not None else None)
 
@@ -246,7 +262,9 @@ def quadrisect(s: Slice, max_area: float) -> Slice:
     if not (np.isfinite(max_area) and max_area > 0):
         raise ValueError(f"max_area must be positive, got {max_area}")
     done_c, done_e, done_q, done_o = [], [], [], []
-    c, e, q = s.corners, s.element, s.is_quad
+    c = s.corners
+    e = s.element
+    q = s.is_quad
     o = s.outer if s.outer is not None else np.zeros((len(e), 4), bool)
     for _ in range(200):
         area = polygon_areas(Slice(s.t, c, e, q))
