@@ -70,10 +70,10 @@ from workbench.measurement.images import crack_pixels
 from workbench.measurement.interleave import draw_clock, interleaved_ratios
 from workbench.measurement.timing import time_call
 from workbench.output.figures import save_field_figure, save_image_grid
-from workbench.output.tables import atomic_open
 from workbench.paths.colormap import colormap_lut
 from workbench.paths.drawing import prepared
 from workbench.paths.spacetime import OVERDRAWS, SpacetimeStyle, spacetime_path, top_camera
+from workbench.reproductions._pixel_exact_figures import plot_sweep
 
 from ._declared.fig_pixel_exact import DECLARED
 
@@ -113,6 +113,13 @@ class Views:
     def __init__(self, exp: ExperimentContext, width: int) -> None:
         self.exp, self.width = exp, width
         self.table = colormap_lut(COLORMAP)
+        self._tops: dict[int, tuple[SpacetimeScene, float]] = {}
+
+    def top_height(self, scene: SpacetimeScene) -> float:
+        """:func:`top_height` of ``scene``, once per scene (kept, so that its id stays its own)."""
+        if self._tops.get(id(scene), (None,))[0] is not scene:
+            self._tops[id(scene)] = (scene, top_height(scene))
+        return self._tops[id(scene)][1]
 
     def grid(self, scene: SpacetimeScene) -> PixelGrid:
         return PixelGrid.fit(*scene.bounds(), self.width)
@@ -121,7 +128,7 @@ class Views:
         """(measurement, grid) of the top view, timed with ``time_it``; ``origin`` (3,) is the
         float64 upload origin (default the grid centre)."""
         grid = self.grid(scene)
-        camera = top_camera(grid, (-1.0, top_height(scene) + 1.0), origin=origin)
+        camera = top_camera(grid, (-1.0, self.top_height(scene) + 1.0), origin=origin)
         return self._measure(scene, style, camera, (grid.width, grid.height), BACKGROUND,
                              time_it), grid
 
@@ -129,7 +136,7 @@ class Views:
         """(H, W, 4) uint8 image of a perspective view from 35° above the plate, on
         CRACK_BACKGROUND."""
         lo, hi = scene.bounds()
-        top = top_height(scene)
+        top = self.top_height(scene)
         camera = Camera.fit_box(np.r_[lo, 0.0], np.r_[hi, top], azimuth=25, elevation=35,
                                 projection="perspective", up="z", margin=0.9,
                                 aspect=4 / 3, origin=np.r_[(lo + hi) / 2, 0.0])
@@ -361,32 +368,6 @@ def closed_form_error(sol: Solution, grid: PixelGrid, exact) -> float:
     return float(np.abs(exact.U[cov] - U).max())
 
 
-def plot_sweep(rows: list[dict], path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4), dpi=100)
-    for ax, sweep, label in zip(axes, ("quadrisection", "resolution"),
-                                ("quadrisection threshold", "mesh resolution")):
-        for shading, marker in (("per_vertex", "o"), ("per_pixel", "s")):
-            pts = [(row["wall_ms"], row["mean_diff_255"]) for row in rows
-                   if row["sweep"] == sweep and row["path"] == shading]
-            if pts:
-                x, y = zip(*pts)
-                ax.plot(x, y, marker=marker, label=shading.replace("_", " "))
-        ax.axhline(1.0, color="grey", lw=0.8, ls="--")
-        ax.set_xlabel("wall time per frame [ms]")
-        ax.set_ylabel("mean colour error [1/255]")
-        ax.set_yscale("log")
-        ax.set_title(f"run time against error: {label}")
-        ax.legend()
-    fig.tight_layout()
-    with atomic_open(path, "wb") as fh:
-        fig.savefig(fh, format="png")
-    plt.close(fig)
-
-
 # ------------------------------------------------------------------------------- stability
 def stability_rows(exp: ExperimentContext, views: Views) -> list[dict]:
     """Far from the origin, degenerate slices and zero fields, per pixel, against the exact
@@ -561,7 +542,7 @@ def interleaved_rows(exp: ExperimentContext, views: Views, keep: dict) -> list[d
     target = max(keep)
     _, scene, s = keep[target]
     grid = views.grid(scene)
-    camera = top_camera(grid, (-1.0, top_height(scene) + 1.0))
+    camera = top_camera(grid, (-1.0, views.top_height(scene) + 1.0))
     size = (grid.width, grid.height)
     with prepared(exp.gl, scene, spacetime_path(spacetime_style("per_pixel")), camera=camera,
                   size=size) as pixel, \
