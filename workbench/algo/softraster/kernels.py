@@ -71,7 +71,8 @@ def pack(r, g, b):
 
 @numba.njit(cache=True, inline="always")
 def headlight(nx, ny, nz):
-    """0.25 + 0.75·|n_z|/|n| (float32) for an eye-space normal; 0.25 for a zero normal."""
+    """``0.25 + 0.75·abs(n_z)/len(n)`` (float32) for an eye-space normal n; 0.25 for a zero
+    normal."""
     len2 = nx * nx + ny * ny + nz * nz
     if len2 > 0:
         return np.float32(0.25) + np.float32(0.75) * (abs(nz) / np.sqrt(len2))
