@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from workbench.experiment import EXPERIMENTS, experiment, run_experiment
-from workbench.experiment.warm import warm_all, warm_experiment
+from workbench.experiment.registry import warm_all
+from workbench.experiment.warm import warm_experiment
 
 
 def _kernel():

@@ -112,8 +112,7 @@ def cmd_reproduce(args) -> int:
 def cmd_warm(args) -> int:
     """Warm the named experiments (all by default) in ``--jobs`` processes; 0, or 2 with one
     line for an unknown name or a bad ``--jobs``."""
-    from ..experiment.registry import discover
-    from ..experiment.warm import warm_all
+    from ..experiment.registry import discover, warm_all
 
     found = discover()
     names = args.names or sorted(found)

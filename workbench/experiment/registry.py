@@ -20,8 +20,10 @@ import pkgutil
 import re
 import shutil
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
+from multiprocessing import get_context
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -225,3 +227,34 @@ def clean_dead_runs(root: Path, name: str) -> list[Path]:
             tmp.unlink(missing_ok=True)
             done.append(tmp)
     return done
+
+
+def _warm_by_name(name: str) -> tuple[str, float]:
+    """Worker side of :func:`warm_all`: discover the experiments, warm ``name``."""
+    return name, warm_experiment(discover()[name])
+
+
+def warm_all(names: Sequence[str], jobs: int = 2,
+             progress: Callable[[str], None] | None = None) -> dict[str, float]:
+    """Warm every experiment of ``names`` (see
+    :func:`~workbench.experiment.warm.warm_experiment`) in ``jobs`` spawned
+    processes at once; returns the wall seconds of each, by name. Refuses ``jobs`` < 1
+    (ValueError). The first failure propagates after the running warm-ups end."""
+    if int(jobs) != jobs or jobs < 1:
+        raise ValueError(f"jobs must be a whole number >= 1, got {jobs!r}")
+    seconds: dict[str, float] = {}
+    if jobs == 1:
+        found = discover()
+        for name in names:
+            seconds[name] = warm_experiment(found[name])
+            if progress:
+                progress(f"{name}: {seconds[name]:.1f} s")
+        return seconds
+    with ProcessPoolExecutor(max_workers=int(jobs), mp_context=get_context("spawn")) as pool:
+        futures = [pool.submit(_warm_by_name, name) for name in names]
+        for future in as_completed(futures):
+            name, took = future.result()
+            seconds[name] = took
+            if progress:
+                progress(f"{name}: {took:.1f} s")
+    return seconds

@@ -15,19 +15,18 @@ larger case produces still compile inside the real run. They are few; the timed 
 meet them warm themselves up (``warmup`` calls of :mod:`workbench.measurement.timing`), and the
 single-shot stage times of a pipeline are the ones to read with that in mind.
 
-:func:`warm_all` runs every registered experiment's tiny size in ``jobs`` processes at once
-(spawned, each with its own GL context): ``install.sh`` calls it (``workbench warm``) so that
-the numba cache is filled once, at install, and the first ``reproduce`` on a fresh clone
-compiles nothing. Warm-up runs never write into the figures folder or the results store.
+:func:`~workbench.experiment.registry.warm_all` runs every registered experiment's tiny size in
+``jobs`` processes at once (spawned, each with its own GL context): ``install.sh`` calls it
+(``workbench warm``) so that the numba cache is filled once, at install, and the first
+``reproduce`` on a fresh clone compiles nothing. Warm-up runs never write into the figures
+folder or the results store.
 """
 
 from __future__ import annotations
 
 import tempfile
 import time
-from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from multiprocessing import get_context
+from collections.abc import Callable
 
 from .context import ExperimentContext
 
@@ -46,37 +45,3 @@ def warm_experiment(experiment, progress: Callable[[str], None] | None = None) -
         finally:
             context.close()
     return time.perf_counter() - start
-
-
-def _warm_by_name(name: str) -> tuple[str, float]:
-    """Worker side of :func:`warm_all`: discover the experiments, warm ``name``."""
-    from .registry import discover
-
-    return name, warm_experiment(discover()[name])
-
-
-def warm_all(names: Sequence[str], jobs: int = 2,
-             progress: Callable[[str], None] | None = None) -> dict[str, float]:
-    """Warm every experiment of ``names`` (see :func:`warm_experiment`) in ``jobs`` spawned
-    processes at once; returns the wall seconds of each, by name. Refuses ``jobs`` < 1
-    (ValueError). The first failure propagates after the running warm-ups end."""
-    if int(jobs) != jobs or jobs < 1:
-        raise ValueError(f"jobs must be a whole number >= 1, got {jobs!r}")
-    seconds: dict[str, float] = {}
-    if jobs == 1:
-        from .registry import discover
-
-        found = discover()
-        for name in names:
-            seconds[name] = warm_experiment(found[name])
-            if progress:
-                progress(f"{name}: {seconds[name]:.1f} s")
-        return seconds
-    with ProcessPoolExecutor(max_workers=int(jobs), mp_context=get_context("spawn")) as pool:
-        futures = [pool.submit(_warm_by_name, name) for name in names]
-        for future in as_completed(futures):
-            name, took = future.result()
-            seconds[name] = took
-            if progress:
-                progress(f"{name}: {took:.1f} s")
-    return seconds

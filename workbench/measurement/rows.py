@@ -98,6 +98,10 @@ def measure(backend: moderngl.Context | Backend, scene: Scene, path: str | Rende
     ``wall_samples_ms``; None untimed, ``gpu_ms`` None on a software renderer), and
     ``covered_px`` (pixels that differ from the background). Times in ms, on the renderer
     named.
+
+    Takes more than 12 arguments because it is the one public measurement call: the drawing
+    arguments of :func:`~workbench.paths.drawing.render` plus the timing options, all but the
+    first seven keyword-only; grouping them into an options object would only move the names.
     """
     if timed and (int(repeats) != repeats or repeats < MIN_REPEATS):
         raise ValueError(f"repeats must be an integer >= {MIN_REPEATS}, got {repeats}")
