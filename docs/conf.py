@@ -87,14 +87,13 @@ nitpick_ignore_regex = [
 ]
 
 
-def _resolve_reexport(app, env, node, contnode):
-    """A ``py`` reference to ``workbench.pkg.Name`` where ``pkg`` re-exports ``Name`` from one
-    of its modules: resolved to the documented ``workbench.pkg.module.Name``; None otherwise."""
+def _documented_name(target: str, domain) -> str | None:
+    """The documented name of the object ``target`` (``workbench.pkg.Name``) imports as: the
+    module that defines it and its qualified name (``workbench.pkg.module.Name``); for data,
+    which knows no module, the one documented name below ``workbench`` that holds the very same
+    object. None where ``target`` does not import, or names nothing documented."""
     import importlib
 
-    target = node.get("reftarget", "")
-    if node.get("refdomain") != "py" or not target.startswith("workbench."):
-        return None
     module_name, _, attr = target.rpartition(".")
     obj, rest = None, []
     while module_name:
@@ -104,6 +103,8 @@ def _resolve_reexport(app, env, node, contnode):
         except ImportError:
             module_name, _, head = module_name.rpartition(".")
             rest.insert(0, head)
+        except Exception:  # a module that fails to import is autodoc's warning, not ours
+            return None
     if obj is None:
         return None
     try:
@@ -111,19 +112,15 @@ def _resolve_reexport(app, env, node, contnode):
             obj = getattr(obj, name)
     except AttributeError:
         return None
-    domain = env.get_domain("py")
     defined = getattr(obj, "__module__", None)
     qualname = getattr(obj, "__qualname__", None)
     if isinstance(obj, type(importlib)):
         defined, qualname = obj.__name__, None
-    elif not (defined and qualname):
-        # data (a tuple, a dict) knows no module: the documented name below this package
-        # that holds the very same object
-        prefix = "workbench."
+    elif not (isinstance(defined, str) and isinstance(qualname, str)):
         same = []
         for name in domain.objects:
             holder, _, last = name.rpartition(".")
-            if last == attr and name.startswith(prefix) and name != target:
+            if last == attr and name.startswith("workbench."):
                 try:
                     if getattr(importlib.import_module(holder), last) is obj:
                         same.append(name)
@@ -132,13 +129,38 @@ def _resolve_reexport(app, env, node, contnode):
         if len(same) != 1:
             return None
         defined, qualname = same[0].rpartition(".")[0], attr
-    if not defined or not defined.startswith("workbench."):
+    if not isinstance(defined, str) or not defined.startswith("workbench."):
         return None
-    canonical = f"{defined}.{qualname}" if qualname else defined
-    if canonical == target:
+    return f"{defined}.{qualname}" if qualname else defined
+
+
+def _resolve_reexport(app, env, node, contnode):
+    """A ``py`` reference that Sphinx did not find, resolved the way Python would: a fully
+    qualified ``workbench.pkg.Name`` that ``pkg`` re-exports from one of its modules, or a short
+    name written in a docstring or signature of module ``m`` (``:func:`section_planes``` in a
+    package's notes, ``Camera`` imported under ``TYPE_CHECKING``) that ``m`` defines or
+    imports; resolved to the documented name. None where neither applies."""
+    target = node.get("reftarget", "")
+    if node.get("refdomain") != "py" or not target or target.startswith("."):
         return None
-    return domain.resolve_xref(env, node["refdoc"], app.builder, node["reftype"], canonical,
-                               node, contnode)
+    module, cls = node.get("py:module"), node.get("py:class")
+    if target.startswith("workbench."):
+        candidates = [target]
+    elif module and module.startswith("workbench."):
+        candidates = [f"{module}.{cls}.{target}" if cls else None, f"{module}.{target}",
+                      _bound_name(module, target)]
+    else:
+        return None
+    domain = env.get_domain("py")
+    for candidate in filter(None, candidates):
+        canonical = _documented_name(candidate, domain)
+        if canonical is None or canonical == target:
+            continue
+        found = domain.resolve_xref(env, node["refdoc"], app.builder, node["reftype"],
+                                    canonical, node, contnode)
+        if found is not None:
+            return found
+    return None
 
 
 def _bound_name(modname: str, name: str) -> str | None:
