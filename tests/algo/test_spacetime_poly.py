@@ -32,6 +32,7 @@ from workbench.algo.spacetime.poly import (
     height_normal,
     local_frames,
     monomials,
+    speed,
 )
 
 PROPERTY = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -293,6 +294,24 @@ def test_evaluate_derivatives_match_finite_differences_of_the_fit():
         tangent = np.column_stack([np.full(len(x), dx), np.full(len(x), dy), scale * gs_fd[:, j]])
         cos = np.einsum("ki,ki->k", n, tangent) / np.linalg.norm(tangent, axis=1)
         assert np.abs(cos).max() < 1e-6
+
+
+def test_speed_alone_is_evaluates_speed_and_the_velocitys_norm():
+    """speed() is evaluate()'s "speed" to the last bit, and that is |v| of the finite
+    difference of the displacement in time (independent of the contraction it shares)."""
+    pts, simp = kuhn_grid(3, (6.0, 6.0, 1.0), (-3.0, -3.0, 0.0))
+    coeffs = fit_cubic(pts, simp, RadialPulse(centre=(-12.0, 0.0)).displacement)
+    centre, extent = local_frames(pts, simp)
+    el, x, y, t = inside_points(pts, simp, 200, np.random.default_rng(5))
+    full = evaluate(coeffs, centre, extent, el, x, y, t)
+    alone = speed(coeffs, centre, extent, el, x, y, t)
+    assert np.array_equal(alone, full["speed"])
+    h = 1e-4
+    u = [evaluate(coeffs, centre, extent, el, x, y, t + s * h)["displacement"] for s in (1, -1)]
+    v_fd = np.linalg.norm((u[0] - u[1]) / (2 * h), axis=1)
+    assert np.abs(alone - v_fd).max() <= 1e-6 * v_fd.max()
+    with pytest.raises(ValueError):
+        speed(coeffs, centre, extent, [len(coeffs)], 0.0, 0.0, 0.0)
 
 
 # --------------------------------------------------------------------------- convergence

@@ -49,7 +49,11 @@ import numpy as np
 from workbench.algo.spacetime.exact import colour_error, edge_distance, exact_image
 from workbench.algo.spacetime.fields import BAR, STEEL, RadialPulse
 from workbench.algo.spacetime.mesh import front_refined, rect_triangulation
-from workbench.algo.spacetime.poly import evaluate, evaluate_float32_global, evaluate_float32_local
+from workbench.algo.spacetime.poly import (
+    evaluate_float32_global,
+    evaluate_float32_local,
+    speed,
+)
 from workbench.algo.spacetime.raster import PixelGrid
 from workbench.algo.spacetime.scene import (
     DOMAIN,
@@ -101,9 +105,9 @@ def top_height(scene: SpacetimeScene) -> float:
     if scene.is_bar:
         return 1.0
     c = scene.corners.reshape(-1, 2)
-    speed = evaluate(scene.coeffs, scene.centre, scene.extent, np.repeat(scene.element, 4),
-                     c[:, 0], c[:, 1], scene.t)["speed"]
-    return float(HEIGHT_SCALE * speed.max()) + 1e-3
+    fastest = speed(scene.coeffs, scene.centre, scene.extent, np.repeat(scene.element, 4),
+                    c[:, 0], c[:, 1], scene.t).max()
+    return float(HEIGHT_SCALE * fastest) + 1e-3
 
 
 class Views:
