@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from meshes import quad_grid
 
-from workbench.algo.fepatch.atlas import build_atlas, plane_frames
+from workbench.algo.fepatch.atlas import build_atlas, plane_frames, quantile_of
 
 
 def plates(n_plates, seed):
@@ -85,3 +85,13 @@ def test_texels_per_element_of_a_uniform_grid():
     assert atlas.texels_per_element == pytest.approx(6.25)
     with pytest.raises(ValueError, match="labels"):
         build_atlas(coords, elements, np.zeros(99, int))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.floats(min_value=1e-300, max_value=1e300), min_size=1, max_size=40),
+       st.sampled_from([0.0, 0.02, 0.1, 0.3, 0.5, 0.75, 1.0]) | st.floats(0.0, 1.0))
+def test_quantile_of_is_numpys_quantile_to_the_last_bit(values, q):
+    """The atlas's quantile is numpy's (an independent implementation), bit for bit, on any
+    positive finite values: duplicates, 600 decades of magnitude, one value."""
+    v = np.array(values)
+    assert quantile_of(v, q) == float(np.quantile(v, q))
