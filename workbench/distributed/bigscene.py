@@ -9,10 +9,10 @@ domain, so the writer never holds more than one sheet. The sheets share no node,
 sheet's vertices, normals and values equal those of the whole scene; global triangle indices
 run sheet by sheet, as in the whole scene's triangle list.
 
-:func:`run_chunked_sortlast` renders a chunked scene on a cluster (:class:`ChunkDomains`) and,
-for the reference, in this process domain by domain (:func:`~workbench.distributed.chunked.
-render_chunked`), and reports the times, the bytes the compositing moved, each worker's peak
-memory and whether the images are equal.
+:func:`run_chunked_sortlast` renders a chunked scene on a cluster (:class:`ChunkDomains`) and, for
+the reference, in this process domain by domain
+(:func:`~workbench.distributed.chunked.render_chunked`), and reports the times, the bytes the
+compositing moved, each worker's peak memory and whether the images are equal.
 """
 
 from __future__ import annotations

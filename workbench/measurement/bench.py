@@ -222,8 +222,8 @@ class Bench:
              warmup: int = 1, repeat: int | None = None, **columns: Any) -> Timing:
         """Time ``run()`` (wall ms): ``warmup`` untimed calls, then ``repeat`` (default the
         bench's) timed ones, each after an untimed ``setup()`` where given; one row named
-        ``function`` with ``columns``. Returns the :class:`~workbench.measurement.timing.
-        Timing` (its ``result`` is the last call's value)."""
+        ``function`` with ``columns``. Returns the
+        :class:`~workbench.measurement.timing.Timing` (its ``result`` is the last call's value)."""
         repeat = self.repeat if repeat is None else repeat
         if setup is None:
             return self._add(function, time_call(run, warmup=warmup, repeat=repeat), columns)
@@ -261,14 +261,14 @@ class Bench:
                    repeat: int | None = None, reported: bool = False,
                    columns_of: Mapping[str, Mapping[str, Any]] | None = None,
                    **columns: Any) -> dict[str, Timing]:
-        """Time ``clocks`` (name → callable, or a :class:`~workbench.measurement.interleave.
-        Clock` with an untimed setup) interleaved, one call of each per round, ``warmup``
-        untimed rounds then ``repeat`` timed ones. With ``reported`` each call returns its own
-        seconds, which are the samples. One row per clock (``columns`` and its
-        ``columns_of[name]`` added); each (numerator, denominator) of ``ratios`` puts the
-        median per-round ratio with its 95 % interval on the numerator's row
-        (``over_<denominator>``, ``_lo``, ``_hi``, ``_pairs``). Refuses ratios naming unknown
-        clocks and fewer than two clocks."""
+        """Time ``clocks`` (name → callable, or a
+        :class:`~workbench.measurement.interleave.Clock` with an untimed setup) interleaved, one
+        call of each per round, ``warmup`` untimed rounds then ``repeat`` timed ones. With
+        ``reported`` each call returns its own seconds, which are the samples. One row per clock
+        (``columns`` and its ``columns_of[name]`` added); each (numerator, denominator) of
+        ``ratios`` puts the median per-round ratio with its 95 % interval on the numerator's row
+        (``over_<denominator>``, ``_lo``, ``_hi``, ``_pairs``). Refuses ratios naming unknown clocks
+        and fewer than two clocks."""
         if len(clocks) < 2:
             raise ValueError(f"interleave needs two or more clocks, got {list(clocks)}")
         repeat = self.repeat if repeat is None else repeat

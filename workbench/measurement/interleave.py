@@ -39,8 +39,8 @@ class Clock:
 def draw_clock(ready: Prepared,
                background: tuple[float, float, float, float] = WHITE) -> Clock:
     """The clock of a prepared path: setup binds its target, clears it to ``background`` and
-    waits; run draws and waits for the backend (as :func:`~workbench.measurement.timing.
-    time_draw` times a draw)."""
+    waits; run draws and waits for the backend (as
+    :func:`~workbench.measurement.timing.time_draw` times a draw)."""
     def setup() -> None:
         ready.bind()
         ready.target.clear(background)

@@ -363,7 +363,7 @@ def resolution_rows(exp: ExperimentContext, views: Views) -> list[dict]:
 
 
 def closed_form_error(sol: Solution, grid: PixelGrid, exact) -> float:
-    """Max |U_fitted − U_closed form| (kJ/m³) over the covered pixel centres: how far the
+    """Max ``|U_fitted − U_closed form|`` (kJ/m³) over the covered pixel centres: how far the
     stored solution itself is from the field it approximates."""
     xs, ys = grid.centres()
     X, Y = np.meshgrid(xs, ys)
@@ -446,7 +446,7 @@ def degenerate_rows(exp, views: Views, near: Solution, t_lo: float, t_hi: float)
 
 
 def zero_field_rows(exp, views: Views, n: int) -> list[dict]:
-    """Zero strain and zero velocity: before the pulse reaches the far corner, U and |v|
+    """Zero strain and zero velocity: before the pulse reaches the far corner, U and ``|v|``
     vanish."""
     early = plate_solution(n, 0.0, 1.0, bands=1)
     s = slice_at(early.mesh, 0.5)
