@@ -23,7 +23,7 @@ def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
         "bench", help="run benchmarks and store their rows in the results store",
         description="Run the benchmark modules (all, or those named): each case timed with the "
-                    "project's timing (warm-up untimed, repetitions, median with its 95 %% "
+                    "project's timing (warm-up untimed, repetitions, median with its 95 % "
                     "interval; comparisons interleaved), its rows appended to the results "
                     "store with the run's provenance. Compare two runs with `workbench "
                     "results compare`.")
