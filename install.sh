@@ -19,6 +19,6 @@ python=${PYTHON:-python3}
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -e '.[test,notebook,docs]'
 # compile the numba kernels once, now, into their disk cache (every experiment's tiny run, two at
-# a time), so that the first run compiles nothing; WORKBENCH_NO_WARM=1 skips it
+# a time), so that the first run compiles little; WORKBENCH_NO_WARM=1 skips it
 [ -n "${WORKBENCH_NO_WARM:-}" ] || .venv/bin/workbench warm --jobs 2
 echo "workbench installed in .venv ($(.venv/bin/workbench --version))"

@@ -18,8 +18,8 @@ single-shot stage times of a pipeline are the ones to read with that in mind.
 :func:`~workbench.experiment.registry.warm_all` runs every registered experiment's tiny size in
 ``jobs`` processes at once (spawned, each with its own GL context): ``install.sh`` calls it
 (``workbench warm``) so that the numba cache is filled once, at install, and the first
-``reproduce`` on a fresh clone compiles nothing. Warm-up runs never write into the figures
-folder or the results store.
+``reproduce`` on a fresh clone compiles only what the tiny runs do not reach. Warm-up runs
+never write into the figures folder or the results store.
 """
 
 from __future__ import annotations
