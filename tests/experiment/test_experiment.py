@@ -325,6 +325,16 @@ def test_time_call_is_wall_only_and_keeps_result():
         time_call(lambda: None, repeat=3)
 
 
+
+def test_time_call_runs_its_setup_untimed_before_every_call():
+    import time
+
+    calls = []
+    t = time_call(lambda: calls.append("run"), warmup=1, repeat=5,
+                  setup=lambda: (calls.append("setup"), time.sleep(0.02)))
+    assert calls == ["setup", "run"] * 6
+    assert t.wall_ms_max < 20.0  # the 20 ms sleep of every setup is outside the clock
+
 # ---------------------------------------------------------------- registry
 
 

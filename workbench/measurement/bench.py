@@ -225,18 +225,8 @@ class Bench:
         ``function`` with ``columns``. Returns the
         :class:`~workbench.measurement.timing.Timing` (its ``result`` is the last call's value)."""
         repeat = self.repeat if repeat is None else repeat
-        if setup is None:
-            return self._add(function, time_call(run, warmup=warmup, repeat=repeat), columns)
-        check_counts(warmup, repeat)
-        wall, result = [], None
-        for i in range(warmup + repeat):
-            setup()
-            start = time.perf_counter()
-            result = run()
-            elapsed = (time.perf_counter() - start) * 1e3
-            if i >= warmup:
-                wall.append(elapsed)
-        return self._add(function, Timing.from_samples(wall, result=result), columns)
+        return self._add(function, time_call(run, warmup=warmup, repeat=repeat, setup=setup),
+                         columns)
 
     def time_reported(self, function: str, run: Callable[[], Any], warmup: int = 1,
                       repeat: int | None = None, **columns: Any) -> dict[str, Timing]:

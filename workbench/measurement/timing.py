@@ -194,12 +194,13 @@ def time_readback(fb: Framebuffer | SoftwareTarget, repeat: int) -> list[float]:
 
 
 def time_call(fn: Callable[[], Any], warmup: int = 1, repeat: int = 5,
-              stop: StoppingRule | None = None) -> Timing:
+              stop: StoppingRule | None = None,
+              setup: Callable[[], Any] | None = None) -> Timing:
     """Wall time (ms) of the CPU work ``fn()``; GPU and read-back times are None.
 
     The value returned by the last call is kept in ``Timing.result``. With ``stop`` the calls
-    go on after ``repeat`` as in :func:`time_draw`. Refuses ``repeat`` < 5 and a negative
-    ``warmup``.
+    go on after ``repeat`` as in :func:`time_draw`. ``setup``, where given, is called untimed
+    before every call (warm-up calls too). Refuses ``repeat`` < 5 and a negative ``warmup``.
     """
     check_counts(warmup, repeat)
     wall: list[float] = []
@@ -207,6 +208,8 @@ def time_call(fn: Callable[[], Any], warmup: int = 1, repeat: int = 5,
     i = 0
     while i < warmup + repeat or (stop is not None and not stop.done(wall)):
         i += 1
+        if setup is not None:
+            setup()
         start = time.perf_counter()
         result = fn()
         elapsed = (time.perf_counter() - start) * 1e3
