@@ -13,7 +13,7 @@ from workbench.experiment.declare import (
     Table,
     interval_columns,
 )
-from workbench.experiment.report import ClaimRow, declared_claims
+from workbench.experiment.report import ClaimRow, declared_claims, declared_headlines
 from workbench.output.tables import read_table
 
 MAIN = Table("table", Column("scene", "", "the scene"), Column("wall_ms", "ms", "wall time"),
@@ -85,6 +85,8 @@ def test_declarations_refuse_what_contradicts_them():
         declared([Claim("q", {"table": ("scene", "gpu_ms")}, lambda tables: [])])
     with pytest.raises(DeclarationError, match="table 'nothing' is not declared"):
         declared([Claim("q", {"nothing": ("scene",)}, lambda tables: [])])
+    with pytest.raises(DeclarationError, match="reads column 'gpu_ms'"):  # a headline too
+        Declaration("p", (MAIN,), headline=Claim("h", {"table": ("gpu_ms",)}, lambda t: []))
 
 
 def test_interval_columns_are_the_four_of_an_interleaved_ratio():
@@ -158,3 +160,5 @@ def test_every_reproduction_declares_its_paper_and_claims():
         for claim in found:
             for table, columns in claim.reads.items():
                 assert set(columns) <= {c for c in columns if declaration.table(table).column(c)}
+    # each declares one headline for the README's table, reading declared columns only
+    assert set(declared_headlines()) == set(claims)

@@ -11,8 +11,17 @@ import pytest
 
 from workbench.cli import main
 from workbench.experiment.context import ExperimentContext
+from workbench.experiment.declare import HEADLINE_CHARS, Claim
 from workbench.experiment.registry import EXPERIMENTS, experiment, run_experiment
-from workbench.experiment.report import BEGIN, END, write_report
+from workbench.experiment.report import (
+    BEGIN,
+    BENCH_BEGIN,
+    BENCH_END,
+    END,
+    headline_of,
+    latest_sources,
+    write_report,
+)
 from workbench.measurement.rows import Together, measure_together
 from workbench.measurement.stats import StoppingRule
 from workbench.paths import make_path
@@ -208,15 +217,53 @@ def test_the_report_is_written_from_the_store(tmp_path):
     write_report(store, readme, tmp_path / "docs" / "results.md")
     text = readme.read_text()
     assert "typed by hand" not in text and text.endswith(f"{END}\n\ntail\n")
-    assert "1.25× [1.20, 1.30] the position-only draw" in text
+    # the README's row is the declared headline, one short sentence, and names the run
+    row = next(line for line in text.splitlines() if "`render_paths`" in line)
+    assert ("8 triangles at 64x64: per-pixel bands 2.00 ms, 1.25× [1.20, 1.30] the "
+            "position-only draw, 0.500× [0.400, 0.600] pyrender's (4× MSAA)") in row
+    assert "| quick, " in row and recorder.machine["cpu"] in text
     assert "not in the results store yet" in text  # the other experiments
     doc = (tmp_path / "docs" / "results.md").read_text()
     assert recorder.run_id in doc and "### targets" in doc and recorder.machine["cpu"] in doc
+    assert "pyrender's time (SSIM 0.990 against it)" in doc  # every claim, not the headline
+    # a headline of more than one sentence, or a long one, is refused, naming the experiment
+    source = latest_sources(store)["render_paths"]
+    for said in (["a", "b"], ["x" * (HEADLINE_CHARS + 1)]):
+        with pytest.raises(ValueError, match="headline of render_paths must be one sentence"):
+            headline_of(store, source, Claim("q", {}, lambda tables, said=said: said))
     # the stored table's legend comes from the experiment's declaration
     assert "- `contour_wall_ms` (ms): wall time of the per-pixel band draw" in doc
     with pytest.raises(ValueError, match="no .* section"):
         readme.write_text("# no markers\n")
         write_report(store, readme, tmp_path / "docs" / "results.md")
+
+
+@pytest.mark.gl
+def test_the_benchmarks_section_is_written_from_the_store(tmp_path):
+    store = ResultsStore(tmp_path / "store")
+    readme, history = tmp_path / "README.md", tmp_path / "history.md"
+    readme.write_text(f"{BEGIN}\n{END}\n")
+    history.write_text(f"# h\n\n{BENCH_BEGIN}\ntyped\n{BENCH_END}\n\n## typed record\n")
+    recorder = start_run(store.root, "run probe --quick", size="quick")
+    recorder.append([{"scene": "s"}], experiment="table_quad_strips", table="table",
+                    experiment_size="quick")
+    for size, ms in (("quick", 2.0), ("full", 5.0), ("quick", 3.0)):  # full wins over later
+        bench = start_run(store.root, "bench probe", size=size)
+        bench.append([{"case": "nap", "function": "ours", "wall_ms": ms, "wall_ms_lo": ms - 1,
+                       "wall_ms_hi": ms + 1, "over_theirs": 0.5, "over_theirs_lo": 0.4,
+                       "over_theirs_hi": 0.6, "over_theirs_pairs": 7},
+                      {"case": "nap", "function": "count", "naps": 1}],
+                     experiment="bench:probe", table="nap", experiment_size=size)
+        if size == "full":
+            full = bench.run_id
+    write_report(store, readme, tmp_path / "results.md", history=history)
+    text = history.read_text()
+    assert "typed" not in text.split("## typed record")[0] and "## typed record" in text
+    assert f"**probe**, run {full} (" in text and "full size" in text
+    assert "- nap: ours: 5.00 ms [4.00, 6.00]; ÷ theirs 0.500× [0.400, 0.600]" in text
+    history.write_text("# no markers\n")
+    with pytest.raises(ValueError, match="no '<!-- benchmarks:begin -->'"):
+        write_report(store, readme, tmp_path / "results.md", history=history)
 
 
 # ---------------------------------------------------------------- the command line

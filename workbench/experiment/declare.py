@@ -12,7 +12,8 @@ it reproduces, its :class:`Table` s and its :class:`Claim` s. Everything else re
 * ``table.md`` and every further table's Markdown get a legend under the table (each column's
   unit and meaning, :meth:`Table.legend`);
 * :mod:`workbench.experiment.report` states each experiment's claims from its stored rows,
-  each claim reading only the declared columns it names;
+  each claim reading only the declared columns it names, and its one headline (a claim of a
+  single short sentence) in the README;
 * the shape tests compare the tables written with the declared columns.
 
 A column name may hold one placeholder in braces (``"{scene} es2008 pipeline ms"``) standing
@@ -31,6 +32,8 @@ from typing import Any
 from ..output.tables import STORE_ONLY_SUFFIX
 
 Tables = Callable[[str], list[Mapping[str, Any]]]
+HEADLINE_CHARS = 160
+"""The longest headline the README's table takes (characters of its one sentence)."""
 _PLACEHOLDER = re.compile(r"\{([A-Za-z_][A-Za-z0-9_]*)\}")
 
 
@@ -198,12 +201,15 @@ class Claim:
 @dataclass(frozen=True)
 class Declaration:
     """What an experiment declares: the ``paper`` it reproduces (as the report names it, say
-    "es2008 Tables 2–3"), its ``tables`` and its ``claims``. Refuses two tables of one name and
-    a claim reading a table or column not declared."""
+    "es2008 Tables 2–3"), its ``tables``, its ``claims`` (``docs/results.md`` states them all)
+    and its ``headline``: the one claim the README's table states, a single sentence of at
+    most :data:`HEADLINE_CHARS` characters. Refuses two tables of one name and a claim or
+    headline reading a table or column not declared."""
 
     paper: str
     tables: tuple[Table, ...]
     claims: tuple[Claim, ...] = field(default=())
+    headline: Claim | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "tables", tuple(self.tables))
@@ -211,7 +217,7 @@ class Declaration:
         names = [t.name for t in self.tables]
         if len(set(names)) != len(names):
             raise DeclarationError(f"tables declared twice: {names}")
-        for claim in self.claims:
+        for claim in (*self.claims, *([self.headline] if self.headline else [])):
             for table, columns in claim.reads.items():
                 spec = self.table(table)
                 for column in columns:

@@ -9,8 +9,10 @@ given with its 95 % interval (``1.13× [1.07, 1.22]``); a ratio of two separate 
 says so. The README lists the experiments with claims ordered by paper.
 
 :func:`write_report` rewrites the part of the README between ``<!-- results:begin -->`` and
-``<!-- results:end -->`` and the whole of ``docs/results.md`` (every stored table with its
-declared legend), each atomically.
+``<!-- results:end -->`` (one headline per experiment), the whole of ``docs/results.md`` (every
+claim, every stored table with its declared legend) and the benchmarks section of
+``docs/history.md`` (between ``<!-- benchmarks:begin -->`` and ``<!-- benchmarks:end -->``: each
+benchmark's latest stored run), each atomically.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ if TYPE_CHECKING:
     from .declare import Claim, Declaration
 
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
+BENCH_BEGIN, BENCH_END = "<!-- benchmarks:begin -->", "<!-- benchmarks:end -->"
 
 
 @dataclass(frozen=True)
@@ -61,12 +64,15 @@ class Source:
         return f"{self.size} size, commit {commit}, {self.started[:10]}{load}"
 
 
-def latest_sources(store: ResultsStore) -> dict[str, Source]:
-    """Per experiment, its latest stored run at full size, else at quick size (tiny runs,
-    sweeps and benchmarks are not reported)."""
+def latest_sources(store: ResultsStore, benchmarks: bool = False) -> dict[str, Source]:
+    """Per experiment, its latest stored run at full size, else at quick size (tiny runs and
+    sweeps are not reported); with ``benchmarks`` the same per benchmark (``bench:<name>``)
+    instead of per experiment."""
     if not {"experiment", "experiment_size"} <= set(
             store.query("SELECT * FROM rows LIMIT 0").column_names):
         return {}  # nothing an experiment wrote
+    which = ("r.experiment LIKE 'bench:%'" if benchmarks
+             else "r.experiment NOT LIKE 'bench:%'")
     found = store.query(
         "SELECT r.experiment, r.experiment_size, r.run_id, any_value(u.started) AS started, "
         "any_value(u.\"commit\") AS \"commit\", any_value(u.dirty) AS dirty, "
@@ -75,8 +81,7 @@ def latest_sources(store: ResultsStore) -> dict[str, Source]:
         "any_value(u.load_1m) AS load_1m "
         "FROM rows r JOIN runs u USING (run_id) LEFT JOIN machines m USING (machine_id) "
         "WHERE r.experiment_size IN ('full', 'quick') AND r.experiment NOT LIKE 'sweep:%' "
-        "AND r.experiment NOT LIKE 'bench:%' "
-        "GROUP BY ALL").to_pylist()
+        f"AND {which} GROUP BY ALL").to_pylist()
     best: dict[str, Source] = {}
     for row in found:
         source = Source(row["experiment"], row["run_id"], row["experiment_size"],
@@ -167,54 +172,132 @@ class ClaimRow(dict):
 def declared_claims() -> dict[str, tuple[str, tuple[Claim, ...]]]:
     """Experiment → (paper, claims) of every registered experiment whose declaration holds
     claims, ordered by paper."""
+    found = {name: (declared.paper, declared.claims)
+             for name, declared in _declarations().items() if declared.claims}
+    return dict(sorted(found.items(), key=lambda item: (item[1][0], item[0])))
+
+
+def declared_headlines() -> dict[str, tuple[str, Claim]]:
+    """Experiment → (paper, headline) of every registered experiment that declares a
+    headline, ordered by paper."""
+    found = {name: (declared.paper, declared.headline)
+             for name, declared in _declarations().items() if declared.headline is not None}
+    return dict(sorted(found.items(), key=lambda item: (item[1][0], item[0])))
+
+
+def _declarations() -> dict[str, Declaration]:
     from .registry import EXPERIMENTS, discover
 
     discover()
-    found = {name: (exp.declared.paper, exp.declared.claims) for name, exp in EXPERIMENTS.items()
-             if exp.declared is not None and exp.declared.claims}
-    return dict(sorted(found.items(), key=lambda item: (item[1][0], item[0])))
+    return {name: exp.declared for name, exp in EXPERIMENTS.items() if exp.declared is not None}
+
+
+def stated(store: ResultsStore, source: Source, claim: Claim) -> list[str]:
+    """The sentences of ``claim`` from ``source``'s stored tables, each table's rows holding
+    only the columns the claim declares; a claim the run's tables cannot give is named as
+    missing."""
+    def tables(table: str) -> list[ClaimRow]:
+        reads = claim.reads.get(table)
+        if reads is None:
+            raise KeyError(f"claim {claim.quantity!r} reads table {table!r} without declaring it")
+        return [ClaimRow(r, reads, claim.quantity) for r in stored_table(store, source, table)]
+    try:
+        return claim.state(tables)
+    except (KeyError, TypeError) as exc:
+        return [f"(not in this run's tables: {exc})"]
 
 
 def claims_of(store: ResultsStore, source: Source) -> list[str]:
     """The claims of ``source``'s experiment, from its declaration (none for an experiment
-    that declares none), each reading the declared columns of its stored tables; a claim
-    that the run's stored tables cannot give is named as missing."""
+    that declares none), each reading the declared columns of its stored tables."""
     entry = declared_claims().get(source.experiment)
-    if entry is None:
-        return []
-    out = []
-    for claim in entry[1]:
-        def tables(table: str, claim: Claim = claim) -> list[ClaimRow]:
-            reads = claim.reads.get(table)
-            if reads is None:
-                raise KeyError(f"claim {claim.quantity!r} reads table {table!r} without "
-                               f"declaring it")
-            return [ClaimRow(r, reads, claim.quantity)
-                    for r in stored_table(store, source, table)]
-        try:
-            out += claim.state(tables)
-        except (KeyError, TypeError) as exc:
-            out.append(f"(not in this run's tables: {exc})")
-    return out
+    return [] if entry is None else [s for claim in entry[1] for s in stated(store, source, claim)]
 
 
 # ---------------------------------------------------------------- the two documents
+def headline_of(store: ResultsStore, source: Source, claim: Claim) -> str:
+    """The one sentence of the headline ``claim`` from ``source``'s run (a note saying so where
+    its tables hold no rows for it); ValueError naming the experiment where the claim states
+    more than one sentence or one longer than
+    :data:`~workbench.experiment.declare.HEADLINE_CHARS` characters."""
+    from .declare import HEADLINE_CHARS
+
+    sentences = stated(store, source, claim)
+    if not sentences:
+        return "(no rows for the headline in this run's tables)"
+    if len(sentences) != 1 or len(sentences[0]) > HEADLINE_CHARS:
+        raise ValueError(f"the headline of {source.experiment} must be one sentence of at most "
+                         f"{HEADLINE_CHARS} characters; it states {sentences!r}")
+    return sentences[0]
+
+
+def ran_on(source: Source) -> str:
+    """The short ``full, llvmpipe, 2 cores, a5f26a0`` of a run (the README's last column)."""
+    gl = (source.renderer or "no renderer").split(" (")[0]
+    commit = (source.commit or "no commit")[:7] + (" (dirty)" if source.dirty else "")
+    return f"{source.size}, {gl}, {source.cores} cores, {commit}"
+
+
 def readme_section(store: ResultsStore) -> str:
-    """The README's table of measured claims, one row per experiment."""
+    """The README's table of headline results, one short row per experiment that declares a
+    headline (its other claims are in ``docs/results.md``), and the machines they ran on."""
     sources = latest_sources(store)
-    rows = []
-    for experiment, (paper, _) in declared_claims().items():
+    rows, machines = [], {}
+    for experiment, (paper, claim) in declared_headlines().items():
         source = sources.get(experiment)
         if source is None:
             rows.append({"paper": paper, "experiment": f"`{experiment}`",
-                         "measured": "not in the results store yet", "where": ""})
+                         "headline": "not in the results store yet", "ran on": ""})
             continue
         rows.append({"paper": paper, "experiment": f"`{experiment}`",
-                     "measured": "; ".join(claims_of(store, source)) or "(no claim rows)",
-                     "where": f"{source.where}; {source.which}"})
+                     "headline": headline_of(store, source, claim), "ran on": ran_on(source)})
+        machines.setdefault(source.where, []).append(experiment)
     note = ("Written by `workbench results report` from the latest stored run of each "
-            "experiment; ratios marked interleaved come with their 95 % interval.")
-    return f"{BEGIN}\n{note}\n\n{markdown_table(rows)}{END}"
+            "experiment (full size where there is one); a ratio measured interleaved carries "
+            "its 95 % interval. Every claim and table: [docs/results.md](docs/results.md).")
+    where = "".join(f"\n- {place}: " + ("every experiment above" if len(names) == len(sources)
+                                         else ", ".join(f"`{e}`" for e in names))
+                    for place, names in machines.items())
+    where = f"\nMachines (renderer; CPU):{where}\n" if where else ""
+    return f"{BEGIN}\n{note}\n\n{markdown_table(rows)}{where}{END}"
+
+
+def benchmark_lines(rows: list[dict[str, Any]]) -> list[str]:
+    """One line per timed row of a benchmark's stored case: ``function: 12.3 ms [12.1, 12.6]``
+    with the row's interleaved ratios (``÷ fcpw 0.52× [0.50, 0.55]``)."""
+    out = []
+    for r in rows:
+        if r.get("wall_ms") is None:
+            continue
+        ratios = [f"; ÷ {key[5:]} {interval(r, key)}" for key in r
+                  if key.startswith("over_") and not key.endswith(("_lo", "_hi", "_pairs"))
+                  and r[key] is not None]
+        out.append(f"{r.get('function')}: {num(r['wall_ms'])} ms [{num(r.get('wall_ms_lo'))}, "
+                   f"{num(r.get('wall_ms_hi'))}]{''.join(ratios)}")
+    return out
+
+
+def benchmark_section(store: ResultsStore) -> str:
+    """The benchmarks' section of ``docs/history.md`` (between :data:`BENCH_BEGIN` and
+    :data:`BENCH_END`): per benchmark its latest stored run (full size where there is one),
+    where it ran, and per case each timed function's median with its 95 % interval and its
+    interleaved ratios."""
+    parts = [BENCH_BEGIN, "Written by `workbench results report` from the latest stored run of "
+             "each benchmark (`workbench bench`; full size where there is one): each timed "
+             "function's median wall time with its 95 % interval, and its interleaved ratios "
+             "with theirs. The rows, with every column: `workbench results query \"SELECT * "
+             "FROM rows WHERE experiment = 'bench:NAME'\"`.", ""]
+    sources = latest_sources(store, benchmarks=True)
+    if not sources:
+        parts += ["No benchmark run is stored yet.", ""]
+    for experiment, source in sources.items():
+        parts += [f"**{experiment[len('bench:'):]}**, run {source.run_id} ({source.where}; "
+                  f"{source.which}):", ""]
+        for case in stored_table_names(store, source):
+            lines = benchmark_lines(stored_table(store, source, case))
+            parts += [f"- {case}: " + ("; ".join(lines) if lines else "no timed rows")]
+        parts.append("")
+    return "\n".join(parts + [BENCH_END])
 
 
 def results_document(store: ResultsStore) -> str:
@@ -256,28 +339,39 @@ def stored_legend(declared: Declaration | None, table: str,
     return declared.table(table).legend(table_columns(rows))
 
 
-def replace_section(text: str, section: str, name: str = "README") -> str:
-    """``text`` with the part from :data:`BEGIN` to :data:`END` replaced by ``section``;
-    ValueError naming ``name`` where the markers are missing or out of order."""
-    start, end = text.find(BEGIN), text.find(END)
+def replace_section(text: str, section: str, name: str = "README",
+                    markers: tuple[str, str] = (BEGIN, END)) -> str:
+    """``text`` with the part from the first of ``markers`` to the second replaced by
+    ``section``; ValueError naming ``name`` where the markers are missing or out of order."""
+    begin, end_marker = markers
+    start, end = text.find(begin), text.find(end_marker)
     if start < 0 or end < start:
-        raise ValueError(f"{name} has no '{BEGIN}' … '{END}' section to write the results into")
-    return text[:start] + section + text[end + len(END):]
+        raise ValueError(f"{name} has no '{begin}' … '{end_marker}' section to write the "
+                         f"results into")
+    return text[:start] + section + text[end + len(end_marker):]
 
 
 def write_report(store: ResultsStore, readme: str | os.PathLike[str],
-                 doc: str | os.PathLike[str]) -> list[Path]:
-    """Rewrite the results section of ``readme`` and the whole of ``doc`` from ``store``;
-    returns both paths. Refuses an empty store and a README without the markers, before
-    writing either."""
+                 doc: str | os.PathLike[str],
+                 history: str | os.PathLike[str] | None = None) -> list[Path]:
+    """Rewrite the results section of ``readme``, the whole of ``doc`` and, where ``history``
+    is given, its benchmarks section (:func:`benchmark_section`) from ``store``; returns the
+    paths written. Refuses an empty store and a README or history without its markers, before
+    writing any."""
     if not latest_sources(store):
         raise ValueError(f"the results store {store.root} holds no experiment run "
                          f"(run `workbench reproduce` or `workbench run NAME` first)")
     readme, doc = Path(readme), Path(doc)
-    text = replace_section(readme.read_text(encoding="utf-8"), readme_section(store),
-                           str(readme))
+    texts = {readme: replace_section(readme.read_text(encoding="utf-8"),
+                                     readme_section(store), str(readme))}
+    if history is not None:
+        history = Path(history)
+        texts[history] = replace_section(history.read_text(encoding="utf-8"),
+                                         benchmark_section(store), str(history),
+                                         (BENCH_BEGIN, BENCH_END))
     document = results_document(store)
-    atomic_write_text(readme, text)
+    for path, text in texts.items():
+        atomic_write_text(path, text)
     doc.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(doc, document)
-    return [readme, doc]
+    return [readme, doc, *([history] if history is not None else [])]

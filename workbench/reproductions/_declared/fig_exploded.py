@@ -90,6 +90,21 @@ def reveal_claims(tables) -> list[str]:
     return out
 
 
+def reveal_headline(tables) -> list[str]:
+    """The car (else the first scene): views revealing the part and the occlusion count's
+    cost."""
+    rows = tables("table")
+    if not rows:
+        return []
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    scene = "car" if "car" in scenes else scenes[0]
+    mine = [r for r in rows if r["scene"] == scene]
+    frames = [int(r["frames_to_reveal"]) for r in mine if str(r["frames_to_reveal"]).isdigit()]
+    return [f"{scene}: part {mine[0]['focus_part']} revealed in {len(frames)} of {len(mine)} "
+            f"views, within {max(frames) if frames else 'n/a'} frames; counting occlusion costs "
+            f"{span([r['occlusion_over_draw'] for r in mine])}× the draw"]
+
+
 DECLARED = Declaration(
     paper="ghost2013",
     tables=(TABLE, COMPARE, CAR_PARTS),
@@ -97,4 +112,8 @@ DECLARED = Declaration(
                   {"table": ("scene", "focus_part", "frames_to_reveal", "sweep_deg",
                              "occlusion_over_draw", "separate_over_draw")},
                   reveal_claims),),
+    headline=Claim("views revealing the focus part and the occlusion count's cost",
+                   {"table": ("scene", "focus_part", "frames_to_reveal",
+                              "occlusion_over_draw")},
+                   reveal_headline),
 )
