@@ -84,13 +84,19 @@ def add_parser(subparsers) -> None:
     add_results_option(f)
     f.set_defaults(func=cmd_pareto)
 
-    r = sub.add_parser("report", help="regenerate the README's claims and docs/results.md",
+    r = sub.add_parser("report", help="regenerate the README's claims, docs/results.md and "
+                                      "the benchmarks of docs/history.md",
                        description="Write the measured claims of the README (between its "
-                                   "results markers) and docs/results.md from the latest "
-                                   "stored run of each experiment, each ratio with its "
-                                   "interval and the machine it ran on.")
+                                   "results markers: one headline per experiment), "
+                                   "docs/results.md (every claim and stored table) and the "
+                                   "benchmarks section of docs/history.md from the latest "
+                                   "stored run of each experiment and benchmark, each ratio "
+                                   "with its interval and the machine it ran on.")
     r.add_argument("--readme", default="README.md", metavar="FILE")
     r.add_argument("--doc", default="docs/results.md", metavar="FILE")
+    r.add_argument("--history", metavar="FILE",
+                   help="the page whose benchmarks section is rewritten (default "
+                        "docs/history.md where it exists; 'none' to leave it)")
     add_results_option(r)
     r.set_defaults(func=cmd_report)
 
@@ -172,12 +178,17 @@ def cmd_pareto(args) -> int:
 
 
 def cmd_report(args) -> int:
-    """``workbench results report``: rewrite the README's claims and docs/results.md; 0."""
+    """``workbench results report``: rewrite the README's claims, docs/results.md and the
+    benchmarks section of docs/history.md; 0."""
     from ..experiment.report import write_report
     from ..output.targets import output_target
 
     # refused before the README is read: reading a FIFO would block
-    written = write_report(store_of(args), *map(output_target, (args.readme, args.doc)))
+    readme, doc = map(output_target, (args.readme, args.doc))
+    history = args.history or ("docs/history.md" if Path("docs/history.md").is_file()
+                               else "none")
+    written = write_report(store_of(args), readme, doc,
+                           history=None if history == "none" else output_target(history))
     for path in written:
         print(f"wrote {path}", file=sys.stderr)
     return 0
