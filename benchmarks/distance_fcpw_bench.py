@@ -10,14 +10,18 @@ car deck refined k x k (:func:`workbench.scene.generators.refine`; full 8, quick
 * ``fcpw`` -- :mod:`workbench.references.distances` tool "fcpw": one vectorized fcpw scene
   per excluded part set, ``find_closest_points`` with the cut-off as search radius, float32,
   all cores. Its own query clock: the ``find_closest_points`` calls only.
+* ``hierarchy`` (only with ``--set hierarchy=true``) --
+  :func:`~workbench.algo.nearest.parts.part_distances`, the crash2000 AABB hierarchy with one
+  element per leaf (the experiment's Table 2 row), exact float64. Its own query clock.
 
 Checks before timing: our distances equal the crash2000 hierarchy's
 (:func:`~workbench.algo.nearest.parts.part_distances`) to the last bit (the benchmark stops
 otherwise); fcpw's are compared with ours (``fcpw_off``: nodes off by more than 1e-6 mm,
 ``fcpw_max_error_mm``). Timed interleaved with the reported query seconds, ``ours`` carrying
-``over_fcpw`` (below 1: ours faster).
+``over_fcpw`` (below 1: ours faster), and with the hierarchy ``over_hierarchy``.
 
-Run: ``workbench bench distance_fcpw_bench [--quick]`` (needs the car deck and fcpw).
+Run: ``workbench bench distance_fcpw_bench [--quick] [--set hierarchy=true]`` (needs the car
+deck and fcpw).
 """
 
 from __future__ import annotations
@@ -34,7 +38,7 @@ CUTOFF = 1.5
                                   "refined car deck",
            cases=[Case("car", {"refine": 8}, {"refine": 2})],
            requires=[needs_shared_file(CAR_DECK), needs_module("fcpw")])
-def distance_fcpw(bench, refine: int) -> None:
+def distance_fcpw(bench, refine: int, hierarchy: bool = False) -> None:
     from workbench import data
     from workbench.algo.nearest.parts import batched_part_distances, part_distances
     from workbench.references.distances import compare_with_exact, reference_part_distances
@@ -53,11 +57,16 @@ def distance_fcpw(bench, refine: int) -> None:
         raise ValueError(f"ours differs from the hierarchy at {len(bad)} nodes, first "
                          f"{bad[:5].tolist()}")
     c = compare_with_exact(ours.distance, fcpw)
+    clocks = {"ours": lambda: batched_part_distances(mesh, CUTOFF).query_s,
+              "fcpw": lambda: reference_part_distances("fcpw", mesh, CUTOFF).seconds_query}
+    ratios = [("ours", "fcpw")]
+    if hierarchy:
+        clocks["hierarchy"] = lambda: part_distances(mesh, CUTOFF).query_s
+        ratios.append(("ours", "hierarchy"))
     bench.interleave(
-        {"ours": lambda: batched_part_distances(mesh, CUTOFF).query_s,
-         "fcpw": lambda: reference_part_distances("fcpw", mesh, CUTOFF).seconds_query},
-        [("ours", "fcpw")], reported=True,
+        clocks, ratios, reported=True,
         columns_of={"ours": {"precision": "float64, exact"},
+                    "hierarchy": {"precision": "float64, exact"},
                     "fcpw": {"precision": "float32", "fcpw_off": c["off"],
                              "fcpw_max_error_mm": c["max_abs_error"],
                              "cutoff_disagreements": c["cutoff_disagreements"]}},

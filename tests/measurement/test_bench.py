@@ -116,6 +116,27 @@ def test_bad_names_and_options_exit_2_with_one_line(capsys, folder, tmp_path):
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
 
 
+def test_set_overrides_a_parameter_of_every_case_and_refuses_one_not_taken(capsys, folder,
+                                                                         tmp_path):
+    store_root = tmp_path / "store"
+    run = bench_run(capsys, folder, store_root, "--set", "ms=45")
+    store = ResultsStore(store_root)
+    (row,) = store.query("SELECT * FROM rows WHERE function = 'sleep'").to_pylist()
+    assert row["requested_ms"] == 45 and row["wall_ms"] >= 45.0  # the set value was slept
+    (record,) = store.query(f"SELECT * FROM runs WHERE run_id = '{run}'").to_pylist()
+    assert record["command"] == "bench probe --set ms=45 --quick"
+    for bad, says in ((["probe", "--set", "nosuch=1"], "takes no parameter 'nosuch' (it "
+                                                       "takes: ms)"),
+                      (["--set", "ms=1"], "--set needs the benchmarks it applies to named")):
+        assert main(["bench", *bad, "--dir", str(folder), "--store", str(tmp_path / "s")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and says in err[0], err
+    assert not (tmp_path / "s").exists()
+    with pytest.raises(SystemExit) as exc:
+        main(["bench", "probe", "--dir", str(folder), "--set", "no equals sign"])
+    assert exc.value.code == 2
+
+
 def test_unmet_requirements_skip_with_the_reason(folder):
     discover(folder)
     result = run_benchmark("absent", "quick")

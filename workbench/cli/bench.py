@@ -10,8 +10,10 @@ machine, commit and libraries) with ``experiment = "bench:<name>"``, ``table = <
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 from .arguments import at_least, refused
 
@@ -37,6 +39,11 @@ def add_parser(subparsers) -> None:
                         "figures/results)")
     p.add_argument("--out", default="figures/bench", metavar="DIR",
                    help="folder of the bench.csv/bench.md table (default figures/bench)")
+    p.add_argument("--set", action="append", default=[], dest="overrides",
+                   type=parameter_setting, metavar="KEY=VALUE",
+                   help="set a parameter of every case of the benchmarks named (repeatable; "
+                        "VALUE read as an integer, a number, true/false, else text), e.g. "
+                        "`distance_fcpw_bench --set hierarchy=true`; the rows carry it")
     p.add_argument("--dir", metavar="DIR",
                    help="benchmark modules folder (default: $WORKBENCH_BENCHMARKS, else the "
                         "checkout's benchmarks/)")
@@ -45,7 +52,7 @@ def add_parser(subparsers) -> None:
 
 def cmd_bench(args) -> int:
     """``workbench bench``: list, or run and record; 0, or 2 for an unknown name."""
-    from ..measurement.bench import discover, get_benchmark, run_benchmark
+    from ..measurement.bench import check_overrides, discover, get_benchmark, run_benchmark
     from ..output.tables import table_columns, write_table
     from ..output.targets import output_folder
     from .results import store_of
@@ -58,20 +65,25 @@ def cmd_bench(args) -> int:
             print(f"{name}: {b.description} (cases: {cases})")
         return 0
     names = list(dict.fromkeys(args.names)) or sorted(registry)
+    overrides = dict(args.overrides)
+    if overrides and not args.names:
+        return refused(ValueError("--set needs the benchmarks it applies to named"))
     try:
         for name in names:
             get_benchmark(name)
-    except KeyError as exc:
+            check_overrides(name, overrides)
+    except (KeyError, ValueError) as exc:
         return refused(exc)
     out = output_folder(Path(args.out), create=True)
     size = "quick" if args.quick else "full"
     from ..results.recording import start_run
 
-    recorder = start_run(store_of(args).root, "bench " + " ".join(names) + " --quick" * args.quick,
-                         size=size)
+    settings = "".join(f" --set {key}={value}" for key, value in overrides.items())
+    recorder = start_run(store_of(args).root, "bench " + " ".join(names) + settings
+                         + " --quick" * args.quick, size=size)
     table = []
     for name in names:
-        result = run_benchmark(name, size, args.repeat, progress=_say)
+        result = run_benchmark(name, size, args.repeat, progress=_say, overrides=overrides)
         by_case: dict[str, list[dict]] = {}
         for row in result.rows:
             by_case.setdefault(row["case"], []).append(row)
@@ -87,6 +99,26 @@ def cmd_bench(args) -> int:
     print(f"stored {recorder.appended} rows of {len(names)} benchmarks under run "
           f"{recorder.run_id} in {recorder.store.root}; table {out / 'bench.md'}")
     return 0
+
+
+def parameter_setting(text: str) -> tuple[str, Any]:
+    """``KEY=VALUE`` → ``(KEY, value)``, the value an int, a float, a bool (``true``/``false``)
+    or else the text; an argparse type (refused in one line without ``=`` or a key)."""
+    key, equals, value = text.partition("=")
+    if not equals or not key.isidentifier():
+        raise argparse.ArgumentTypeError(f"expected KEY=VALUE with KEY a parameter name, "
+                                         f"got {text!r}")
+    if value.lower() in ("true", "false"):
+        return key, value.lower() == "true"
+    for kind in (int, float):
+        try:
+            return key, kind(value)
+        except ValueError:
+            pass
+    return key, value
+
+
+parameter_setting.__name__ = "KEY=VALUE"
 
 
 def _say(line: str) -> None:

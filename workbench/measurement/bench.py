@@ -24,13 +24,16 @@ columns and the timing columns of :data:`~workbench.measurement.timing.TIMING_CO
 experiment's row. A benchmark needing what the machine lacks declares it (``requires``: the
 helpers :func:`needs_module`, :func:`needs_shared_file`, :func:`needs_gl`,
 :func:`needs_gpu`, :func:`needs_memory_gib`) and is skipped with the reason; a case can skip
-itself (:meth:`Bench.require`, :func:`skip`). Recording the rows is the caller's part
-(``workbench bench``, :mod:`workbench.cli.bench`).
+itself (:meth:`Bench.require`, :func:`skip`). A run may set any parameter the function takes
+for every case (``overrides``, ``workbench bench NAME --set KEY=VALUE``: a benchmark's options,
+such as ``distance_fcpw_bench``'s ``hierarchy``); the rows carry the values. Recording the
+rows is the caller's part (``workbench bench``, :mod:`workbench.cli.bench`).
 """
 
 from __future__ import annotations
 
 import importlib.util
+import inspect
 import os
 import re
 import sys
@@ -186,10 +189,11 @@ class Bench:
     ``rows``. ``progress`` receives one line per timed function."""
 
     def __init__(self, case: Case, size: str, repeat: int,
-                 progress: Progress | None = None) -> None:
+                 progress: Progress | None = None,
+                 overrides: Mapping[str, Any] | None = None) -> None:
         check_counts(0, repeat)
         self.case, self.size, self.repeat = case, size, int(repeat)
-        self.parameters = case.parameters(size)
+        self.parameters = {**case.parameters(size), **(overrides or {})}
         self.rows: list[dict[str, Any]] = []
         self._progress = progress
 
@@ -307,15 +311,36 @@ class BenchResult:
     skipped: dict[str, str]
 
 
+def parameter_names(name: str) -> list[str]:
+    """The keyword parameters the benchmark ``name``'s function takes (besides ``bench``):
+    what its cases set and ``overrides`` may set."""
+    signature = inspect.signature(get_benchmark(name).function)
+    return [p.name for p in list(signature.parameters.values())[1:]
+            if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+
+
+def check_overrides(name: str, overrides: Mapping[str, Any]) -> None:
+    """Refuse (ValueError naming the benchmark and the parameters it takes) an override of a
+    parameter the benchmark ``name``'s function does not take."""
+    known = parameter_names(name)
+    unknown = [key for key in overrides if key not in known]
+    if unknown:
+        raise ValueError(f"benchmark {name!r} takes no parameter {unknown[0]!r} (it takes: "
+                         f"{', '.join(known) or 'none'})")
+
+
 def run_benchmark(name: str, size: str = "full", repeat: int | None = None,
-                  progress: Progress | None = None) -> BenchResult:
+                  progress: Progress | None = None,
+                  overrides: Mapping[str, Any] | None = None) -> BenchResult:
     """Run every case of the registered benchmark ``name`` at ``size`` ("full" or "quick")
-    with ``repeat`` timed repetitions (default 7 full, 5 quick; at least 5). A benchmark whose
-    requirements are unmet runs nothing and is reported skipped (``skipped["*"]``); a case
-    that raises :class:`Skipped` is skipped with its reason. ``progress`` receives a line per
-    case and per timed function. Unknown names raise KeyError; a bad size or count
-    ValueError."""
+    with ``repeat`` timed repetitions (default 7 full, 5 quick; at least 5), each case's
+    parameters updated by ``overrides`` (parameter → value; the rows carry them). A benchmark
+    whose requirements are unmet runs nothing and is reported skipped (``skipped["*"]``); a
+    case that raises :class:`Skipped` is skipped with its reason. ``progress`` receives a line
+    per case and per timed function. Unknown names raise KeyError; a bad size or count, or an
+    override of a parameter the benchmark does not take, ValueError."""
     bench = get_benchmark(name)
+    check_overrides(name, overrides or {})
     if size not in SIZES:
         raise ValueError(f"benchmark size must be one of {SIZES}, got {size!r}")
     repeat = DEFAULT_REPEAT[size] if repeat is None else repeat
@@ -329,7 +354,7 @@ def run_benchmark(name: str, size: str = "full", repeat: int | None = None,
     skipped: dict[str, str] = {}
     for case in bench.cases:
         start = time.perf_counter()
-        run = Bench(case, size, repeat, progress)
+        run = Bench(case, size, repeat, progress, overrides)
         try:
             bench.function(run, **run.parameters)
         except Skipped as exc:
