@@ -4,6 +4,7 @@ scenes.
 =============  ===================================================================
 ``cluster``    the Dask cluster (a ``LocalCluster`` or a scheduler address), each
                worker's GL context and the per-host draw lock
+``kept``       clusters kept for a block of work (an experiment's warm-up and run)
 ``domains``    a mesh split into sort-last domains
 ``chunked``    a sort-last scene on disk, one folder per domain
 ``bigscene``   the es2008 benchmark written sheet by sheet as a chunked scene

@@ -4,7 +4,9 @@
 machine (one thread each) or connects to an existing scheduler, registers
 :class:`GLContextPlugin` (every worker creates one headless EGL context, in the thread its tasks
 run on, and reuses it for every task) and closes what it started on the way out, also on
-KeyboardInterrupt. A task reaches its worker's context with :func:`worker_context`.
+KeyboardInterrupt; inside :func:`~workbench.distributed.kept.kept_clusters` a local cluster is
+kept for the whole block instead. A task reaches its worker's context with
+:func:`worker_context`.
 
 Each worker is pinned to one EGL device before its first context exists (:func:`pin_devices`:
 round-robin over each host's devices, or an explicit list), so the workers of a multi-GPU node
@@ -31,6 +33,8 @@ from typing import TYPE_CHECKING
 
 import dask
 from distributed import Client, LocalCluster, Lock, WorkerPlugin, get_worker
+
+from .kept import innermost_kept
 
 if TYPE_CHECKING:
     import moderngl
@@ -267,10 +271,36 @@ def sweep_cluster(workers: int | None = None, scheduler: str | None = None, *,
     fill the cores by themselves; None leaves llvmpipe one thread per core, as timed draws
     (one at a time per host) want.
 
-    Everything started here is closed on the way out. Refused: ``workers`` < 1 and ``workers``
-    together with ``scheduler`` (ValueError), a scheduler that cannot be reached or has no
-    workers within a minute (OSError).
+    Everything started here is closed on the way out, except inside
+    :func:`~workbench.distributed.kept.kept_clusters`,
+    where a local cluster of the same arguments is started once and shared until that block
+    ends. Refused: ``workers`` < 1 and ``workers`` together with ``scheduler`` (ValueError), a
+    scheduler that cannot be reached or has no workers within a minute (OSError).
     """
+    if scheduler is not None and workers is not None:
+        raise ValueError("--workers sizes a local cluster; an existing scheduler keeps its workers")
+    if workers is not None and (int(workers) != workers or workers < 1):
+        raise ValueError(f"workers must be a positive integer, got {workers}")
+    arguments = dict(workers=workers, scheduler=scheduler, raster_threads=raster_threads, gl=gl,
+                     imports=tuple(imports), devices=None if devices is None else tuple(devices),
+                     verbose=verbose)
+    kept = innermost_kept() if scheduler is None else None
+    if kept is None:
+        with _started_cluster(**arguments) as cluster:
+            yield cluster
+        return
+    key = tuple(arguments.items())
+    if key not in kept.clusters:
+        kept.clusters[key] = kept.stack.enter_context(_started_cluster(**arguments))
+    yield kept.clusters[key]
+
+
+@contextmanager
+def _started_cluster(workers: int | None, scheduler: str | None, raster_threads: int | None,
+                     gl: bool, imports: tuple[str, ...], devices: Sequence[int] | None,
+                     verbose: bool | None) -> Iterator[SweepCluster]:
+    """The cluster :func:`sweep_cluster` describes, started (or connected to) here and closed
+    on the way out."""
     if scheduler is not None and workers is not None:
         raise ValueError("--workers sizes a local cluster; an existing scheduler keeps its workers")
     if workers is not None and (int(workers) != workers or workers < 1):

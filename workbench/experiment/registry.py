@@ -139,8 +139,10 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     folder is in place. With ``warm`` (the default) a quick or full run is preceded by the
     experiment's tiny run, untimed and thrown away
     (:func:`~workbench.experiment.warm.warm_experiment`), so that no table times the
-    compilation of a kernel. What killed runs left behind (staging folders, a previous output
-    folder set aside, temporary files) is cleaned up first. Returns ``(rows, out_dir)``.
+    compilation of a kernel; a Dask cluster the experiment starts is started once and kept
+    for both runs (:func:`~workbench.distributed.kept.kept_clusters`), its workers warm. What
+    killed runs left behind (staging folders, a previous output folder set aside, temporary
+    files) is cleaned up first. Returns ``(rows, out_dir)``.
     Unknown names raise KeyError listing the known ones; rows that are not dicts raise TypeError.
     An output folder that is a symbolic link (wherever it points) or not a folder is refused
     (ValueError) before the experiment runs, and again just before the swap. A declared
@@ -156,19 +158,26 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     out_dir = root / exp.name
     clean_dead_runs(root, exp.name)
     output_folder(out_dir)
-    if warm and size != "tiny":
-        took = warm_experiment(exp)
-        if progress is not None:
-            progress(f"kernels warmed by the tiny run ({took:.1f} s, not timed)")
-    staging = Path(tempfile.mkdtemp(dir=root, prefix=f".{exp.name}.",
-                                    suffix=f".{os.getpid()}.partial"))
-    os.chmod(staging, 0o777 & ~current_umask())  # mkdtemp makes 0700; the output folder is public
-    context = ExperimentContext(exp.name, staging, size, progress, declared=exp.declared)
-    try:
+    from ..distributed.kept import kept_clusters
+
+    with kept_clusters():  # the tiny run's cluster, its workers warm, serves the timed run
+        if warm and size != "tiny":
+            took = warm_experiment(exp)
+            if progress is not None:
+                progress(f"kernels warmed by the tiny run ({took:.1f} s, not timed)")
+        staging = Path(tempfile.mkdtemp(dir=root, prefix=f".{exp.name}.",
+                                        suffix=f".{os.getpid()}.partial"))
+        os.chmod(staging, 0o777 & ~current_umask())  # mkdtemp makes 0700; the folder is public
+        context = ExperimentContext(exp.name, staging, size, progress, declared=exp.declared)
         try:
-            rows = exp.function(context)
-        finally:
-            context.close()
+            try:
+                rows = exp.function(context)
+            finally:
+                context.close()
+        except BaseException:
+            shutil.rmtree(staging, ignore_errors=True)
+            raise
+    try:
         if rows is None:
             raise TypeError(f"experiment {name!r} returned None instead of a list of rows")
         rows = list(rows)
