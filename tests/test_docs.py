@@ -112,6 +112,20 @@ def test_the_readme_is_short_and_keeps_its_markers_and_two_commands():
         assert (ROOT / image).is_file() and (ROOT / image).stat().st_size < 200_000, image
 
 
+def test_the_readme_headlines_are_short_and_from_full_size_runs():
+    from workbench.experiment.declare import HEADLINE_CHARS
+    from workbench.experiment.report import BEGIN, END, declared_headlines
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text[text.index(BEGIN):text.index(END)]
+    rows = [[c.strip() for c in line.strip("|").split("|")]
+            for line in section.splitlines() if line.startswith("| ") and "`" in line]
+    assert {row[1].strip("`") for row in rows} == set(declared_headlines())
+    for paper, experiment, headline, ran_on in rows:
+        assert len(headline) <= HEADLINE_CHARS, experiment
+        assert ran_on.startswith("full, "), (experiment, ran_on)
+
+
 def test_the_files_the_pages_name_exist():
     pages = [ROOT / "README.md", *(DOCS / f"{p}.md" for p in
                                    ("cli", "python", "extending", "architecture"))]
