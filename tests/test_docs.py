@@ -121,7 +121,7 @@ def test_the_readme_headlines_are_short_and_from_full_size_runs():
     rows = [[c.strip() for c in line.strip("|").split("|")]
             for line in section.splitlines() if line.startswith("| ") and "`" in line]
     assert {row[1].strip("`") for row in rows} == set(declared_headlines())
-    for paper, experiment, headline, ran_on in rows:
+    for _paper, experiment, headline, ran_on in rows:
         assert len(headline) <= HEADLINE_CHARS, experiment
         assert ran_on.startswith("full, "), (experiment, ran_on)
 

@@ -2,6 +2,7 @@
 compared with another run (no change against itself, the slowed path flagged, only it), and
 the claims report written from it; and the ``workbench results`` command line."""
 
+import math
 import subprocess
 import time
 from pathlib import Path
@@ -256,8 +257,17 @@ def test_the_benchmarks_section_is_written_from_the_store(tmp_path):
                      experiment="bench:probe", table="nap", experiment_size=size)
         if size == "full":
             full = bench.run_id
+    repeated = start_run(store.root, "bench again", size="full")
+    repeated.append([{"case": "near", "function": "query", "set": s, "cutoff_mm": c,
+                      "wall_ms": ms, "wall_ms_lo": ms, "wall_ms_hi": ms, "tests": t}
+                     for s, c, ms, t in (("nodes", 1.5, 1.0, 3), ("nodes", math.inf, 2.0, None),
+                                         ("moved", 1.5, 3.0, 4))],
+                    experiment="bench:again", table="near", experiment_size="full")
     write_report(store, readme, tmp_path / "results.md", history=history)
     text = history.read_text()
+    assert ("- near: query (set nodes, cutoff_mm 1.50): 1.00 ms [1.00, 1.00]; "
+            "query (set nodes, cutoff_mm ∞): 2.00 ms [2.00, 2.00]; "
+            "query (set moved, cutoff_mm 1.50): 3.00 ms" in text)
     assert "typed" not in text.split("## typed record")[0] and "## typed record" in text
     assert f"**probe**, run {full} (" in text and "full size" in text
     assert "- nap: ours: 5.00 ms [4.00, 6.00]; ÷ theirs 0.500× [0.400, 0.600]" in text

@@ -264,17 +264,47 @@ def readme_section(store: ResultsStore) -> str:
 
 def benchmark_lines(rows: list[dict[str, Any]]) -> list[str]:
     """One line per timed row of a benchmark's stored case: ``function: 12.3 ms [12.1, 12.6]``
-    with the row's interleaved ratios (``÷ fcpw 0.52× [0.50, 0.55]``)."""
+    with the row's interleaved ratios (``÷ fcpw 0.52× [0.50, 0.55]``). A function timed more
+    than once in the case (say, per query set) is named with the columns that tell its rows
+    apart: ``query (cutoff_mm 1.5, set nodes): …``."""
+    timed = [r for r in rows if r.get("wall_ms") is not None]
+    qualifiers = _qualifiers(timed)
     out = []
-    for r in rows:
-        if r.get("wall_ms") is None:
-            continue
+    for r in timed:
         ratios = [f"; ÷ {key[5:]} {interval(r, key)}" for key in r
                   if key.startswith("over_") and not key.endswith(("_lo", "_hi", "_pairs"))
                   and r[key] is not None]
-        out.append(f"{r.get('function')}: {num(r['wall_ms'])} ms [{num(r.get('wall_ms_lo'))}, "
+        named = ", ".join(f"{key} {_value(r[key])}" for key in qualifiers)
+        label = f"{r.get('function')} ({named})" if named else f"{r.get('function')}"
+        out.append(f"{label}: {num(r['wall_ms'])} ms [{num(r.get('wall_ms_lo'))}, "
                    f"{num(r.get('wall_ms_hi'))}]{''.join(ratios)}")
     return out
+
+
+_MEASURED = ("wall_", "gpu_", "over_", "readback_")
+
+
+def _qualifiers(timed: list[dict[str, Any]]) -> list[str]:
+    """The columns, set in every timed row and not measured times, whose values differ between
+    rows of one function: what tells a function's repeated rows apart (none when no function
+    repeats). A counter set on some rows only (a hierarchy's tests) is not one."""
+    by_function: dict[Any, list[dict[str, Any]]] = {}
+    for r in timed:
+        by_function.setdefault(r.get("function"), []).append(r)
+    repeated = [group for group in by_function.values() if len(group) > 1]
+    if not repeated:
+        return []
+    keys = [k for k in timed[0] if k not in ("function", "repeats", "row_index")
+            and not k.startswith(_MEASURED) and all(r.get(k) is not None for r in timed)]
+    return [k for k in keys
+            if any(len({repr(r[k]) for r in group}) > 1 for group in repeated)]
+
+
+def _value(value: Any) -> str:
+    """A column value in a label: floats as :func:`num`, the rest as text."""
+    if isinstance(value, float):
+        return num(value)
+    return str(value)
 
 
 def benchmark_section(store: ResultsStore) -> str:
