@@ -261,13 +261,15 @@ def test_the_benchmarks_section_is_written_from_the_store(tmp_path):
     repeated.append([{"case": "near", "function": "query", "set": s, "cutoff_mm": c,
                       "wall_ms": ms, "wall_ms_lo": ms, "wall_ms_hi": ms, "tests": t}
                      for s, c, ms, t in (("nodes", 1.5, 1.0, 3), ("nodes", math.inf, 2.0, None),
-                                         ("moved", 1.5, 3.0, 4))],
+                                         ("moved", 1.5, 3.0, 4))]
+                   + [{"case": "near", "function": "build", "wall_ms": 4.0, "wall_ms_lo": 4.0,
+                       "wall_ms_hi": 4.0}],
                     experiment="bench:again", table="near", experiment_size="full")
     write_report(store, readme, tmp_path / "results.md", history=history)
     text = history.read_text()
     assert ("- near: query (set nodes, cutoff_mm 1.50): 1.00 ms [1.00, 1.00]; "
             "query (set nodes, cutoff_mm ∞): 2.00 ms [2.00, 2.00]; "
-            "query (set moved, cutoff_mm 1.50): 3.00 ms" in text)
+            "query (set moved, cutoff_mm 1.50): 3.00 ms [3.00, 3.00]; build: 4.00 ms" in text)
     assert "typed" not in text.split("## typed record")[0] and "## typed record" in text
     assert f"**probe**, run {full} (" in text and "full size" in text
     assert "- nap: ours: 5.00 ms [4.00, 6.00]; ÷ theirs 0.500× [0.400, 0.600]" in text

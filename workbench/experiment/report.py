@@ -274,7 +274,8 @@ def benchmark_lines(rows: list[dict[str, Any]]) -> list[str]:
         ratios = [f"; ÷ {key[5:]} {interval(r, key)}" for key in r
                   if key.startswith("over_") and not key.endswith(("_lo", "_hi", "_pairs"))
                   and r[key] is not None]
-        named = ", ".join(f"{key} {_value(r[key])}" for key in qualifiers)
+        named = ", ".join(f"{key} {_value(r[key])}" for key in qualifiers
+                          if r.get(key) is not None)
         label = f"{r.get('function')} ({named})" if named else f"{r.get('function')}"
         out.append(f"{label}: {num(r['wall_ms'])} ms [{num(r.get('wall_ms_lo'))}, "
                    f"{num(r.get('wall_ms_hi'))}]{''.join(ratios)}")
@@ -285,17 +286,19 @@ _MEASURED = ("wall_", "gpu_", "over_", "readback_")
 
 
 def _qualifiers(timed: list[dict[str, Any]]) -> list[str]:
-    """The columns, set in every timed row and not measured times, whose values differ between
-    rows of one function: what tells a function's repeated rows apart (none when no function
-    repeats). A counter set on some rows only (a hierarchy's tests) is not one."""
+    """The columns, set in every row of every function timed more than once and not measured
+    times, whose values differ between rows of one function: what tells a function's repeated
+    rows apart (none when no function repeats). A counter that one repeated function's rows
+    lack (a hierarchy's tests, which the BVH's rows do not carry) is not one."""
     by_function: dict[Any, list[dict[str, Any]]] = {}
     for r in timed:
         by_function.setdefault(r.get("function"), []).append(r)
     repeated = [group for group in by_function.values() if len(group) > 1]
     if not repeated:
         return []
-    keys = [k for k in timed[0] if k not in ("function", "repeats", "row_index")
-            and not k.startswith(_MEASURED) and all(r.get(k) is not None for r in timed)]
+    rows = [r for group in repeated for r in group]
+    keys = [k for k in rows[0] if k not in ("function", "repeats", "row_index")
+            and not k.startswith(_MEASURED) and all(r.get(k) is not None for r in rows)]
     return [k for k in keys
             if any(len({repr(r[k]) for r in group}) > 1 for group in repeated)]
 
