@@ -67,14 +67,15 @@ def test_frames_equal_render_of_each_state(ctx, crash, mesh, tmp_path, path, fie
     ("position", None, 12), ("gouraud", None, 24), ("element_color", FIELD, 16)])
 def test_bytes_per_state_are_the_paths_bytes_per_step(ctx, mesh, path, field, per_vertex):
     """Coordinates (12 bytes a vertex), normals (12) where the path lights per vertex, field
-    values (4) where it colours: set_step's bytes, the prepared path's bytes_per_step and the
-    measured row's alike."""
+    values (4) where it colours, and the index of the triangles (12 a triangle: the d3plot
+    deletes a shell at its last state, live triangles are written first): set_step's bytes,
+    the prepared path's bytes_per_step and the measured row's alike."""
     style = make_path(path, field=field).style
     loop, frames = frames_of(ctx, mesh, path, style)
     row = measure(ctx, mesh, path, style, size=SIZE, timed=False).row
     for frame in frames:
         assert frame.bytes_uploaded == frame.bytes_per_step == row["bytes_per_step"]
-    assert row["bytes_per_step"] == row["vertices"] * per_vertex
+    assert row["bytes_per_step"] == row["vertices"] * per_vertex + 12 * row["triangles"]
     assert loop.prepare_bytes == row["bytes_uploaded"] > row["bytes_per_step"]
     assert all(f.upload_ms >= 0 and f.draw_ms > 0 for f in frames)
 
@@ -181,7 +182,8 @@ def test_gif_holds_every_state(ctx, crash, mesh, tmp_path, capsys):
         assert np.abs(got[..., :3].astype(int) - want).mean() < 0.5
     printed = capsys.readouterr().out
     assert "3 frames of d3plot (3 states), path element_color" in printed
-    assert "80 bytes uploaded (the path's bytes_per_step: 80)" in printed
+    assert "116 bytes uploaded (the path's bytes_per_step: 116)" in printed  # 80 + the index
+    assert "deleted elements per state (not drawn): 0, 0, 1" in printed
     assert [p.name for p in tmp_path.iterdir()] == ["crash.gif"]  # no temporary file left
 
 

@@ -394,6 +394,32 @@ def test_crash_sequence_step0_topology_and_shapes(crashed):
     assert np.array_equal(c.node_fields["thickness"], m.node_fields["thickness"])
 
 
+def test_crash_sequence_erodes_at_the_failure_strain_and_keeps_the_failure_value(crashed):
+    """An element is deleted from the first state its strain (of the crash without erosion)
+    reaches the failure strain on, for good, and keeps that state's value; the others are the
+    crash without erosion, unchanged. Checked element by element with a plain loop."""
+    m, c = crashed
+    strain = c.element_fields["plastic_strain"]
+    failure = float(np.quantile(strain[-1], 0.9))
+    e = crash_sequence(m, steps=8, crush=0.3, axis="x", failure_strain=failure)
+    alive, got = e.element_fields["alive"], e.element_fields["plastic_strain"]
+    assert np.array_equal(e.steps, c.steps) and alive.shape == strain.shape
+    for k in range(m.n_elements):
+        hits = [t for t in range(8) if strain[t, k] >= failure]
+        if not hits:
+            assert alive[:, k].all() and np.array_equal(got[:, k], strain[:, k])
+            continue
+        first = hits[0]
+        assert alive[:first, k].all() and not alive[first:, k].any()
+        assert np.array_equal(got[:first + 1, k], strain[:first + 1, k])
+        assert (got[first:, k] == strain[first, k]).all()
+    assert 0 < (alive[-1] == 0).sum() < m.n_elements
+    assert e.erodes and e.field_range("plastic_strain")[1] < failure
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="failure_strain must be a positive"):
+            crash_sequence(m, steps=3, failure_strain=bad)
+
+
 def test_crash_sequence_displacement_grows_and_is_largest_at_the_front(crashed):
     m, c = crashed
     d = c.node_fields["displacement"]

@@ -400,3 +400,34 @@ def test_the_notebook_executes_and_shows_an_image(tmp_path):
     said = "".join(o.get("text", "") for o in outputs if o.output_type == "stream")
     shown = "car" if shared_file(CAR_DECK) is not None else "semicylinders:16"
     assert said.startswith(f"{shown}: ")
+
+
+
+def test_the_live_view_hides_a_deleted_shell_at_its_state(ctx, tmp_path):
+    """The notebook viewer's drawing side: at the state that deletes the triangle shell, its
+    frame is the image of the live shell alone drawn with the viewer's camera, and covers
+    fewer pixels than the state before."""
+    from meshes import write_d3plot
+
+    from workbench.paths import make_path, render
+    from workbench.scene.readers import load
+    from workbench.viewer.live import LiveView
+
+    size = (64, 48)
+    mesh = load(write_d3plot(tmp_path))
+    live = mesh.subset(mesh.alive(2))
+    live.element_fields.pop("alive")
+    view = LiveView(mesh, "flat", size=size)
+    try:
+        view.set_step(1)
+        before = view.frame()
+        view.set_step(2)
+        eroded, camera = view.frame(), view.camera()
+    finally:
+        view.release()
+    with ctx:  # the viewer made its own context current
+        alone = render(ctx, live, "flat", make_path("flat").style, camera, size, step=2)
+    np.testing.assert_array_equal(eroded, alone[..., :3])
+    covered = (eroded != 255).any(axis=-1).sum()
+    assert 0 < covered < (before != 255).any(axis=-1).sum()
+

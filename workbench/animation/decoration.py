@@ -74,9 +74,12 @@ class Decoration:
     time_units: str = ""
 
     def __call__(self, frame: Frame) -> np.ndarray:
-        """(H', W', 3) uint8: ``frame.image`` with its time stamp, and its colour bar where the
-        decoration has a field and the frame a value range."""
+        """(H', W', 3) uint8: ``frame.image`` with its time stamp ("deleted: N" after it where
+        the state deletes elements), and its colour bar where the decoration has a field and
+        the frame a value range."""
         title = f"{self.title}, {time_stamp(frame.step, frame.time, self.time_units)}"
+        if frame.deleted:
+            title += f", deleted: {frame.deleted}"
         if self.field is not None and frame.value_range is not None:
             fig = field_figure(frame.image, value_range=frame.value_range,
                                colormap=self.colormap, label=self.field, units=self.units,

@@ -126,7 +126,8 @@ class Frame:
     draw and the read-back, the clear before it excluded), ``bytes_uploaded`` (what those
     uploads sent), ``bytes_per_step`` (the prepared path's own count of one ``set_step``) and
     ``no_result`` (the legend text of the field's values without one in that state, say ``no
-    result: 12 nodes``; None where every value is finite or without a field)."""
+    result: 12 nodes``; None where every value is finite or without a field), ``deleted`` (the
+    elements deleted in that state, not drawn or ghosted: erosion)."""
 
     step: int
     time: float | None
@@ -137,18 +138,15 @@ class Frame:
     bytes_uploaded: int
     bytes_per_step: int
     no_result: str | None = None
+    deleted: int = 0
 
 
 def state_value_range(mesh: FEMesh, field: str, step: int) -> tuple[float, float]:
-    """(lo, hi) of ``field`` in state ``step``, finite values only, as
+    """(lo, hi) of ``field`` in state ``step``, finite values of the elements in use only
+    (:meth:`~workbench.scene.mesh.FEMesh.field_range`), as
     :func:`~workbench.paths.colormap.scale_for` makes a range over all states: a constant
     field gets ``(v, v + 1)``, a state without a finite value ``(0, 1)``."""
-    values = mesh.node_field(field, step) if field in mesh.node_fields \
-        else mesh.element_field(field, step)
-    finite = values[np.isfinite(values)]
-    if not finite.size:
-        return 0.0, 1.0
-    lo, hi = float(finite.min()), float(finite.max())
+    lo, hi = mesh.field_range(field, step)
     return lo, hi if hi > lo else lo + 1.0
 
 
@@ -239,6 +237,11 @@ class FrameLoop:
         count, per = missing_count(self.mesh, self.field, step)
         return no_result_label(count, per) if count else None
 
+    def deleted(self, step: int) -> int:
+        """The number of elements deleted in state ``step`` (0 for a scene without erosion)."""
+        alive = getattr(self.mesh, "alive", None)
+        return 0 if alive is None else int(self.mesh.n_elements - alive(step).sum())
+
     def time_of(self, step: int) -> float | None:
         """The mesh's time of state ``step`` (None for a mesh without times)."""
         times = self.mesh.times
@@ -260,7 +263,7 @@ class FrameLoop:
                 k = drawn.state
                 yield Frame(k, self.time_of(k), drawn.image, value_range, drawn.update_ms,
                             drawn.draw_ms + drawn.read_ms, drawn.sent,
-                            ready.path.bytes_per_step, self.no_result(k))
+                            ready.path.bytes_per_step, self.no_result(k), self.deleted(k))
 
     def _per_step(self) -> Iterator[Frame]:
         """Prepared again for every state, with that state's value range; each preparation
@@ -277,4 +280,4 @@ class FrameLoop:
                 for drawn in draw_frames(ready, (k,)):
                     yield Frame(k, self.time_of(k), drawn.image, value_range, ready.prepare_ms,
                                 drawn.draw_ms + drawn.read_ms, sent, ready.path.bytes_per_step,
-                                self.no_result(k))
+                                self.no_result(k), self.deleted(k))

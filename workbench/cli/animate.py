@@ -117,6 +117,9 @@ def add_parser(subparsers) -> None:
     p.add_argument("--time-units", default="",
                    help="unit of the states' times, for the time stamp (a d3plot does not name "
                         "it: its times are in the model's time unit)")
+    p.add_argument("--show-deleted", choices=("hide", "ghost"), default="hide",
+                   help="elements deleted at a state (erosion): hidden (default), or ghost: "
+                        "drawn translucent")
     p.add_argument("-O", "--option", type=key_value, action="append", metavar="KEY=VALUE",
                    help="any style option of the path (repeatable)")
     add_device_argument(p)
@@ -129,6 +132,8 @@ def _style(args, path_name: str):
     from ..paths.registry import check_options, path_class
 
     options = {"field": args.field, "bands": args.bands}
+    if args.show_deleted != "hide":
+        options["deleted"] = args.show_deleted
     options.update(dict(args.option or ()))
     if args.colormap is not None:
         options["colormap"] = args.colormap
@@ -173,7 +178,7 @@ def cmd_animate(args) -> int:
     def decorated():
         for frame in loop:
             costs.append((frame.upload_ms, frame.draw_ms, frame.bytes_uploaded,
-                          frame.bytes_per_step, frame.value_range))
+                          frame.bytes_per_step, frame.value_range, frame.deleted))
             bar.update()
             yield decorate(frame)
 
@@ -195,7 +200,7 @@ def _spread(values: list[float]) -> str:
 def _report(out, count: int, mesh, path_name: str, loop, costs: list[tuple],
             args) -> list[str]:
     """The lines printed: what was written, what preparing cost, the per-state costs."""
-    upload, draw, sent, per_step, ranges = (list(c) for c in zip(*costs))
+    upload, draw, sent, per_step, ranges, deleted = (list(c) for c in zip(*costs))
     scale = ""
     if loop.field is not None:
         scale = f", {loop.field} on a {args.scale} scale"
@@ -215,4 +220,8 @@ def _report(out, count: int, mesh, path_name: str, loop, costs: list[tuple],
     else:
         lines += [f"per state, prepared again for its own scale: prepare {_spread(upload)}, "
                   f"{draws}, {each} bytes uploaded (set_step alone: {per_step[0]})"]
+    if any(deleted):
+        how = "ghosted" if loop.style.deleted == "ghost" else "not drawn"
+        lines.append(f"deleted elements per state ({how}): "
+                     + ", ".join(str(d) for d in deleted))
     return lines

@@ -54,6 +54,9 @@ def add_parser(subparsers) -> None:
     p.add_argument("-O", "--option", type=key_value, action="append", metavar="KEY=VALUE",
                    help="any style option of the path (repeatable)")
     p.add_argument("--wireframe", action="store_true", help="overdraw element edges")
+    p.add_argument("--show-deleted", choices=("hide", "ghost"), default="hide",
+                   help="elements deleted at the step (erosion, a d3plot's element deletion): "
+                        "hidden (default), or ghost: drawn translucent (GL only)")
     p.add_argument("--all-faces", action="store_true",
                    help="draw every face of solid elements, not only the boundary faces")
     p.add_argument("--strips", choices=("none", "triangle", "quad"), default="none",
@@ -137,7 +140,7 @@ def _render_options(args, kind: str) -> dict:
     spacetime path they are refused), ``--colormap`` and every ``--option``."""
     flags = {"field": args.field, "step": args.step, "bands": args.bands,
              "wireframe": args.wireframe, "crease_deg": args.crease, "strips": args.strips,
-             "fepatch": args.fepatch}
+             "fepatch": args.fepatch, "deleted": args.show_deleted}
     if kind == "mesh":
         options = dict(flags)
     else:

@@ -38,6 +38,14 @@ Conventions every path follows (a reference renderer can match them exactly):
 * **Wire frame** (``Style.wireframe``): the element edges (quad edges, no diagonals) drawn as a
   second pass of ``GL_LINES``; the fill pass uses polygon offset (factor 1, units 1) so the
   lines win the depth test — the "standard wire frame" line overdraw of fe2003 Table 3.
+* **Erosion** (a mesh whose element field ``"alive"`` holds a 0,
+  :attr:`~workbench.scene.mesh.FEMesh.erodes`): at each step the mesh paths of a triangle list
+  write the triangles and wire-frame edges of the live elements to the front of their index
+  buffers and draw only those (``set_step`` sends the whole index, the same bytes every step);
+  the deleted ones behind them are drawn translucent with ``Style.deleted = "ghost"``. The
+  colour range comes from live elements only. ``deleted`` counts the elements hidden at the
+  step drawn. A strip layout keeps every element: it draws them with an
+  :class:`~workbench.paths.mesh.ErosionWarning`.
 """
 
 from __future__ import annotations
@@ -183,6 +191,10 @@ class GLPath(RenderPath):
         self._objects: list = []
         self._program = self._line_program = self._line_vao = None
         self._textures: list = []  # (texture, unit) bound before each draw
+        # indices the fill and line passes draw (-1: the whole buffer); fewer where a path
+        # hides deleted elements (erosion) at the step
+        self._fill_vertices = self._line_vertices = -1
+        self.deleted = 0  # elements hidden at the drawn step
 
     def prepare(self, ctx: moderngl.Context, scene: Scene, camera: Camera) -> None:
         if self.ctx is not None:
@@ -225,7 +237,7 @@ class GLPath(RenderPath):
             ctx, "position.vert.glsl", "position.frag.glsl",
             defines={"NUM_CLIP": len(self.style.clip_planes)}))
         self._line_program["base_color"].value = self.style.wire_color
-        index = self._keep(ctx.buffer(edges.tobytes()))
+        index = self._line_index = self._keep(ctx.buffer(edges.tobytes()))
         self._line_vao = self._keep(ctx.vertex_array(
             self._line_program, [(positions, "3f", "position")], index, index_element_size=4))
         self.edges = len(edges)
@@ -287,15 +299,16 @@ class GLPath(RenderPath):
         with self._clip_distances(len(style.clip_planes)):
             if self._line_vao is not None:
                 ctx.polygon_offset = POLYGON_OFFSET
-                self._vao.render(mode)
+                self._vao.render(mode, vertices=self._fill_vertices)
                 ctx.polygon_offset = (0.0, 0.0)
-                self._line_vao.render(moderngl.LINES)
+                self._line_vao.render(moderngl.LINES, vertices=self._line_vertices)
             else:
-                self._vao.render(mode)
+                self._vao.render(mode, vertices=self._fill_vertices)
 
     def release(self) -> None:
         for obj in reversed(self._objects):
             obj.release()
         self._objects.clear()
         self._textures = []
+        self._fill_vertices = self._line_vertices = -1
         self.ctx = None

@@ -172,6 +172,21 @@ class MeshDrawData:
             return out
         return t if self.vertex_node is None else t[self.vertex_node]
 
+    def live_triangles(self, step: int) -> np.ndarray | None:
+        """(T,) bool over the triangle list, the triangles of elements in use at ``step``;
+        None where the mesh deletes no element or the layout is strips (no
+        ``triangle_element``): everything is drawn (:class:`~.mesh.ErosionWarning`)."""
+        if not self.mesh.erodes or self.triangle_element is None:
+            return None
+        return self.mesh.alive(step)[self.triangle_element]
+
+    def live_edges(self, step: int) -> np.ndarray | None:
+        """(E,) bool over ``edges``, the wire-frame edges of elements in use at ``step``; None
+        without erosion or without a wire frame."""
+        if self.edges is None or not self.mesh.erodes:
+            return None
+        return self.mesh.live_edges(step)
+
     def triangle_list(self) -> np.ndarray:
         """(T, 3) int64 the drawn triangles as a list (strips unrolled, restarts dropped)."""
         if self.primitive == "triangles":

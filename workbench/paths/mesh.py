@@ -20,6 +20,7 @@ one flag per triangle; an element path's flag rides on the element's provoking v
 
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING, ClassVar
 
 import moderngl
@@ -30,7 +31,7 @@ from ..gl import Camera, load_program
 from .base import GLPath
 from .colormap import NO_RESULT_COLOR, ColorScale, scale_for
 from .drawdata import Layout, MeshDrawData, Topology, compact, vertex_of_node
-from .style import Style
+from .style import GHOST_ALPHA, Style
 
 if TYPE_CHECKING:
     from ..scene.mesh import FEMesh
@@ -47,6 +48,10 @@ def field_kind(mesh: FEMesh, name: str) -> str:
         return "element"
     raise KeyError(f"{mesh.name} has no field {name!r}; node fields: {sorted(mesh.node_fields)}, "
                    f"element fields: {sorted(mesh.element_fields)}")
+
+
+class ErosionWarning(UserWarning):
+    """A path draws elements the mesh deletes at the drawn state (erosion): said, not hidden."""
 
 
 class MeshPath(GLPath):
@@ -143,6 +148,12 @@ class MeshPath(GLPath):
         scale = self.check_mesh(mesh)
         topology = self.topology(mesh)
         layout = self.layout(mesh, topology)
+        if mesh.erodes and layout.triangle_element is None:
+            deleted = int((~np.stack([mesh.alive(t) for t in range(mesh.n_steps)])).any(0).sum())
+            warnings.warn(f"{mesh.name} deletes {deleted} elements part-way (erosion); path "
+                          f"{self.name!r} draws strips, which keep every element: the deleted "
+                          f"ones are drawn (a triangle list hides them: strips='none', "
+                          f"quad_diagonal='shorter')", ErosionWarning, stacklevel=2)
         vertex_node, n_vertices, index, split_rows, remap = compact(topology, layout,
                                                                     mesh.n_nodes)
         element_vertex = topology.element_vertex
@@ -209,7 +220,7 @@ class MeshPath(GLPath):
             uploaded += self._colormap_texture(ctx, data.scale)
         self._vao = self._keep(ctx.vertex_array(self._program, content, self._index,
                                                 index_element_size=4))
-        self._content, self._id_program = content, None
+        self._content, self._id_program, self._ghost_vao = content, None, None
         if "base_color" in self._uniforms(self._program):
             self._program["base_color"].value = style.base_color
         if data.edges is not None:
@@ -253,7 +264,28 @@ class MeshPath(GLPath):
             sent += normals.nbytes
         if self.field_per is not None and not self.data.static_values:
             sent += self._upload_values(step)
+        sent += self._upload_live(step)
         self.step = step
+        return sent
+
+    def _upload_live(self, step: int) -> int:
+        """With erosion, write the triangles (and wire-frame edges) of the elements in use at
+        ``step`` to the front of their index buffers and draw only those; the bytes sent (the
+        whole index buffer: the same every step)."""
+        live = self.data.live_triangles(step)
+        if live is None:
+            return 0
+        index, self._fill_vertices = self._live_index(live)
+        self._index.write(index.tobytes())
+        self.deleted = int(self.mesh.n_elements - self.mesh.alive(step).sum())
+        sent = index.nbytes
+        edges = self.data.live_edges(step)
+        if edges is not None:
+            pairs = np.ascontiguousarray(np.concatenate([self.data.edges[edges],
+                                                         self.data.edges[~edges]]), np.int32)
+            self._line_index.write(pairs.tobytes())
+            self._line_vertices = int(edges.sum()) * 2
+            sent += pairs.nbytes
         return sent
 
     def _upload_values(self, step: int) -> int:
@@ -266,9 +298,44 @@ class MeshPath(GLPath):
         self._missing.write(missing)
         return values.nbytes + missing.nbytes
 
+    def _live_index(self, live: np.ndarray) -> tuple[np.ndarray, int]:
+        """(the int32 triangle index to upload, the vertices the fill pass draws) with the
+        triangles ``live`` (bool over the triangle list) shown: the live triangles first and
+        the deleted ones behind them, for the ghost pass; the whole index every step, so each
+        step sends the same bytes."""
+        index = np.concatenate([self.data.index[live], self.data.index[~live]])
+        return np.ascontiguousarray(index, np.int32), int(live.sum()) * 3
+
     def draw(self) -> None:
         self.ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
         self._render(self.mode)
+        if self.style.deleted == "ghost" and self._fill_vertices >= 0:
+            self._draw_ghosts()
+
+    def _draw_ghosts(self) -> None:
+        """The deleted elements' triangles (behind the live ones in the index buffer) in
+        ``base_color`` at opacity GHOST_ALPHA, blended over what is drawn, depth-tested."""
+        count = self.data.triangles * 3 - self._fill_vertices
+        if count <= 0:
+            return
+        ctx = self.ctx
+        if self._ghost_vao is None:
+            program = self._keep(load_program(ctx, "position.vert.glsl", "ghost.frag.glsl",
+                                              defines={"NUM_CLIP": len(self.style.clip_planes)}))
+            program["ghost_color"].value = (*self.style.base_color, GHOST_ALPHA)
+            self._ghost_vao = self._keep(ctx.vertex_array(
+                program, [(self._positions, "3f", "position")], self._index,
+                index_element_size=4))
+        program = self._ghost_vao.program
+        for name in ("mvp", "clip_planes"):
+            if name in self._uniforms(program) and name in self._uniforms(self._program):
+                program[name].value = self._program[name].value
+        ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
+        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+        with self._clip_distances(len(self.style.clip_planes)):
+            self._ghost_vao.render(moderngl.TRIANGLES, vertices=count,
+                                   first=self._fill_vertices)
+        ctx.enable_only(moderngl.DEPTH_TEST)
 
     # ------------------------------------------------------------------ sort-last domains
     def draw_triangles(self, ids: np.ndarray, triangle_ids: bool = False) -> None:
@@ -278,6 +345,7 @@ class MeshPath(GLPath):
         plus one (an unsigned integer target; 0 where nothing is drawn), through the same
         placement and clip planes, so the same triangle wins each pixel as in the colour pass.
 
+        A triangle of an element deleted at the drawn step (erosion) gives no fragment.
         Refused (ValueError): a strip layout (a triangle is no index range of it) and a line
         pass or an alpha test (their fragments are not the triangles')."""
         self._require_prepared()
@@ -286,10 +354,14 @@ class MeshPath(GLPath):
                 self.style.hide_range is not None:
             raise ValueError(f"path {self.name!r} draws domains of a triangle list without a "
                              f"wire frame or hidden range (strips {self.style.strips!r})")
-        index = np.ascontiguousarray(data.triangle_list()[np.asarray(ids, np.int64)],
-                                     np.int32)
+        ids = np.asarray(ids, np.int64)
+        index = np.ascontiguousarray(data.triangle_list()[ids], np.int32)
         if not len(index):
             return
+        live = data.live_triangles(self.step)
+        if live is not None:  # a deleted element's triangle made degenerate: no fragment,
+            dead = ~live[ids]  # and every other triangle keeps its position in ``ids``
+            index[dead] = index[dead][:, :1]
         ctx = self.ctx
         buffer = ctx.buffer(index.tobytes())
         if triangle_ids:
@@ -298,13 +370,13 @@ class MeshPath(GLPath):
                                    index_element_size=4)
         else:
             vao = ctx.vertex_array(self._program, self._content, buffer, index_element_size=4)
-        vao_before, line_before = self._vao, self._line_vao
+        vao_before, line_before, count = self._vao, self._line_vao, self._fill_vertices
         try:
-            self._vao = vao
+            self._vao, self._fill_vertices = vao, -1
             ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
             self._render(moderngl.TRIANGLES)
         finally:
-            self._vao, self._line_vao = vao_before, line_before
+            self._vao, self._line_vao, self._fill_vertices = vao_before, line_before, count
             vao.release()
             buffer.release()
 

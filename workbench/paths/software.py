@@ -119,6 +119,7 @@ class SoftwarePath(RenderPath):
         self.stats = None
         self.mesh = self.data = self.scale = None
         self._workspace: dict = {}
+        self.deleted = 0  # elements hidden at the drawn step (erosion)
 
     @classmethod
     def default_camera(cls, scene: Scene, size: tuple[int, int], **kwargs: Any) -> Camera:
@@ -148,6 +149,9 @@ class SoftwarePath(RenderPath):
         if camera.projection != "orthographic":
             raise ValueError("the software rasterizer draws orthographic views only")
         data = self._drawn.draw_data(mesh)
+        if style.deleted == "ghost" and mesh.erodes:
+            raise ValueError("the software rasterizer hides deleted elements; "
+                             "deleted='ghost' (translucent) is drawn on GL only")
         self.data, self.scale = data, data.scale
         self._triangles = np.ascontiguousarray(data.triangle_list(), np.int64)
         self.triangles, self.vertices = len(self._triangles), data.n_vertices
@@ -201,6 +205,14 @@ class SoftwarePath(RenderPath):
                 self._values = data.vertex_values(t)
             else:
                 self._triangle_values = t[data.triangle_element]
+        # erosion: only the triangles of elements in use at the step are rasterized
+        live = data.live_triangles(step)
+        self._live_triangles, self._live_values = self._triangles, self._triangle_values
+        if live is not None:
+            self._live_triangles = self._triangles[live]
+            if self._triangle_values is not None:
+                self._live_values = self._triangle_values[live]
+        self.deleted = 0 if live is None else int(mesh.n_elements - mesh.alive(step).sum())
         self.step = step
         return sum(a.nbytes for a in (self._positions, self._normals, self._values,
                                       self._triangle_values) if a is not None)
@@ -212,22 +224,26 @@ class SoftwarePath(RenderPath):
         if self.mesh is None or self.target is None:
             raise RuntimeError(f"software path {self.name!r} needs prepare and make_target")
         _, self.stats = render(
-            self._positions, self._triangles, self._view, self._projection, self.target.size,
-            self._shading, self.options, normals=self._normals, values=self._values,
-            triangle_values=self._triangle_values, clip_planes=self._planes,
+            self._positions, self._live_triangles, self._view, self._projection,
+            self.target.size, self._shading, self.options, normals=self._normals,
+            values=self._values, triangle_values=self._live_values, clip_planes=self._planes,
             frame=self.target.frame, vectorized=vectorized, workspace=self._workspace)
 
     def render_triangles(self, ids: ArrayLike,
                          background: tuple[int, int, int, int] = (255, 255, 255, 255)) -> Frame:
         """A new frame of :attr:`target`'s size (``make_target`` first) with only the triangles
         ``ids`` of the path's triangle list drawn, keeping their indices in that list as the
-        frame's triangle indices: the frame of one domain for sort-last compositing."""
+        frame's triangle indices: the frame of one domain for sort-last compositing. A triangle of
+        an element deleted at the drawn step (erosion) is not drawn."""
         if self.mesh is None or self.target is None:
             raise RuntimeError(f"software path {self.name!r} needs prepare and make_target")
         ids = np.asarray(ids, np.int64)
         if ids.ndim != 1 or (len(ids) and (ids.min() < 0 or ids.max() >= self.triangles)):
             raise ValueError(f"triangle ids must be a 1-D array of indices below "
                              f"{self.triangles}")
+        live = self.data.live_triangles(self.step)
+        if live is not None:  # erosion: a deleted element's triangles are not drawn
+            ids = ids[live[ids]]
         tv = None if self._triangle_values is None else self._triangle_values[ids]
         frame, _ = render(self._positions, self._triangles[ids], self._view, self._projection,
                           self.target.size, self._shading, self.options, ids=ids,
@@ -238,9 +254,14 @@ class SoftwarePath(RenderPath):
     def raster_inputs(self) -> RasterInputs:
         """What :meth:`draw` rasterizes at the current step, for writing it elsewhere
         (:func:`workbench.distributed.chunked.write_chunked`): float64 drawn vertex coordinates,
-        normals, values, triangles, shading and model-space clip planes."""
+        normals, values, triangles, shading and model-space clip planes. Refused (ValueError)
+        at a step where elements are deleted: the triangle list keeps every element."""
         if self.mesh is None:
             raise ValueError(f"software path {self.name!r} is not prepared")
+        if self.deleted:
+            raise ValueError(f"{self.mesh.name} has {self.deleted} elements deleted at step "
+                             f"{self.step}: its raster inputs keep every element; write the "
+                             f"live elements (FEMesh.subset(mesh.alive(step))) instead")
         shown = self.data.shown_coordinates(self.step)
         coordinates = shown if self.data.vertex_node is None else shown[self.data.vertex_node]
         return RasterInputs(np.ascontiguousarray(coordinates, np.float64), self._normals,

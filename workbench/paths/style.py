@@ -22,6 +22,8 @@ if TYPE_CHECKING:
 MAX_CLIP_PLANES = 4
 STRIPS = ("none", "triangle", "quad")
 QUAD_DIAGONALS = ("auto", "shorter", "strip")
+DELETED = ("hide", "ghost")
+GHOST_ALPHA = 0.25  # opacity of a deleted element drawn with deleted="ghost"
 
 
 @dataclass
@@ -42,7 +44,9 @@ class Style:
     quad_diagonal: how quads are split, "shorter" (the shorter diagonal), "strip" (the diagonal
     of the quad's strip) or "auto" ("strip" for quad strips, else "shorter").
     fepatch: the fe2003 parameter set of the texture paths, "A" or "B" (their Table 1), or
-    "alpha_g1,d,l_outer,l_inner" in degrees and model units.
+    "alpha_g1,d,l_outer,l_inner" in degrees and model units. deleted: what is drawn of an
+    element deleted at the step (erosion, the mesh's ``"alive"`` field): "hide" (nothing) or
+    "ghost" (``base_color`` at opacity :data:`GHOST_ALPHA`, over the live elements).
 
     Refused with ValueError: more than 4 clip planes, a plane that is not 4 finite numbers with a
     non-zero normal, a negative step, a non-finite magnification, a crease angle outside
@@ -67,6 +71,7 @@ class Style:
     strip_cutoff: int = 1
     quad_diagonal: str = "auto"
     fepatch: str = "A"
+    deleted: str = "hide"
 
     def __post_init__(self) -> None:
         planes = np.asarray(self.clip_planes, np.float64).reshape(-1, 4) if len(self.clip_planes) \
@@ -93,6 +98,8 @@ class Style:
             setattr(self, name, color)
         if self.strips not in STRIPS:
             raise ValueError(f"strips must be one of {STRIPS}, got {self.strips!r}")
+        if self.deleted not in DELETED:
+            raise ValueError(f"deleted must be one of {DELETED}, got {self.deleted!r}")
         if self.quad_diagonal not in QUAD_DIAGONALS:
             raise ValueError(f"quad_diagonal must be one of {QUAD_DIAGONALS}, "
                              f"got {self.quad_diagonal!r}")

@@ -6,6 +6,8 @@ Built-in scenes are a registry, like render paths and experiments: a function de
 * ``car`` — the LS-DYNA car deck of the shared data; ``d3plot`` — the shared d3plot result;
 * ``crash[:S]`` — the car through a synthetic frontal crush of S states (default 8), its rigid
   parts held still, with node field ``displacement`` and element field ``plastic_strain``;
+  ``crash_eroded[:S]`` the same with erosion (element field ``alive``: a shell whose plastic
+  strain reaches :data:`CRASH_FAILURE_STRAIN` is deleted from that state on);
 * ``semicylinders[:N]`` — the es2008 benchmark, N×N quads per sheet (default 250: 1 M
   triangles; 64 quick);
 * ``panels[:Q]`` — generated stamped panels, about Q quads.
@@ -136,7 +138,8 @@ def load_mesh(spec: str, quick: bool = False, all_faces: bool = False) -> FEMesh
     scene = load_scene(spec, quick, all_faces)
     if scene.kind != "mesh":
         raise ValueError(f"{spec!r} is a {scene.kind} scene; this takes an FE mesh (a mesh file, "
-                         f"car, crash[:S], d3plot, semicylinders[:N] or panels[:Q])")
+                         f"car, crash[:S], crash_eroded[:S], d3plot, semicylinders[:N] or "
+                         f"panels[:Q])")
     return scene
 
 
@@ -188,6 +191,22 @@ def crash(size: int | None, quick: bool) -> FEMesh:
     rigid = [part for part, title in car.part_names.items() if "rigid" in title.lower()]
     crash = crash_sequence(car, steps=size or 8, still_parts=rigid)
     crash.name = "crash"
+    return crash
+
+
+CRASH_FAILURE_STRAIN = 2.5  # crash_eroded: about 2 % of the shells fail by the last state
+
+
+@builtin("crash_eroded", "the crash with erosion: a shell whose plastic strain reaches "
+                         f"{CRASH_FAILURE_STRAIN} is deleted from that state on", sized=True)
+def crash_eroded(size: int | None, quick: bool) -> FEMesh:
+    from .generators import crash_sequence
+
+    car = _shared_mesh("crash_eroded", CAR_DECK)
+    rigid = [part for part, title in car.part_names.items() if "rigid" in title.lower()]
+    crash = crash_sequence(car, steps=size or 8, still_parts=rigid,
+                           failure_strain=CRASH_FAILURE_STRAIN)
+    crash.name = "crash_eroded"
     return crash
 
 

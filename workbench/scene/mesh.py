@@ -25,6 +25,9 @@ if TYPE_CHECKING:
     from .derived import Triangulation
 
 
+ALIVE = "alive"  # the element field of erosion: 1 in use, 0 deleted
+
+
 class MeshError(ValueError):
     """An FE mesh that cannot be drawn or measured: empty, or with dangling node references."""
 
@@ -165,13 +168,62 @@ class FEMesh:
         values = self.element_fields[name]
         return values if values.ndim == 1 else values[0 if step is None else step]
 
-    def field_range(self, name: str) -> tuple[float, float]:
-        """(min, max) of a field over all steps, finite values only."""
+    def field_range(self, name: str, step: int | None = None) -> tuple[float, float]:
+        """(min, max) of a field over all steps (or at ``step`` only), finite values of live
+        elements only: with erosion (:attr:`erodes`) a deleted element's value, and a node's
+        value at a step where no live element uses it, take no part (a deleted shell keeps its
+        failure value). (0, 1) where no value is left."""
         values = self.node_fields.get(name)
+        per_node = values is not None
         if values is None:
             values = self.element_fields[name]
-        finite = values[np.isfinite(values)]
+        steps = range(self.n_steps) if step is None else [step]
+        if values.ndim == 2:
+            values = values[list(steps)]
+        keep = np.isfinite(values)
+        if self.erodes:
+            live = np.stack([self.live_nodes(t) if per_node else self.alive(t) for t in steps])
+            keep = keep & (live if values.ndim == 2 else live.any(axis=0))
+        finite = values[keep]
         return (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+
+    # ----------------------------------------------------------------- erosion
+    @property
+    def erodes(self) -> bool:
+        """Whether an element is deleted at some step: the element field ``"alive"`` (1 in
+        use, 0 deleted, as the d3plot reader gives it) holds a 0."""
+        alive = self.element_fields.get(ALIVE)
+        return alive is not None and bool((alive == 0).any())
+
+    def alive(self, step: int | None = None) -> np.ndarray:
+        """(M,) bool, the elements in use at ``step``: all of them without an ``"alive"``
+        field; with one, those whose value is not 0 (a missing value counts as in use)."""
+        if ALIVE not in self.element_fields:
+            return np.ones(self.n_elements, bool)
+        return self.element_field(ALIVE, step) != 0
+
+    def deleted_count(self, step: int | None = None) -> dict[int, int]:
+        """{part id: number of elements deleted at ``step``}, parts without one left out."""
+        deleted = ~self.alive(step)
+        parts, counts = np.unique(self.parts[deleted], return_counts=True)
+        return {int(p): int(c) for p, c in zip(parts, counts)}
+
+    def live_nodes(self, step: int | None = None) -> np.ndarray:
+        """(N,) bool, the nodes used by an element in use at ``step``."""
+        used = np.zeros(self.n_nodes, bool)
+        used[self.elements[self.alive(step)].ravel()] = True
+        return used
+
+    def live_edges(self, step: int | None = None) -> np.ndarray:
+        """(E,) bool over :attr:`edges`: the edges of an element in use at ``step``."""
+        from .derived import unique_edges
+
+        def keys(edges: np.ndarray) -> np.ndarray:
+            return (edges[:, 0].astype(np.int64) << 32) | edges[:, 1].astype(np.int64)
+
+        everything, live = keys(self.edges), keys(unique_edges(self.elements[self.alive(step)]))
+        at = np.minimum(np.searchsorted(live, everything), max(len(live) - 1, 0))
+        return (live[at] == everything) if len(live) else np.zeros(len(everything), bool)
 
     def used_nodes(self) -> np.ndarray:
         """Sorted indices of the nodes referenced by at least one element."""

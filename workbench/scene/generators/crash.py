@@ -16,7 +16,8 @@ _AXES = {"x": 0, "y": 1, "z": 2}
 
 def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str = "-x", *,
                    fold_wavelength: float | None = None, duration: float = 0.1,
-                   still_parts: Sequence[int] = ()) -> FEMesh:
+                   still_parts: Sequence[int] = (), failure_strain: float | None = None
+                   ) -> FEMesh:
     """A copy of ``mesh`` with ``steps`` time steps of a smooth, progressive front crush.
 
     The impactor comes from the ``axis`` side (one of "x", "y", "z", "-x", "-y", "-z": "x" makes
@@ -40,8 +41,12 @@ def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str
     yield, accumulated (it never decreases). Step 0 equals the input geometry; topology, parts and
     static fields are kept. ``still_parts``: part ids that do not move (a rigid barrier or pole);
     the front and extent are those of the other parts, and a node moves unless only still parts
-    use it. Refused: meshes that already have time steps, steps < 2, crush not in (0, 1), an
-    unknown axis, a model with no extent along the axis, only still parts.
+    use it. ``failure_strain`` (> 0): erosion as a crash code writes it, an element whose
+    plastic strain reaches it is deleted from that state on (element field ``"alive"``, 1 in
+    use and 0 deleted) and keeps the value it failed with (its ``plastic_strain`` is frozen).
+    Refused: meshes that already have time steps, steps < 2, crush not in (0, 1), an
+    unknown axis, a model with no extent along the axis, only still parts, a failure strain
+    that is not a positive number.
     """
     if mesh.steps is not None:
         raise MeshError(f"{mesh.name}: already has {mesh.n_steps} time steps; crash a static mesh")
@@ -63,6 +68,13 @@ def crash_sequence(mesh: FEMesh, steps: int = 20, crush: float = 0.25, axis: str
                       for key, v in mesh.element_fields.items()}
     node_fields["displacement"] = displacement
     element_fields["plastic_strain"] = strain
+    if failure_strain is not None:
+        failure_strain = _positive_float(failure_strain, "failure_strain")
+        failed = np.maximum.accumulate(strain >= failure_strain, axis=0)
+        first = np.argmax(failed, axis=0)  # the state each failed element failed in
+        strain[failed] = np.broadcast_to(strain[first, np.arange(strain.shape[1])],
+                                         strain.shape)[failed]
+        element_fields["alive"] = (~failed).astype(np.float64)
     return FEMesh(
         nodes=nodes.copy(),
         elements=mesh.elements,
