@@ -230,3 +230,13 @@ def test_the_exploded_path_hides_deleted_elements_and_keeps_its_parts(ctx):
     with pytest.raises(ValueError, match="exploded path hides deleted elements"):
         render(ctx, mesh, "exploded", make_path("exploded", focus=1, deleted="ghost").style,
                camera, SIZE, step=1)
+
+
+def test_the_fe2003_texture_path_says_it_draws_deleted_elements(ctx):
+    from workbench.paths.mesh import ErosionWarning
+
+    mesh = plate()
+    mesh.element_fields["alive"][0, 3] = 0  # deleted at the state the path draws
+    with pytest.warns(ErosionWarning, match="deletes 1 elements at step 0.*'fe_wire_texture' "
+                                            "draws one simplified surface"):
+        render(ctx, mesh, "fe_wire_texture", size=SIZE)

@@ -36,6 +36,7 @@ relative to ``camera.origin`` (float64 subtraction first); clip planes and the c
 
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING
 
 import moderngl
@@ -45,6 +46,7 @@ from ..algo.fepatch.mesh_model import fepatch_model
 from ..algo.fepatch.surface import CORNER_ROW, corner_rows
 from ..gl import Camera, load_program
 from .base import GLPath
+from .mesh import ErosionWarning
 
 if TYPE_CHECKING:
     from ..scene.protocol import Scene
@@ -133,6 +135,11 @@ class FETexturePath(GLPath):
     def _check_scene(self, scene) -> None:
         """Refuse the styles listed in the module docstring and an unusable surface."""
         self._check_style()
+        if getattr(scene, "erodes", False) and not scene.alive(self.style.step).all():
+            deleted = int((~scene.alive(self.style.step)).sum())
+            warnings.warn(f"{scene.name} deletes {deleted} elements at step {self.style.step} "
+                          f"(erosion); path {self.name!r} draws one simplified surface of every "
+                          f"element: the deleted ones are drawn", ErosionWarning, stacklevel=2)
         surface = self._surface_for(scene)
         self._check_surface(surface)
         self._surface = surface
