@@ -149,6 +149,25 @@ def test_info_names_the_renderer(capsys):
     assert "renderer" in out and "moderngl" in out
 
 
+def test_info_of_a_d3plot_lists_its_fields_and_deleted_elements(tmp_path, capsys):
+    """The lasso-written d3plot (two shells in parts 5 and 9; the triangle, part 9, deleted at
+    the last of three states): sizes, times, each field with its range over live elements,
+    and the deleted count per state and per part; a missing file is one line, exit 2."""
+    from meshes import write_d3plot
+
+    assert main(["info", str(write_d3plot(tmp_path))]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == "d3plot: 5 nodes, 2 elements, 2 parts, 3 states (units mm)"
+    assert "times: 0 .. 0.002" in out
+    assert "element field 'plastic_strain' (per state): 0 .. 0.02" in out
+    assert "element field 'alive': 1 in use, 0 deleted (erosion)" in out
+    assert "deleted elements (erosion), per state: 0, 0, 1" in out
+    assert [line for line in out if line.startswith("  part")] == ["  part 9: 0, 0, 1"]
+    assert main(["info", str(tmp_path / "missing.k")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "missing.k" in err
+
+
 def test_hausdorff_of_a_plate_and_its_lifted_copy(deck, tmp_path, capsys):
     lifted = tmp_path / "lifted.k"
     lifted.write_text(DECK.replace("             0.0\n", "             5.0\n"))

@@ -1,5 +1,7 @@
 """``workbench info``: the renderer, the OpenGL version, every EGL device of this machine, the
-versions of the libraries the workbench uses, and where the shared data is."""
+versions of the libraries the workbench uses, and where the shared data is; ``workbench info
+MESH``: what a mesh file or built-in scene holds (sizes, parts, states and times, the node and
+element fields with their ranges, and the elements deleted per part and state)."""
 
 from __future__ import annotations
 
@@ -18,6 +20,11 @@ def add_parser(subparsers) -> None:
     p = subparsers.add_parser("info",
                               help="renderer, OpenGL version, EGL devices, library versions, "
                                    "shared data")
+    p.add_argument("mesh", nargs="?", metavar="MESH",
+                   help="a mesh file or built-in scene: print what it holds instead (sizes, "
+                        "parts, states, fields, deleted elements per part and state)")
+    p.add_argument("--all-faces", action="store_true",
+                   help="with MESH: every face of its solids, not only their boundary")
     add_device_argument(p)
     p.set_defaults(func=cmd_info)
 
@@ -35,8 +42,56 @@ def device_table(devices) -> list[str]:
             for row in (header, *rows)]
 
 
+def mesh_lines(mesh) -> list[str]:
+    """What ``mesh`` (an :class:`~workbench.scene.mesh.FEMesh`) holds, a line each: sizes,
+    parts, states with their times, every field with its kind, shape and range over the live
+    elements (no value where it has none), and, where elements are deleted (erosion), the
+    count per state and part."""
+    import numpy as np
+
+    from ..scene.mesh import ALIVE
+
+    lines = [f"{mesh.name}: {mesh.n_nodes} nodes, {mesh.n_elements} elements, "
+             f"{len(np.unique(mesh.parts))} parts, {mesh.n_steps} state"
+             f"{'s' * (mesh.n_steps != 1)} (units {mesh.units})"]
+    if mesh.times is not None:
+        times = np.asarray(mesh.times, np.float64)
+        lines.append(f"times: {times[0]:.6g} .. {times[-1]:.6g}")
+    for kind, fields in (("node", mesh.node_fields), ("element", mesh.element_fields)):
+        for name in sorted(fields):
+            values = fields[name]
+            if name == ALIVE:
+                lines.append(f"element field {name!r}: 1 in use, 0 deleted (erosion)")
+                continue
+            lo, hi = mesh.field_range(name)
+            finite = np.isfinite(values).any()
+            per = "per state" if values.ndim == 2 else "static"
+            value = f"{lo:.6g} .. {hi:.6g}" if finite else "no value"
+            missing = int((~np.isfinite(values)).sum())
+            lines.append(f"{kind} field {name!r} ({per}): {value}"
+                         + (f", {missing} values without a result" if missing else ""))
+    if mesh.erodes:
+        lines.append("deleted elements (erosion), per state: " + ", ".join(
+            str(mesh.n_elements - int(mesh.alive(k).sum())) for k in range(mesh.n_steps)))
+        counts = [mesh.deleted_count(k) for k in range(mesh.n_steps)]
+        for part in sorted(set().union(*counts)):
+            title = mesh.part_names.get(part)
+            lines.append(f"  part {part}" + (f" ({title})" if title else "") + ": "
+                         + ", ".join(str(c.get(part, 0)) for c in counts))
+    else:
+        lines.append("deleted elements (erosion): none")
+    return lines
+
+
 def cmd_info(args) -> int:
-    """Print the renderer, the EGL devices, versions and the shared data folder; 0."""
+    """Print the renderer, the EGL devices, versions and the shared data folder (or, with a
+    mesh, what it holds: :func:`mesh_lines`); 0."""
+    if args.mesh is not None:
+        from ..scene.builtin import load_mesh
+
+        for line in mesh_lines(load_mesh(args.mesh, all_faces=args.all_faces)):
+            print(line)
+        return 0
     from ..data import shared_data_dir
     from ..gl import create_context, renderer
     from ..gl.context import gl_version, probed_devices
