@@ -240,3 +240,14 @@ def test_the_fe2003_texture_path_says_it_draws_deleted_elements(ctx):
     with pytest.warns(ErosionWarning, match="deletes 1 elements at step 0.*'fe_wire_texture' "
                                             "draws one simplified surface"):
         render(ctx, mesh, "fe_wire_texture", size=SIZE)
+
+
+def test_a_still_names_its_state_time_and_deleted_elements():
+    from workbench.cli.render import still_title
+
+    mesh = plate()
+    assert still_title(mesh, "flat", 0) == "plate (flat), state 0"
+    mesh.times = np.array([0.0, 2.5e-3])
+    assert still_title(mesh, "flat", 1) == "plate (flat), state 1, t = 0.0025, deleted: 5"
+    static = FEMesh(mesh.nodes, mesh.elements, name="static")
+    assert still_title(static, "gouraud", 0) == "static (gouraud)"

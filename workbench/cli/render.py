@@ -135,6 +135,20 @@ def _check_field_and_step(scene, args) -> None:
         raise ValueError(f"{scene.name} has {scene.n_steps} steps; --step {args.step} is outside")
 
 
+def still_title(mesh, path_name: str, step: int) -> str:
+    """The title of a still of ``mesh``: ``NAME (PATH)``, then for a mesh of several states
+    the state and its time (:func:`~workbench.animation.decoration.time_stamp`), and where the
+    state deletes elements ``deleted: N``."""
+    from ..animation.decoration import time_stamp
+
+    title = f"{mesh.name} ({path_name})"
+    if mesh.n_steps > 1:
+        time = None if mesh.times is None else float(mesh.times[step])
+        title += f", {time_stamp(step, time)}"
+    deleted = mesh.n_elements - int(mesh.alive(step).sum())
+    return title + (f", deleted: {deleted}" if deleted else "")
+
+
 def _render_options(args, kind: str) -> dict:
     """The path options of ``workbench render``: the mesh flags (mesh paths only; set on a
     spacetime path they are refused), ``--colormap`` and every ``--option``."""
@@ -236,7 +250,8 @@ def cmd_render(args) -> int:
     out = Path(args.output)
     field = args.field if args.field is not None else getattr(path.style, "field", None)
     write_image(out, image, path, field if is_mesh else None, args,
-                f"{scene.name} ({path_name})", scene=scene if is_mesh else None)
+                still_title(scene, path_name, args.step) if is_mesh
+                else f"{scene.name} ({path_name})", scene=scene if is_mesh else None)
     strips = f", {path.strips} strip{'s' * (path.strips != 1)}" if path.strips else ""
     print(f"{out}: {scene.name}, {path.triangles} triangles, {path.vertices_sent} "
           f"vertices sent{strips}, path {path_name}"
