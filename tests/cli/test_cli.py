@@ -282,18 +282,35 @@ def test_render_refuses_coordinates_too_far_to_resolve(tmp_path, capsys):
     assert "magnitude 1e+20" in err and "translate it nearer the origin" in err
 
 
-def test_a_missing_parameter_is_one_error_line_and_nothing_is_drawn(tmp_path):
+def test_an_include_without_its_thickness_parameter_draws_its_geometry_not_its_thickness(
+        tmp_path):
+    """A deck whose section thickness names a parameter it does not define (an include read
+    without its master deck): the geometry is drawn with one warning line naming the
+    parameter; drawing the thickness is refused in one line naming the parameter and the
+    master deck to read, and nothing is written."""
     deck = tmp_path / "part.k"
     deck.write_text(DECK.replace("*NODE", "*PART\np\n         1         1\n*SECTION_SHELL\n"
                                           "         1\n&t\n*NODE"))
-    out = tmp_path / "part.png"
-    result = subprocess.run([sys.executable, "-m", "workbench.cli", "render", str(deck),
-                             "--field", "thickness", "--size", "40x30", "-o", str(out)],
-                            capture_output=True, text=True)
+
+    def render(*options):
+        out = tmp_path / "part.png"
+        out.unlink(missing_ok=True)
+        result = subprocess.run([sys.executable, "-m", "workbench.cli", "render", str(deck),
+                                 "--size", "40x30", "-o", str(out), *options],
+                                capture_output=True, text=True)
+        return result, out
+
+    result, out = render()
+    assert result.returncode == 0 and out.exists()
+    warned = [line for line in result.stderr.splitlines() if line.strip()]
+    assert len(warned) == 1 and f"{deck}:7: *SECTION_SHELL: parameter 't' is not defined" in \
+        warned[0] and "the geometry is read" in warned[0]
+    result, out = render("--field", "thickness")
     assert result.returncode == 2 and not out.exists()
-    assert result.stderr.strip().splitlines() == [
-        f"workbench: error: {deck}:7: *SECTION_SHELL: parameter 't' is not defined by "
-        f"*PARAMETER in this deck or its includes (it defines no parameter) in '&t'"]
+    assert result.stderr.strip().splitlines()[-1] == (
+        f"workbench: error: thickness cannot be drawn: {deck}:7: the thickness of part 1 uses "
+        f"parameter 't', defined nowhere in this deck or its includes: read the master deck "
+        f"that defines it")
 
 
 @pytest.mark.parametrize("argv, message", [

@@ -6,10 +6,11 @@ from __future__ import annotations
 import signal
 from contextlib import contextmanager
 
+import numpy as np
 import pytest
 
 from workbench.cli import main
-from workbench.scene.readers import ParseError
+from workbench.scene.readers import ParseError, ParseWarning
 from workbench.scene.readers.keyword import read_keyword
 
 GUARD_S = 3  # a read that runs longer than this fails the test instead of hanging it
@@ -136,19 +137,31 @@ def test_what_is_not_arithmetic_is_refused_without_python_eval(tmp_path, text):
 
 
 # --------------------------------------------------------------------------- undefined, NaN
-def test_an_undefined_parameter_is_refused_with_its_name_and_line(tmp_path):
+def warned(path) -> ParseWarning:
+    """The one ParseWarning of reading ``path``, whose geometry is read, thickness missing."""
+    with time_limit(), pytest.warns(ParseWarning) as said:
+        mesh = read_keyword(path)
+    assert len(said) == 1 and mesh.n_elements == 1
+    assert np.isnan(mesh.element_fields["thickness"]).all()
+    return said[0].message
+
+
+def test_an_undefined_thickness_parameter_is_warned_with_its_name_and_line(tmp_path):
+    """An include read without the master deck that defines its thickness parameter: the
+    geometry is read; one warning names the parameter, its line, what is defined, the part."""
     card = f"{'R alpha':<10}{'1.0':<10}{'R beta':<10}2.0"
     path = deck(tmp_path, ["*PARAMETER", card], thickness="&gamma")
-    error = refused(path)
-    assert error.line == 9 and error.keyword == "SECTION_SHELL"
-    assert "parameter 'gamma' is not defined" in error.message
-    assert "defined: 'alpha', 'beta'" in error.message
+    warning = warned(path)
+    assert warning.line == 9 and warning.keyword == "SECTION_SHELL"
+    assert "parameter 'gamma' is not defined" in warning.message
+    assert "defined: 'alpha', 'beta'" in warning.message
+    assert "the shells of part 1 have no thickness" in warning.message
 
 
 def test_an_undefined_parameter_lists_a_few_of_those_defined(tmp_path):
     names = [f"R q{i:<8d}{i}.0" for i in range(12)]
-    error = refused(deck(tmp_path, ["*PARAMETER", *names], thickness="&t"))
-    assert "defined: 'q0', 'q1', 'q2', 'q3', 'q4' and 7 more" in error.message
+    warning = warned(deck(tmp_path, ["*PARAMETER", *names], thickness="&t"))
+    assert "defined: 'q0', 'q1', 'q2', 'q3', 'q4' and 7 more" in warning.message
 
 
 def test_an_undefined_parameter_in_an_expression_is_refused_at_its_line(tmp_path):

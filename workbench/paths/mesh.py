@@ -95,6 +95,8 @@ class MeshPath(GLPath):
 
     def _check_field(self, mesh) -> None:
         name = self.style.field
+        if name in getattr(mesh, "unavailable", {}):
+            raise ValueError(f"{name} cannot be drawn: {mesh.unavailable[name]}")
         if name is None:
             raise ValueError(f"path {self.name!r} draws a field: set Style.field to one of "
                              f"node fields {sorted(mesh.node_fields)} or element fields "

@@ -341,7 +341,8 @@ def _parameters(deck: StrictDeck, fmt: str, rows: list) -> None:
 
 # --------------------------------------------------------------------------- the mesh
 def _thickness_value(deck: StrictDeck, text: bytes) -> float:
-    """A section thickness field: a number or a (signed) ``&name`` parameter reference."""
+    """A section thickness field: a number or a (signed) ``&name`` parameter reference; NaN
+    (no thickness, the geometry still read) for a parameter the deck defines nowhere."""
     text = text.strip()
     sign = -1.0 if text.startswith(b"-") else 1.0
     bare = text.lstrip(b"+-")
@@ -350,7 +351,7 @@ def _thickness_value(deck: StrictDeck, text: bytes) -> float:
         folded = {k.lower(): k for k in deck.parameters}
         key = name if name in deck.parameters else folded.get(name.lower())
         if key is None:
-            raise Refused(f"parameter {name!r} is not defined")
+            return math.nan
         value = deck.parameters[key]
         if not isinstance(value, float):
             raise Refused(f"parameter {name!r} is not a number")

@@ -53,6 +53,9 @@ class FEMesh:
     element_ids: np.ndarray | None = None
     name: str = "mesh"
     units: str = "mm"
+    # fields whose values cannot be known from this file, with why (a thickness parameter
+    # defined in a master deck not read): drawn nowhere, refused where used
+    unavailable: dict[str, str] = field(default_factory=dict)
     # what render paths made the mesh derive, by cache key (see workbench.scene.needs)
     derived: dict[tuple[Any, ...], Any] = field(default_factory=dict, init=False, repr=False)
 
@@ -261,6 +264,7 @@ class FEMesh:
             element_ids=self.element_ids,
             name=self.name,
             units=self.units,
+            unavailable=dict(self.unavailable),
         )
 
     def part(self, part_id: int) -> FEMesh:
@@ -287,6 +291,7 @@ class FEMesh:
             element_ids=None if self.element_ids is None else self.element_ids[element_mask],
             name=name or self.name,
             units=self.units,
+            unavailable=dict(self.unavailable),
         )
 
     # ----------------------------------------------------------------- derived (cached)

@@ -8,6 +8,7 @@ it (its file and 1-based line), found again from the chunks of lines each block 
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -15,7 +16,7 @@ import numpy as np
 
 from ..mesh import FEMesh
 from .cards import _Chunk, _locate
-from .errors import ParseError, build_mesh
+from .errors import ParseError, ParseWarning, build_mesh
 
 if TYPE_CHECKING:
     from .parameters import _Parameters
@@ -89,8 +90,8 @@ def deck_mesh(deck: KeywordDeck, units: str, all_faces: bool = False) -> FEMesh:
     elements = _node_indices(refs, order, sorted_ids, shell_ids, deck.shell_chunks,
                              "ELEMENT_SHELL")
     _check_part_ids(pids, deck.shell_chunks, "ELEMENT_SHELL")
-    thickness, sections_used = (_shell_thickness(deck, pids, elements) if n_shells
-                                else (np.zeros(0), False))
+    thickness, sections_used, unknown = (_shell_thickness(deck, pids, elements) if n_shells
+                                         else (np.zeros(0), False, ""))
     if deck.solid_ids:
         faces, face_pids, face_ids = _solid_faces(deck, element_ids[n_shells:], xyz, order,
                                                   sorted_ids, all_faces)
@@ -108,7 +109,7 @@ def deck_mesh(deck: KeywordDeck, units: str, all_faces: bool = False) -> FEMesh:
     return build_mesh(deck.master, nodes=xyz, elements=elements, parts=pids,
                       element_fields=element_fields, part_names=part_names,
                       node_ids=node_ids, element_ids=shell_ids, name=deck.master.name,
-                      units=units)
+                      units=units, unavailable={"thickness": unknown} if unknown else {})
 
 
 def _solid_faces(deck, solid_ids: np.ndarray, xyz: np.ndarray, order: np.ndarray,
@@ -137,30 +138,48 @@ def _solid_faces(deck, solid_ids: np.ndarray, xyz: np.ndarray, order: np.ndarray
 
 
 def _shell_thickness(deck, pids: np.ndarray,
-                     elements: np.ndarray) -> tuple[np.ndarray, bool]:
+                     elements: np.ndarray) -> tuple[np.ndarray, bool, str]:
     """(M,) mean nodal thickness: element thickness cards, zeros and gaps from the section;
-    and whether a part's ``*SECTION_SHELL`` gave the thickness of its shells."""
+    whether a part's ``*SECTION_SHELL`` gave the thickness of its shells; and why some
+    thickness cannot be known ("" where all can): a section naming a parameter defined
+    nowhere in the deck, warned once a parameter (its parts' thickness NaN)."""
     nodal = np.concatenate(deck.shell_thickness)
     unique, inverse = np.unique(pids, return_inverse=True)
     section_of_part = {}
+    undefined: dict[str, tuple[Any, list[int]]] = {}  # name: (first section, its parts)
     for pid in unique.tolist():
         part = deck.parts.get(pid)
         section = None if part is None else deck.sections.get(part.secid)
         if section is None:
             continue
-        t = np.array([deck.parameters.thickness(text, section.src, section.row)
-                      for text in section.thickness])
+        names = list(map(deck.parameters.undefined, section.thickness))
+        for name in {n for n in names if n}:  # an include read without its master deck
+            undefined.setdefault(name, (section, []))[1].append(pid)
+        t = np.array([np.nan if name else
+                      deck.parameters.thickness(text, section.src, section.row)
+                      for name, text in zip(names, section.thickness)])
         t[1:][t[1:] == 0] = t[0]  # T2..T4 default to T1
         section_of_part[pid] = t
     fallback = np.full((len(pids), 4), np.nan)
     if section_of_part:
         table = np.array([section_of_part.get(p, [np.nan] * 4) for p in unique.tolist()])
         fallback = table[inverse.reshape(-1)]
+    for name, (section, parts) in undefined.items():  # one warning a parameter
+        warnings.warn(ParseWarning(
+            section.src.path, f"{deck.parameters.undefined_message(name)}: the geometry is "
+            f"read, the shells of part{'s' * (len(parts) > 1)} {', '.join(map(str, parts))} "
+            f"have no thickness (read the master deck that defines it for that)",
+            section.row + 1, "SECTION_SHELL"), stacklevel=2)
+    unknown = "; ".join(
+        f"{section.src.path}:{section.row + 1}: the thickness of part"
+        f"{'s' * (len(parts) > 1)} {', '.join(map(str, parts))} uses parameter {name!r}, "
+        f"defined nowhere in this deck or its includes: read the master deck that defines it"
+        for name, (section, parts) in undefined.items())
     use_section = np.isnan(nodal) | (nodal == 0)
     nodal = np.where(use_section, fallback, nodal)
     triangle = elements[:, 3] == elements[:, 2]
     return (np.where(triangle, nodal[:, :3].mean(axis=1), nodal.mean(axis=1)),
-            bool(section_of_part))
+            bool(section_of_part), unknown)
 
 
 def _node_indices(refs: np.ndarray, order: np.ndarray, sorted_ids: np.ndarray,

@@ -33,14 +33,19 @@ element ids may be any integers (written as integers, or integral decimals such 
 never with an exponent); they are kept in ``node_ids`` / ``element_ids`` and mapped to
 indices. Coordinates are taken as they are (millimetres by default).
 
+A section thickness that names a parameter defined nowhere (an include read without the master
+deck that defines it) is read as missing (NaN, the no-result colour) with one
+:class:`~workbench.scene.readers.errors.ParseWarning` per parameter naming it, its line, what is
+defined and the parts: the geometry is drawn.
+
 Refused with :class:`~workbench.scene.readers.errors.ParseError` (file, 1-based line, card text
 and what was expected): a malformed card, a NUL byte, the file's last card when the file may
 end inside it (no line end after it, and fewer columns, or no comma after the last field read),
 an element that names an undefined node, a blank, negative or undefined part id (a deck without
 any ``*PART`` is a mesh file whose part ids are kept), duplicate node or element ids, a deck
-without shell or solid elements, an undefined parameter, a missing or cyclic include or one
-nested deeper than :data:`MAX_INCLUDE_DEPTH` files, and the variants that would change the
-geometry if ignored
+without shell or solid elements, an undefined parameter in an expression, a missing or cyclic
+include or one nested deeper than :data:`MAX_INCLUDE_DEPTH` files, and the variants that would
+change the geometry if ignored
 (``*INCLUDE_TRANSFORM``, ``*ELEMENT_SHELL_COMPOSITE``, ...). Large blocks are converted column by
 column with numpy; the per-card Python path only runs for free-format cards and to locate an
 error.

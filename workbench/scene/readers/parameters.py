@@ -359,6 +359,15 @@ class _Parameters:
                             "SECTION_SHELL")
         return number
 
+    def undefined(self, text: bytes) -> str | None:
+        """The parameter name of a (signed) ``&name`` thickness field whose parameter is
+        defined nowhere in the deck and its includes; None for anything else."""
+        text = text.strip().lstrip(b"+-")
+        if not text.startswith(b"&"):
+            return None
+        name = text[1:].decode("utf-8", "replace").strip()
+        return name if name and self._key(name) is None else None
+
     def value(self, name: str, src: _Source, row: int) -> float:
         """The number parameter ``name`` stands for (names are case-insensitive), evaluating
         ``*PARAMETER_EXPRESSION`` arithmetic; ParseError at line ``row`` of ``src`` for a name
@@ -378,6 +387,11 @@ class _Parameters:
         if name in self.values:
             return name
         return self.folded.get(name.lower())
+
+    def undefined_message(self, name: str) -> str:
+        """``parameter 'name' is not defined by *PARAMETER in this deck or its includes
+        (defined: ...)``."""
+        return self._undefined(name)
 
     def _undefined(self, name: str) -> str:
         defined = list(self.values)
