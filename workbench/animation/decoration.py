@@ -35,6 +35,12 @@ if TYPE_CHECKING:
     from .frames import Frame
 
 
+def state_stamp(step: int, time: float | None, deleted: int = 0, time_units: str = "") -> str:
+    """:func:`time_stamp`, then ``, deleted: N`` where the state deletes elements (erosion)."""
+    stamp = time_stamp(step, time, time_units)
+    return stamp + (f", deleted: {deleted}" if deleted else "")
+
+
 def time_stamp(step: int, time: float | None, time_units: str = "") -> str:
     """``state K, t = T UNITS`` (T to 6 significant digits; no unit where none is given, the
     reader's time unit then being the model's), or ``state K`` for a mesh without times."""
@@ -77,9 +83,8 @@ class Decoration:
         """(H', W', 3) uint8: ``frame.image`` with its time stamp ("deleted: N" after it where
         the state deletes elements), and its colour bar where the decoration has a field and
         the frame a value range."""
-        title = f"{self.title}, {time_stamp(frame.step, frame.time, self.time_units)}"
-        if frame.deleted:
-            title += f", deleted: {frame.deleted}"
+        title = (f"{self.title}, "
+                 f"{state_stamp(frame.step, frame.time, frame.deleted, self.time_units)}")
         if self.field is not None and frame.value_range is not None:
             fig = field_figure(frame.image, value_range=frame.value_range,
                                colormap=self.colormap, label=self.field, units=self.units,

@@ -238,9 +238,8 @@ class FrameLoop:
         return no_result_label(count, per) if count else None
 
     def deleted(self, step: int) -> int:
-        """The number of elements deleted in state ``step`` (0 for a scene without erosion)."""
-        alive = getattr(self.mesh, "alive", None)
-        return 0 if alive is None else int(self.mesh.n_elements - alive(step).sum())
+        """The number of elements deleted in state ``step`` (0 for a mesh without erosion)."""
+        return self.mesh.n_deleted(step)
 
     def time_of(self, step: int) -> float | None:
         """The mesh's time of state ``step`` (None for a mesh without times)."""

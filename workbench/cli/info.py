@@ -72,7 +72,7 @@ def mesh_lines(mesh) -> list[str]:
                          + (f", {missing} values without a result" if missing else ""))
     if mesh.erodes:
         lines.append("deleted elements (erosion), per state: " + ", ".join(
-            str(mesh.n_elements - int(mesh.alive(k).sum())) for k in range(mesh.n_steps)))
+            str(mesh.n_deleted(k)) for k in range(mesh.n_steps)))
         counts = [mesh.deleted_count(k) for k in range(mesh.n_steps)]
         for part in sorted(set().union(*counts)):
             title = mesh.part_names.get(part)

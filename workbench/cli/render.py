@@ -137,16 +137,15 @@ def _check_field_and_step(scene, args) -> None:
 
 def still_title(mesh, path_name: str, step: int) -> str:
     """The title of a still of ``mesh``: ``NAME (PATH)``, then for a mesh of several states
-    the state and its time (:func:`~workbench.animation.decoration.time_stamp`), and where the
-    state deletes elements ``deleted: N``."""
-    from ..animation.decoration import time_stamp
+    the state, its time and where the state deletes elements ``deleted: N``
+    (:func:`~workbench.animation.decoration.state_stamp`, as the animated frames)."""
+    from ..animation.decoration import state_stamp
 
-    title = f"{mesh.name} ({path_name})"
-    if mesh.n_steps > 1:
-        time = None if mesh.times is None else float(mesh.times[step])
-        title += f", {time_stamp(step, time)}"
-    deleted = mesh.n_elements - int(mesh.alive(step).sum())
-    return title + (f", deleted: {deleted}" if deleted else "")
+    title, deleted = f"{mesh.name} ({path_name})", mesh.n_deleted(step)
+    if mesh.n_steps == 1 and not deleted:
+        return title
+    time = None if mesh.times is None else float(mesh.times[step])
+    return f"{title}, {state_stamp(step, time, deleted)}"
 
 
 def _render_options(args, kind: str) -> dict:

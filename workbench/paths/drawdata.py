@@ -82,6 +82,7 @@ class MeshDrawData:
     ``element_vertex`` (M,) the vertex carrying each element's value; ``attributes`` static
     per-vertex float32 arrays (data, format, name); ``edges`` (E, 2) int32 vertex pairs of the
     line-overdraw wire frame (None without); ``triangle_element`` as :class:`Layout`.
+    ``erodes``: whether the mesh deletes elements at some step, read once when made.
     """
 
     mesh: FEMesh
@@ -101,6 +102,10 @@ class MeshDrawData:
     attributes: list[tuple[np.ndarray, str, str]] = field(default_factory=list)
     edges: np.ndarray | None = None
     triangle_element: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        # whether the mesh deletes elements at some step, decided once (not per step)
+        self.erodes = bool(self.mesh.erodes)
 
     # ------------------------------------------------------------------ per step
     def shown_coordinates(self, step: int) -> np.ndarray:
@@ -176,14 +181,14 @@ class MeshDrawData:
         """(T,) bool over the triangle list, the triangles of elements in use at ``step``;
         None where the mesh deletes no element or the layout is strips (no
         ``triangle_element``): everything is drawn (:class:`~.mesh.ErosionWarning`)."""
-        if not self.mesh.erodes or self.triangle_element is None:
+        if not self.erodes or self.triangle_element is None:
             return None
         return self.mesh.alive(step)[self.triangle_element]
 
     def live_edges(self, step: int) -> np.ndarray | None:
         """(E,) bool over ``edges``, the wire-frame edges of elements in use at ``step``; None
         without erosion or without a wire frame."""
-        if self.edges is None or not self.mesh.erodes:
+        if self.edges is None or not self.erodes:
             return None
         return self.mesh.live_edges(step)
 

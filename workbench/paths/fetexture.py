@@ -135,8 +135,8 @@ class FETexturePath(GLPath):
     def _check_scene(self, scene) -> None:
         """Refuse the styles listed in the module docstring and an unusable surface."""
         self._check_style()
-        if getattr(scene, "erodes", False) and not scene.alive(self.style.step).all():
-            deleted = int((~scene.alive(self.style.step)).sum())
+        deleted = scene.n_deleted(self.style.step) if getattr(scene, "erodes", False) else 0
+        if deleted:
             warnings.warn(f"{scene.name} deletes {deleted} elements at step {self.style.step} "
                           f"(erosion); path {self.name!r} draws one simplified surface of every "
                           f"element: the deleted ones are drawn", ErosionWarning, stacklevel=2)

@@ -65,6 +65,7 @@ class MeshPath(GLPath):
     split: ClassVar[bool] = False
     field_per: ClassVar[str | None] = None
     style: Style
+    _ghost_vao = None  # the ghost pass of deleted elements (Style.deleted = "ghost"), if any
 
     @classmethod
     def default_camera(cls, scene: Scene, size: tuple[int, int], *,
@@ -229,6 +230,12 @@ class MeshPath(GLPath):
             uploaded += self._line_pass(ctx, self._positions, data.edges)
         if data.static_values:
             uploaded += self._upload_values(style.step)
+        if style.deleted == "ghost" and data.live_triangles(style.step) is not None:
+            self._ghost_vao = self._keep(ctx.vertex_array(
+                self._keep(load_program(ctx, "position.vert.glsl", "ghost.frag.glsl",
+                                        defines={"NUM_CLIP": len(style.clip_planes)})),
+                [(self._positions, "3f", "position")], self._index, index_element_size=4))
+            self._ghost_vao.program["ghost_color"].value = (*style.base_color, GHOST_ALPHA)
         self._set_clip_planes()
         self.set_camera(camera)
         self.bytes_per_step = self.set_step(style.step)
@@ -279,7 +286,7 @@ class MeshPath(GLPath):
             return 0
         index, self._fill_vertices = self._live_index(live)
         self._index.write(index.tobytes())
-        self.deleted = int(self.mesh.n_elements - self.mesh.alive(step).sum())
+        self.deleted = self.mesh.n_deleted(step)
         sent = index.nbytes
         edges = self.data.live_edges(step)
         if edges is not None:
@@ -311,8 +318,14 @@ class MeshPath(GLPath):
     def draw(self) -> None:
         self.ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
         self._render(self.mode)
-        if self.style.deleted == "ghost" and self._fill_vertices >= 0:
+        if self._ghost_vao is not None:
             self._draw_ghosts()
+
+    def _programs(self) -> list:
+        """The fill and line programs, and the ghost pass's where there is one (its camera and
+        clip planes set with theirs)."""
+        ghost = [] if self._ghost_vao is None else [self._ghost_vao.program]
+        return [*super()._programs(), *ghost]
 
     def _draw_ghosts(self) -> None:
         """The deleted elements' triangles (behind the live ones in the index buffer) in
@@ -321,17 +334,6 @@ class MeshPath(GLPath):
         if count <= 0:
             return
         ctx = self.ctx
-        if self._ghost_vao is None:
-            program = self._keep(load_program(ctx, "position.vert.glsl", "ghost.frag.glsl",
-                                              defines={"NUM_CLIP": len(self.style.clip_planes)}))
-            program["ghost_color"].value = (*self.style.base_color, GHOST_ALPHA)
-            self._ghost_vao = self._keep(ctx.vertex_array(
-                program, [(self._positions, "3f", "position")], self._index,
-                index_element_size=4))
-        program = self._ghost_vao.program
-        for name in ("mvp", "clip_planes"):
-            if name in self._uniforms(program) and name in self._uniforms(self._program):
-                program[name].value = self._program[name].value
         ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
         ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
         with self._clip_distances(len(self.style.clip_planes)):

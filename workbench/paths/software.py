@@ -212,7 +212,7 @@ class SoftwarePath(RenderPath):
             self._live_triangles = self._triangles[live]
             if self._triangle_values is not None:
                 self._live_values = self._triangle_values[live]
-        self.deleted = 0 if live is None else int(mesh.n_elements - mesh.alive(step).sum())
+        self.deleted = 0 if live is None else mesh.n_deleted(step)
         self.step = step
         return sum(a.nbytes for a in (self._positions, self._normals, self._values,
                                       self._triangle_values) if a is not None)

@@ -205,6 +205,10 @@ class FEMesh:
             return np.ones(self.n_elements, bool)
         return self.element_field(ALIVE, step) != 0
 
+    def n_deleted(self, step: int | None = None) -> int:
+        """The number of elements deleted at ``step`` (0 without erosion)."""
+        return self.n_elements - int(self.alive(step).sum())
+
     def deleted_count(self, step: int | None = None) -> dict[int, int]:
         """{part id: number of elements deleted at ``step``}, parts without one left out."""
         deleted = ~self.alive(step)
