@@ -251,3 +251,36 @@ def test_a_still_names_its_state_time_and_deleted_elements():
     assert still_title(mesh, "flat", 1) == "plate (flat), state 1, t = 0.0025, deleted: 5"
     static = FEMesh(mesh.nodes, mesh.elements, name="static")
     assert still_title(static, "gouraud", 0) == "static (gouraud)"
+
+
+def test_a_state_that_keeps_the_deleted_elements_sends_no_index(ctx):
+    """The index buffers are written only where the elements in use change: a state deleting
+    what the state drawn before deleted sends the coordinates alone, and every state, in any
+    order, draws the image of a fresh preparation at that state."""
+    from workbench.animation.frames import draw_frames
+    from workbench.paths import prepared
+
+    mesh = plate()
+    steps = np.concatenate([mesh.steps, mesh.steps[1:] + [0.0, 0.0, 0.5]])
+    alive = mesh.element_fields["alive"][[0, 1, 1]]
+    mesh = FEMesh(mesh.nodes, mesh.elements, mesh.parts, steps,
+                  element_fields={"alive": alive}, name="plate")
+    camera = default_camera(mesh, SIZE)
+    order = [0, 1, 2, 0, 2, 1]
+
+    def fresh(step):
+        return render(ctx, mesh, "flat", make_path("flat", wireframe=True).style, camera,
+                      SIZE, step=step)
+
+    with prepared(ctx, mesh, "flat", make_path("flat", wireframe=True).style, camera,
+                  SIZE) as ready:
+        images, sent = [], []
+        for step in order:
+            drawn = next(draw_frames(ready, [step], update=ready.path.set_step))
+            images.append(drawn.image)
+            sent.append(drawn.sent)
+    for step, image in zip(order, images):
+        np.testing.assert_array_equal(image, fresh(step))
+    coordinates = mesh.n_nodes * 3 * 4
+    assert sent[2] == coordinates  # 1 -> 2: the same elements deleted, no index
+    assert min(sent[1], sent[3], sent[4]) > coordinates  # the elements in use changed

@@ -37,6 +37,8 @@ from workbench.paths.colormap import (
     mark_missing,
     missing_count,
     no_result_label,
+    no_result_text,
+    parts_without_result,
     scale_colour_mask,
     scale_colour_pixels,
 )
@@ -179,6 +181,9 @@ def test_labels_and_counts(mesh):
     assert no_result_label(1, "node") == "no result: 1 node"
     assert no_result_label(12, "element") == "no result: 12 elements"
     assert no_result_label(3, None) == "no result"
+    assert no_result_label(12, "element", [8]) == "no result: 12 elements, part 8"
+    assert no_result_label(9, "element", [1, 2, 3, 4, 5]) == \
+        "no result: 9 elements, parts 1, 2, 3 +2"
     assert missing_count(mesh, "f_block") == (30, "node")
     assert missing_count(mesh, "f_steps", 0) == (0, "node")
     assert missing_count(mesh, "c_rigid") == (int((mesh.parts == 2).sum()), "element")
@@ -405,6 +410,30 @@ def test_extreme_values_draw_scale_colours_alike(ctx, name, field, value_range):
 # --------------------------------------------------------------------------- legends
 def bar_column_green(image, left):
     return int((image[:, left:, :3] == GREEN).all(axis=-1).sum())
+
+
+def test_the_legend_names_the_parts_without_any_result(mesh):
+    # part 2 has no value of c_rigid at all; f_block lacks values in a block of nodes only
+    # (both parts keep some); f_rigid has values at the nodes part 2 shares with part 1, but
+    # every element of part 2 has a node without one, so it is drawn without a result
+    assert parts_without_result(mesh, "c_rigid") == [2]
+    assert parts_without_result(mesh, "f_rigid") == [2]
+    assert parts_without_result(mesh, "f_block") == []
+    n = int((mesh.parts == 2).sum())
+    assert no_result_text(mesh, "c_rigid") == f"no result: {n} elements, part 2"
+    assert no_result_text(mesh, "c") is None
+    # a deleted element of part 2 with a value does not give part 2 a result
+    values = mesh.element_fields["c_rigid"].copy()
+    first = int(np.flatnonzero(mesh.parts == 2)[0])
+    values[first] = 1.0
+    alive = np.ones(mesh.n_elements)
+    alive[first] = 0.0
+    eroded = FEMesh(mesh.nodes, mesh.elements, mesh.parts,
+                    element_fields={"c_rigid": values, "alive": alive})
+    assert parts_without_result(eroded, "c_rigid") == [2]
+    alive[first] = 1.0
+    assert parts_without_result(FEMesh(mesh.nodes, mesh.elements, mesh.parts, element_fields={
+        "c_rigid": values, "alive": alive}), "c_rigid") == []
 
 
 def test_the_colour_bar_states_the_no_result_colour():

@@ -431,3 +431,47 @@ def test_the_live_view_hides_a_deleted_shell_at_its_state(ctx, tmp_path):
     covered = (eroded != 255).any(axis=-1).sum()
     assert 0 < covered < (before != 255).any(axis=-1).sum()
 
+
+
+def test_the_viewer_states_the_state_and_shows_the_colour_bar(make_view, tmp_path):
+    """The stamp above the canvas follows the step slider (time and deleted elements); the
+    colour bar beside it is the scale drawn, as tall as the frame, and shows the no-result key
+    with the rigid part where a part has no result."""
+    import io
+
+    import matplotlib
+    from meshes import write_d3plot
+    from PIL import Image
+
+    from workbench.paths.colormap import NO_RESULT_COLOR, no_result_text
+    from workbench.scene.readers import load
+
+    for name in ("eroded", "rigid"):
+        (tmp_path / name).mkdir()
+    mesh = load(write_d3plot(tmp_path / "eroded"))
+    viewer = make_view(mesh, field="von_mises", units="MPa", time_units="s")
+    assert viewer.stamp.value == f"{mesh.name}, state 0, t = 0 s"
+    viewer.controls["step"].value = 2
+    assert viewer.stamp.value == f"{mesh.name}, state 2, t = 0.002 s, deleted: 1"
+    bar = np.asarray(Image.open(io.BytesIO(viewer.bar.value)).convert("RGB"))
+    assert bar.shape[0] == viewer.live.size[1] + 20  # the frame's height and its margins
+    # the bar's middle column, top to bottom, runs through viridis from its top colour to its
+    # bottom one (the ends within 8 % of the map: matplotlib resamples its 256 colours to the
+    # bar's height; the two rows at each end are the bar's antialiased frame)
+    column = bar[:, 12 + 9].astype(int)
+    column = column[(column != 255).any(axis=-1) & (column != 0).any(axis=-1)][2:-2]  # frame
+    lut = np.rint(matplotlib.colormaps["viridis"](np.arange(256))[:, :3] * 255)
+    gap = np.abs(column[:, None] - lut[None]).max(axis=-1)
+    index = gap.argmin(axis=1)
+    assert gap.min(axis=1).max() <= 8 and len(column) > 50
+    assert index[0] >= 235 and index[-1] <= 20 and (np.diff(index) <= 0).all()
+    green = np.array(NO_RESULT_COLOR) * 255
+    assert not (bar == green).all(axis=-1).any()  # every shell has a value
+    assert make_view(plate()).bar.layout.display == "none"  # no field, no bar
+
+    rigid = load(write_d3plot(tmp_path / "rigid", rigid=True))
+    assert no_result_text(rigid, "von_mises") == "no result: 1 element, part 9"
+    viewer = make_view(rigid, field="von_mises")
+    bar = np.asarray(Image.open(io.BytesIO(viewer.bar.value)).convert("RGB"))
+    assert (bar == green).all(axis=-1).sum() > 50
+    assert viewer.live.stamp() == "state 0, t = 0"

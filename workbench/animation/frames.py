@@ -42,7 +42,7 @@ import numpy as np
 
 from ..paths.backends import as_backend
 from ..paths.base import RenderPath
-from ..paths.colormap import missing_count, no_result_label
+from ..paths.colormap import no_result_text
 from ..paths.drawing import WHITE, Prepared, prepared
 from ..paths.mesh import MeshPath
 from ..paths.registry import make_path, path_class
@@ -231,11 +231,11 @@ class FrameLoop:
 
     def no_result(self, step: int) -> str | None:
         """The legend text of the field's non-finite values in state ``step``
-        (:func:`~workbench.paths.colormap.no_result_label`); None where there are none."""
+        and the parts without any (:func:`~workbench.paths.colormap.no_result_text`); None where
+        there are none."""
         if self.field is None:
             return None
-        count, per = missing_count(self.mesh, self.field, step)
-        return no_result_label(count, per) if count else None
+        return no_result_text(self.mesh, self.field, step)
 
     def deleted(self, step: int) -> int:
         """The number of elements deleted in state ``step`` (0 for a mesh without erosion)."""

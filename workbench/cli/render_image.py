@@ -10,17 +10,15 @@ def write_image(out: Path, image, path, field: str | None, args, title: str,
                 scene=None) -> None:
     """``image`` as a PNG at ``out``: with a colour bar of ``field`` when there is one and a
     colour scale, unless ``--raw``; where ``scene`` (the mesh drawn, at ``args.step``) has
-    non-finite values of the field, the bar states the no-result colour and their count."""
+    non-finite values of the field, the bar states the no-result colour, their count and
+    the parts without any value."""
     from ..output.figures import save_field_figure, save_png
-    from ..paths.colormap import missing_count, no_result_label
+    from ..paths.colormap import no_result_text
 
     out.parent.mkdir(parents=True, exist_ok=True)
     scale = getattr(path, "scale", None)
     if field is not None and not args.raw and scale is not None:
-        no_result = None
-        if scene is not None:
-            count, per = missing_count(scene, field, args.step)
-            no_result = no_result_label(count, per) if count else None
+        no_result = None if scene is None else no_result_text(scene, field, args.step)
         save_field_figure(out, image, value_range=scale.value_range,
                           colormap=path.style.colormap, label=field, units=args.units,
                           title=title, bands=args.bands, no_result=no_result)

@@ -196,8 +196,6 @@ def field_figure(image: ArrayLike, *, value_range: tuple[float, float],
     non-uint8 image, an empty or non-finite range, a non-positive range with ``log`` and a
     negative band count.
     """
-    from matplotlib.ticker import FuncFormatter
-
     image = _check_image(image)
     mappable, edges = _mappable(value_range, colormap, bands, log)
     image = enlarge(image, display_scale(image.shape[0]))
@@ -205,19 +203,45 @@ def field_figure(image: ArrayLike, *, value_range: tuple[float, float],
     top = TITLE_HEIGHT if title else MARGIN
     fig = new_figure(MARGIN + w + BAR_GAP + BAR_WIDTH + BAR_LABELS, MARGIN + h + top)
     show(axes_px(fig, MARGIN, MARGIN, w, h), image)
-    key = NO_RESULT_KEY if no_result else 0
-    bar = fig.colorbar(mappable, cax=axes_px(fig, MARGIN + w + BAR_GAP, MARGIN + key,
-                                              BAR_WIDTH, h - key))
-    if no_result:
-        _no_result_key(fig, MARGIN + w + BAR_GAP, MARGIN, no_result)
-    if edges is not None and bands <= 12:
-        bar.set_ticks(edges)
-        bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
-    bar.set_label(f"{label} [{units}]" if units else label)
+    _bar(fig, MARGIN + w + BAR_GAP, h, mappable, edges, bands, label, units, no_result)
     if title:
         fig.text(0.5, 1.0 - (TITLE_HEIGHT / 2) / (MARGIN + h + top), title, ha="center",
                  va="center")
     return fig
+
+
+def colour_bar(height: int, *, value_range: tuple[float, float],
+               colormap: str | Colormap | ArrayLike, label: str, units: str = "",
+               bands: int = 0, log: bool = False, no_result: str | None = None) -> np.ndarray:
+    """(H, W, 3) uint8: the colour bar of :func:`field_figure` alone, for an image ``height``
+    pixels high (its bar as tall as the image, the margins around it), on white: what a live
+    view shows beside its frames. Refuses what :func:`field_figure` refuses and a height under
+    ``2 * NO_RESULT_KEY`` pixels."""
+    if height < 2 * NO_RESULT_KEY:
+        raise ValueError(f"a colour bar needs a height of {2 * NO_RESULT_KEY} pixels or more, "
+                         f"got {height}")
+    mappable, edges = _mappable(value_range, colormap, bands, log)
+    fig = new_figure(BAR_GAP + BAR_WIDTH + BAR_LABELS, height + 2 * MARGIN)
+    _bar(fig, BAR_GAP, height, mappable, edges, bands, label, units, no_result)
+    fig.canvas.draw()
+    return np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
+
+
+def _bar(fig, left: int, height: int, mappable, edges, bands: int, label: str, units: str,
+         no_result: str | None) -> None:
+    """The colour bar of ``mappable`` at pixel column ``left``, ``height`` pixels from the
+    bottom margin up, ticked at the band ``edges`` (up to 12 bands), labelled ``label
+    [units]``, the no-result key under it where ``no_result`` is given."""
+    from matplotlib.ticker import FuncFormatter
+
+    key = NO_RESULT_KEY if no_result else 0
+    bar = fig.colorbar(mappable, cax=axes_px(fig, left, MARGIN + key, BAR_WIDTH, height - key))
+    if no_result:
+        _no_result_key(fig, left, MARGIN, no_result)
+    if edges is not None and bands <= 12:
+        bar.set_ticks(edges)
+        bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
+    bar.set_label(f"{label} [{units}]" if units else label)
 
 
 def _no_result_key(fig, left: int, bottom: int, text: str) -> None:

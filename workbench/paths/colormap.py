@@ -284,13 +284,51 @@ def missing_count(mesh: FEMesh, field: str, step: int = 0) -> tuple[int, str]:
     return int((~np.isfinite(mesh.element_field(field, step))).sum()), "element"
 
 
-def no_result_label(count: int, per: str | None = "node") -> str:
+def no_result_label(count: int, per: str | None = "node", parts=()) -> str:
     """The legend text of the no-result colour: ``no result: 1 node``, ``no result: 12
-    elements`` (``per`` "node" or "element"; None or a count below 0 gives ``no result``)."""
+    elements`` (``per`` "node" or "element"; None or a count below 0 gives ``no result``),
+    followed by the ``parts`` that have no value at all (a rigid part of a d3plot):
+    ``no result: 120 elements, part 8`` (at most :data:`LISTED_PARTS` named, then ``+K``)."""
     count = int(count)
     if per is None or count < 0:
         return "no result"
-    return f"no result: {count} {per}{'s' * (count != 1)}"
+    text = f"no result: {count} {per}{'s' * (count != 1)}"
+    parts = [int(p) for p in parts]
+    if parts:
+        named = ", ".join(str(p) for p in parts[:LISTED_PARTS])
+        more = f" +{len(parts) - LISTED_PARTS}" if len(parts) > LISTED_PARTS else ""
+        text += f", part{'s' * (len(parts) > 1)} {named}{more}"
+    return text
+
+
+LISTED_PARTS = 3  # parts named in a no-result label before the rest are counted
+
+
+def parts_without_result(mesh: FEMesh, field: str, step: int = 0) -> list[int]:
+    """The part ids (ascending) of ``mesh`` none of whose elements has a finite value of
+    ``field`` at ``step`` (the rigid parts of a d3plot, which carry no stress, strain or
+    thickness): for an element field its elements' values; for a node field an element has a
+    value where all its nodes have one (a triangle with a node without one is drawn whole in
+    the no-result colour). Deleted elements (erosion) count as neither. KeyError for a field
+    the mesh lacks."""
+    if field in mesh.node_fields:
+        finite = np.isfinite(mesh.node_field(field, step))[mesh.elements].all(axis=1)
+    else:
+        finite = np.isfinite(mesh.element_field(field, step))
+    live = mesh.alive(step)
+    parts = mesh.parts[live]
+    with_value = np.unique(parts[finite[live]])
+    return [int(p) for p in np.setdiff1d(np.unique(parts), with_value)]
+
+
+def no_result_text(mesh: FEMesh, field: str, step: int = 0) -> str | None:
+    """The no-result legend text of ``field`` drawn on ``mesh`` at ``step``
+    (:func:`no_result_label` with :func:`missing_count` and :func:`parts_without_result`), or
+    None where every value is finite."""
+    count, per = missing_count(mesh, field, step)
+    if not count:
+        return None
+    return no_result_label(count, per, parts_without_result(mesh, field, step))
 
 
 def scale_colour_mask(image: ArrayLike, scale: ColorScale, *, light: tuple[float, float] = (

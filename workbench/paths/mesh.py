@@ -238,6 +238,7 @@ class MeshPath(GLPath):
             self._ghost_vao.program["ghost_color"].value = (*style.base_color, GHOST_ALPHA)
         self._set_clip_planes()
         self.set_camera(camera)
+        self._live_shown = None  # the triangles in use that the index buffers hold (erosion)
         self.bytes_per_step = self.set_step(style.step)
         self.bytes_uploaded = uploaded + self.bytes_per_step
 
@@ -280,13 +281,17 @@ class MeshPath(GLPath):
     def _upload_live(self, step: int) -> int:
         """With erosion, write the triangles (and wire-frame edges) of the elements in use at
         ``step`` to the front of their index buffers and draw only those; the bytes sent (the
-        whole index buffer: the same every step)."""
+        whole index buffer, or nothing where the step keeps the elements of the step drawn
+        before: the buffers hold them already)."""
         live = self.data.live_triangles(step)
         if live is None:
             return 0
+        self.deleted = self.mesh.n_deleted(step)
+        if self._live_shown is not None and np.array_equal(live, self._live_shown):
+            return 0
+        self._live_shown = live
         index, self._fill_vertices = self._live_index(live)
         self._index.write(index.tobytes())
-        self.deleted = self.mesh.n_deleted(step)
         sent = index.nbytes
         edges = self.data.live_edges(step)
         if edges is not None:

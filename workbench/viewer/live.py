@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..animation.decoration import state_stamp
 from ..animation.frames import draw_frames
 from ..gl import create_context
 from ..paths.drawing import WHITE, Prepared, prepared
@@ -73,6 +74,8 @@ class LiveView:
     ``gouraud``, or with a ``field`` ``pixel_color`` for a node field and ``element_color`` for
     an element field) with the style options ``style``, in frames of ``size`` (W, H) pixels,
     on a new EGL context on device ``device`` (see :func:`workbench.gl.create_context`).
+    ``units`` and ``time_units`` label the colour bar (:meth:`legend`) and the state's time
+    (:meth:`stamp`).
 
     The first view is :meth:`Camera.fit_box` at ``angles`` (azimuth, elevation in degrees),
     ``projection`` and ``up`` axis. The exploded path without a ``focus`` focuses the lowest
@@ -83,8 +86,9 @@ class LiveView:
     def __init__(self, scene: Any, path: str | None = None, *,
                  size: tuple[int, int] = (800, 600), device: int | str | None = None,
                  angles: tuple[float, float] = (30.0, 25.0), projection: str = "orthographic",
-                 up: str = "z", **style: Any) -> None:
+                 up: str = "z", units: str = "", time_units: str = "", **style: Any) -> None:
         self.scene = as_mesh(scene)
+        self.units, self.time_units = units, time_units
         self.path_name = scene_path(self.scene, path, style.get("field"))
         self.options = dict(style)
         self.step = int(self.options.pop("step", 0))
@@ -226,6 +230,34 @@ class LiveView:
             return None
         with self.ctx:
             return self.path.pick(column, row, self.size)
+
+    # ------------------------------------------------------------------ legends
+    def stamp(self) -> str:
+        """The current state as every still and frame states it: ``state K, t = T`` (the
+        mesh's time of the state, in ``time_units``), then ``, deleted: N`` where elements
+        are deleted in it (:func:`~workbench.animation.decoration.state_stamp`)."""
+        times = self.scene.times
+        time = None if times is None else float(times[self.step])
+        return state_stamp(self.step, time, self.scene.n_deleted(self.step), self.time_units)
+
+    def legend(self) -> np.ndarray | None:
+        """(H, W, 3) uint8 the colour bar of the drawn field as tall as the frames (its scale,
+        bands, ``field [units]`` and the no-result key of the current state, as ``workbench
+        render`` draws it: :func:`~workbench.output.figures.colour_bar`); None for a path
+        without a colour scale (or frames too low to hold a bar)."""
+        from ..output.figures import NO_RESULT_KEY, colour_bar
+        from ..paths.colormap import no_result_text
+
+        path = self.path
+        scale = getattr(path, "scale", None)
+        if scale is None or self.size[1] < 2 * NO_RESULT_KEY:
+            return None
+        field, scene = path.style.field, self.scene
+        known = field in scene.node_fields or field in scene.element_fields
+        no_result = no_result_text(scene, field, self.step) if known else None
+        return colour_bar(self.size[1], value_range=scale.value_range,
+                          colormap=path.style.colormap, label=field or "value",
+                          units=self.units, bands=path.style.bands, no_result=no_result)
 
     # ------------------------------------------------------------------ frames
     def frame(self) -> np.ndarray:

@@ -130,16 +130,22 @@ class ViewCanvas(RemoteFrameBuffer):
 
 
 class Viewer(widgets.VBox):
-    """The canvas (``canvas``, a :class:`ViewCanvas`) above the controls that apply to its
-    path (``controls``: name → ipywidget, among "step", "bands", "value_range", "threshold",
-    "focus") and a one-line ``status``; ``live`` is the :class:`LiveView` drawn."""
+    """The state's ``stamp`` (state, time, deleted elements: :meth:`LiveView.stamp`) above the
+    canvas (``canvas``, a :class:`ViewCanvas`) and its colour bar (``bar``, a PNG image of
+    :meth:`LiveView.legend`, hidden for a path without a colour scale), then the controls that
+    apply to its path (``controls``: name → ipywidget, among "step", "bands", "value_range",
+    "threshold", "focus") and a one-line ``status``; ``live`` is the :class:`LiveView` drawn.
+    The stamp and the bar follow every change of step or style."""
 
     def __init__(self, live: LiveView, **kwargs: Any) -> None:
         canvas = ViewCanvas(live)
         status = widgets.Label("")
+        self.stamp, self.bar = widgets.Label(""), widgets.Image(format="png")
         controls = _controls(live)
-        super().__init__([canvas, widgets.HBox(list(controls.values())), status], **kwargs)
+        super().__init__([self.stamp, widgets.HBox([canvas, self.bar]),
+                          widgets.HBox(list(controls.values())), status], **kwargs)
         self.live, self.canvas, self.controls, self.status = live, canvas, controls, status
+        self._show_legend()
         actions = dict(step=live.set_step, bands=lambda v: live.restyle(bands=v),
                        value_range=lambda v: live.restyle(value_range=tuple(v)),
                        threshold=lambda v: live.restyle(threshold=v),
@@ -164,9 +170,18 @@ class Viewer(widgets.VBox):
                 self.status.value = f"refused: {exc}"
                 return
             self.status.value = ""
+            self._show_legend()
             self.canvas.request_draw()
 
         return observe
+
+    def _show_legend(self) -> None:
+        """The stamp and the colour bar of the current state and style."""
+        self.stamp.value = f"{self.live.scene.name}, {self.live.stamp()}"
+        legend = self.live.legend()
+        self.bar.layout.display = "none" if legend is None else None
+        if legend is not None:
+            self.bar.value = _png(legend)
 
     def close(self) -> None:
         """Free the view's GL objects and context and close the canvas and this box; closing
@@ -204,6 +219,17 @@ def _controls(live: LiveView) -> dict[str, widgets.Widget]:
         controls["focus"] = widgets.Dropdown(options=[int(p) for p in path.part_ids],
                                              value=style.focus, description="focus part")
     return controls
+
+
+def _png(image: np.ndarray) -> bytes:
+    """``image`` (H, W, 3) uint8 as PNG bytes."""
+    import io
+
+    from PIL import Image
+
+    buffer = io.BytesIO()
+    Image.fromarray(image).save(buffer, format="PNG")
+    return buffer.getvalue()
 
 
 def view(scene: Any, path: str | None = None, *, size: tuple[int, int] = (800, 600),
