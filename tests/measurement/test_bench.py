@@ -3,13 +3,22 @@
 unchanged re-run."""
 
 import re
+import sys
 import textwrap
 from pathlib import Path
 
 import pytest
 
 from workbench.cli import main
-from workbench.measurement.bench import BENCHMARKS, Bench, Case, benchmark, discover, run_benchmark
+from workbench.measurement.bench import (
+    BENCHMARKS,
+    Bench,
+    Case,
+    benchmark,
+    discover,
+    get_benchmark,
+    run_benchmark,
+)
 from workbench.results.compare import compare_runs
 from workbench.results.store import ResultsStore
 
@@ -170,3 +179,18 @@ def test_a_converted_benchmark_runs_at_its_quick_size():
     hexes = result.rows[0]
     assert (hexes["solids"], hexes["faces"]) == (20**3, 6 * 20**2)  # the quick size
     assert all(r["repeats"] == 5 and r["solids_per_s"] > 0 for r in result.rows)
+
+
+def test_the_eroding_d3plot_benchmark_reads_back_the_deletions_it_wrote():
+    # the d3plot written with lasso-python and read by the workbench's reader deletes, state by
+    # state, exactly the elements the crash it was written from deletes
+    discover()
+    eroding_d3plot = sys.modules[get_benchmark("eroding_d3plot").function.__module__]
+    result = run_benchmark("eroding_d3plot", "quick", overrides={"k": 1, "states": 6})
+    crash = eroding_d3plot.eroding_crash(1, 6)
+    scene = next(r for r in result.rows if r["function"] == "scene")
+    assert scene["deleted"] == " ".join(str(crash.n_deleted(s)) for s in range(6))
+    assert crash.n_deleted(5) > 0 and scene["shells"] == crash.n_elements
+    timed = {(r["path"], r["function"]) for r in result.rows if "wall_ms" in r}
+    assert timed == {(p, f"{w} {t}") for p in ("flat", "element_color")
+                     for w in ("eroding", "plain") for t in ("upload", "draw")}
