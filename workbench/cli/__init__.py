@@ -1,6 +1,7 @@
-"""The ``workbench`` command: info, doctor, render, animate, hausdorff, simplify, list, run,
-reproduce, explode, sweep, stress, results and bench, one module per command (:data:`COMMANDS`),
-each adding its own parser (``add_parser(subparsers)``) that calls its ``cmd_<command>(args)``.
+"""The ``workbench`` command: info, doctor, render, animate, hausdorff, simplify, penetrations,
+list, run, reproduce, explode, sweep, stress, results and bench, one module per command
+(:data:`COMMANDS`), each adding its own parser (``add_parser(subparsers)``) that calls its
+``cmd_<command>(args)``.
 
 Bad input (an unreadable or malformed mesh file, an empty mesh, a missing OpenGL driver, an
 unknown name) ends with a one-line message on stderr and exit status 2, never a traceback (set
@@ -20,8 +21,8 @@ from .arguments import EXIT_BAD_INPUT, OneLineParser, refused
 
 # the command modules, in the order their commands are listed; imported when the parser is
 # built, so that ``python -m workbench.cli.sweep`` runs a module not yet imported
-COMMANDS = ("info", "doctor", "render", "animate", "hausdorff", "simplify", "experiments",
-            "explode", "sweep", "stress", "results", "bench")
+COMMANDS = ("info", "doctor", "render", "animate", "hausdorff", "simplify", "penetrations",
+            "experiments", "explode", "sweep", "stress", "results", "bench")
 # where the names of the former single-module command line are now
 _MOVED = {"cmd_info": "info", "VERSIONED": "info", "cmd_render": "render",
           "cmd_hausdorff": "hausdorff", "cmd_simplify": "simplify", "cmd_list": "experiments",

@@ -149,6 +149,7 @@ class Viewer(widgets.VBox):
         actions = dict(step=live.set_step, bands=lambda v: live.restyle(bands=v),
                        value_range=lambda v: live.restyle(value_range=tuple(v)),
                        threshold=lambda v: live.restyle(threshold=v),
+                       depth_range=lambda v: live.restyle(depth_range=v),
                        focus=lambda v: live.restyle(focus=v))
         for name, control in controls.items():
             control.observe(self._applying(actions[name]), names="value")
@@ -210,7 +211,12 @@ def _controls(live: LiveView) -> dict[str, widgets.Widget]:
         controls["value_range"] = widgets.FloatRangeSlider(
             value=scale.value_range, min=lo, max=hi, step=(hi - lo) / 200,
             description="range", continuous_update=False, readout_format=".3g")
-    if isinstance(path, FlangePath):
+    if isinstance(path, FlangePath) and style.by_thickness:  # the threshold is the thickness
+        controls["depth_range"] = widgets.FloatSlider(
+            value=style.depth_range, min=style.depth_range / 50, max=10 * style.depth_range,
+            step=style.depth_range / 50, description="depth range", continuous_update=False,
+            readout_format=".3g")
+    elif isinstance(path, FlangePath):
         controls["threshold"] = widgets.FloatSlider(
             value=style.threshold, min=style.cutoff / 500, max=style.cutoff,
             step=style.cutoff / 500, description="threshold", continuous_update=False,

@@ -60,6 +60,11 @@ def _bv_distance_sq(bv, node, p0, p1, p2, obb):
     return d
 
 
+# the squared point/bounding-volume distance under its public name, for searches of other
+# criteria over the same forest (:mod:`workbench.algo.nearest.penetrations`)
+bv_distance_sq = _bv_distance_sq
+
+
 @numba.njit(cache=True, inline="always")
 def _is_excluded(node, node_part, own, o0, o1):
     q = node_part[node]
