@@ -201,3 +201,93 @@ def write_d3plot(folder, rigid=False):
     path = folder / "d3plot"
     plot.write_d3plot(str(path))
     return path
+
+
+# adversarial stress tensors (xx, yy, zz, xy, yz, zx), all exact in float32: zero, hydrostatic,
+# repeated eigenvalues, pure shear (trace 0), compression, and a large hydrostatic part under a
+# small deviator (float32 holds 1e6 to 1/16)
+ADVERSARIAL_STRESSES = np.array([
+    [0, 0, 0, 0, 0, 0],
+    [250, 250, 250, 0, 0, 0],
+    [-80, -80, -80, 0, 0, 0],
+    [100, 0, 0, 0, 0, 0],  # uniaxial: s2 = s3
+    [120, 120, 0, 0, 0, 0],  # equibiaxial: s1 = s2
+    [0, 0, 0, 40, 0, 0],  # pure shear
+    [10, -10, 0, 0, 0, 0],  # pure shear, trace 0 in the diagonal
+    [-300, -50, -20, 15, 0, 0],
+    [1e6, 1e6 + 0.0625, 1e6, 0.0625, 0, 0],
+    [-1e6, -1e6, -1e6 + 0.125, 0, 0.0625, 0.0625],
+    [1e6, 1e6, 1e6, 0, 0, 0],
+    [3, 3, 3, 1, 1, 1],  # eigenvalues 5, 2, 2
+], np.float32)
+
+
+def write_rich_d3plot(folder, seed=0, permute=False, rename_node=None):
+    """A four-state d3plot written with lasso-python into ``folder`` (its path): parts 5 (a
+    2 x 2 quad plate), 9 (two quads and a triangle sharing the plate's right edge) and 12
+    (rigid: one quad, the fourth shell, without stress, strain or thickness); node ids
+    101, 104, ... and shell ids 1001, 1003, ...; coordinates, velocities and accelerations
+    drawn from ``seed``; shell stress on three layers (mid, inner, outer) starting with
+    :data:`ADVERSARIAL_STRESSES`, then random tensors; plastic strain on three layers;
+    thickness; the triangle deleted at the last state, with the largest stress (its failure
+    value) there. ``permute`` (True or a seed): the same model with nodes and shells stored
+    in another order (every id kept with its node or shell);
+    ``rename_node``: (old id, new id) changed in the file."""
+    from lasso.dyna import ArrayType, D3plot
+
+    rng = np.random.default_rng(seed)
+    n_states = 4
+    coords = np.array([[x, y, 0] for y in range(3) for x in range(3)]
+                      + [[3, 0, 0], [3, 1, 0], [4, 1, 0], [0, -1, 0], [1, -1, 0]], np.float32)
+    quads = np.array([[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7],
+                      [0, 13, 12, 12],  # placeholder, replaced below (rigid quad)
+                      [2, 9, 10, 5], [5, 10, 8, 8], [9, 11, 10, 10]], np.int32)
+    quads[4] = [12, 13, 1, 0]  # the rigid quad below the plate, sharing nodes 0 and 1
+    part_index = np.array([0, 0, 0, 0, 2, 1, 1, 1], np.int32)
+    node_ids = 101 + 3 * np.arange(len(coords))
+    shell_ids = 1001 + 2 * np.arange(len(quads))
+    if rename_node is not None:
+        node_ids[node_ids == rename_node[0]] = rename_node[1]
+    n_shells, deformable = len(quads), part_index != 2
+    moved = coords[None] + rng.normal(0, 0.1, (n_states, len(coords), 3)).cumsum(axis=0)
+    moved[0] = coords
+    stress = rng.normal(0, 200, (n_states, n_shells, 3, 6))
+    flat = stress[:, deformable].reshape(-1, 6)
+    flat[:len(ADVERSARIAL_STRESSES)] = ADVERSARIAL_STRESSES
+    stress[:, deformable] = flat.reshape(n_states, -1, 3, 6)
+    stress[-1, 6] *= 20
+    strain = rng.uniform(0, 0.3, (n_states, n_shells, 3))
+    thickness = rng.uniform(0.8, 1.6, (n_states, n_shells))
+    alive = np.ones((n_states, n_shells))
+    alive[-1, 6] = 0
+    velocity = rng.normal(0, 5, (n_states, len(coords), 3))
+    acceleration = rng.normal(0, 50, (n_states, len(coords), 3))
+    node_order = np.arange(len(coords))
+    shell_order = np.arange(n_shells)
+    if permute is not False:
+        order = np.random.default_rng(100 + int(permute))
+        node_order, shell_order = order.permutation(len(coords)), order.permutation(n_shells)
+    new_index = np.argsort(node_order)  # where each original node is stored
+    plot = D3plot()
+    a = plot.arrays
+    a[ArrayType.node_coordinates] = coords[node_order]
+    a[ArrayType.node_ids] = node_ids[node_order].astype(np.int32)
+    a[ArrayType.element_shell_node_indexes] = new_index[quads[shell_order]].astype(np.int32)
+    a[ArrayType.element_shell_part_indexes] = part_index[shell_order]
+    a[ArrayType.element_shell_ids] = shell_ids[shell_order].astype(np.int32)
+    a[ArrayType.part_ids] = np.array([5, 9, 12], np.int32)
+    a[ArrayType.part_material_type] = np.array([3, 24, 20], np.int32)
+    a[ArrayType.global_timesteps] = np.arange(n_states, dtype=np.float32) * 1e-3
+    a[ArrayType.node_displacement] = moved[:, node_order].astype(np.float32)
+    a[ArrayType.node_velocity] = velocity[:, node_order].astype(np.float32)
+    a[ArrayType.node_acceleration] = acceleration[:, node_order].astype(np.float32)
+    kept = deformable[shell_order]
+    a[ArrayType.element_shell_stress] = stress[:, shell_order][:, kept].astype(np.float32)
+    a[ArrayType.element_shell_effective_plastic_strain] = \
+        strain[:, shell_order][:, kept].astype(np.float32)
+    a[ArrayType.element_shell_thickness] = thickness[:, shell_order][:, kept].astype(np.float32)
+    a[ArrayType.element_shell_is_alive] = alive[:, shell_order].astype(np.float32)
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / "d3plot"
+    plot.write_d3plot(str(path))
+    return path

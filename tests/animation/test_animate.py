@@ -68,14 +68,18 @@ def test_frames_equal_render_of_each_state(ctx, crash, mesh, tmp_path, path, fie
 def test_bytes_per_state_are_the_paths_bytes_per_step(ctx, mesh, path, field, per_vertex):
     """Coordinates (12 bytes a vertex), normals (12) where the path lights per vertex, field
     values (4) where it colours, and the index of the triangles (12 a triangle: the d3plot
-    deletes a shell at its last state, live triangles are written first): set_step's bytes,
-    the prepared path's bytes_per_step and the measured row's alike."""
+    deletes a shell at its last state, live triangles are written first) at a state whose
+    elements in use change: the prepared path's bytes_per_step and the measured row's alike;
+    the states that keep the elements of the state before send no index."""
     style = make_path(path, field=field).style
     loop, frames = frames_of(ctx, mesh, path, style)
     row = measure(ctx, mesh, path, style, size=SIZE, timed=False).row
-    for frame in frames:
-        assert frame.bytes_uploaded == frame.bytes_per_step == row["bytes_per_step"]
-    assert row["bytes_per_step"] == row["vertices"] * per_vertex + 12 * row["triangles"]
+    index = 12 * row["triangles"]
+    assert row["bytes_per_step"] == row["vertices"] * per_vertex + index
+    assert [f.deleted for f in frames] == [0, 0, 1]
+    assert [f.bytes_uploaded for f in frames] == [row["bytes_per_step"] - index] * 2 + [
+        row["bytes_per_step"]]
+    assert all(f.bytes_per_step == row["bytes_per_step"] for f in frames)
     assert loop.prepare_bytes == row["bytes_uploaded"] > row["bytes_per_step"]
     assert all(f.upload_ms >= 0 and f.draw_ms > 0 for f in frames)
 

@@ -207,7 +207,7 @@ def test_comments_case_unknown_keywords_and_end(tmp_path):
         "$ comment inside a block",
         node(*SQUARE[4]),
         "*ELEMENT_BEAM",
-        "       1       1       1       2       3",
+        "       1       1     101     102     103",
         "*element_shell",
         shell(1, 1, 101, 102, 103, 104),
         "",
@@ -216,7 +216,7 @@ def test_comments_case_unknown_keywords_and_end(tmp_path):
         "this would not parse",
     ])
     mesh = load(path)
-    assert mesh.n_nodes == 5 and mesh.n_elements == 1
+    assert mesh.n_nodes == 5 and mesh.n_elements == 1 and mesh.beams.count == 1
 
 
 def test_triangles(tmp_path):

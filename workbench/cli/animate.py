@@ -17,6 +17,7 @@ import sys
 from typing import NamedTuple
 
 from .arguments import add_device_argument, image_size, key_value, view_angles
+from .field_options import add_field_arguments, load_with_fields
 
 
 class StateSelection(NamedTuple):
@@ -91,7 +92,9 @@ def add_parser(subparsers) -> None:
     p.add_argument("--path", metavar="PATH",
                    help="render path (default: gouraud; pixel_color or element_color with "
                         "--field): any mesh path but flange and exploded")
-    p.add_argument("--field", help="node or element field to colour by")
+    p.add_argument("--field", help="node or element field to colour by (a d3plot's fields: "
+                                    "workbench render --help)")
+    add_field_arguments(p)
     p.add_argument("--steps", type=state_selection, metavar="A:B:S",
                    help="states drawn, as a Python slice: from A (inclusive, default 0) to B "
                         "(exclusive, default the number of states) every S (default 1); "
@@ -157,12 +160,11 @@ def cmd_animate(args) -> int:
     from ..gl import create_context
     from ..output.video import check_even, video_target, write_video
     from ..paths.registry import scene_path
-    from ..scene.builtin import load_mesh
 
     out = video_target(args.output)
     if out.suffix.lower() == ".mp4":
         check_even(args.size, "--size")
-    mesh = load_mesh(args.mesh)
+    mesh, args.field = load_with_fields(args, mesh_only=True)
     steps = args.steps.states(mesh) if args.steps is not None else list(range(mesh.n_steps))
     path_name = scene_path(mesh, args.path, args.field, source=args.mesh)
     check_animated_path(path_name)

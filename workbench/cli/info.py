@@ -42,13 +42,15 @@ def device_table(devices) -> list[str]:
             for row in (header, *rows)]
 
 
-def mesh_lines(mesh) -> list[str]:
+def mesh_lines(mesh, offered=()) -> list[str]:
     """What ``mesh`` (an :class:`~workbench.scene.mesh.FEMesh`) holds, a line each: sizes,
     parts, states with their times, every field with its kind, shape and range over the live
-    elements (no value where it has none), and, where elements are deleted (erosion), the
-    count per state and part."""
+    elements (no value where it has none), the fields of ``offered`` (names its file can give
+    on request) it does not hold, and, where elements are deleted (erosion), the count per
+    state and part."""
     import numpy as np
 
+    from ..scene.kinds import kind_lines
     from ..scene.mesh import ALIVE
 
     lines = [f"{mesh.name}: {mesh.n_nodes} nodes, {mesh.n_elements} elements, "
@@ -57,6 +59,7 @@ def mesh_lines(mesh) -> list[str]:
     if mesh.times is not None:
         times = np.asarray(mesh.times, np.float64)
         lines.append(f"times: {times[0]:.6g} .. {times[-1]:.6g}")
+    lines += kind_lines(mesh)  # beams and SPH particles, where the mesh has them
     for kind, fields in (("node", mesh.node_fields), ("element", mesh.element_fields)):
         for name in sorted(fields):
             values = fields[name]
@@ -70,6 +73,11 @@ def mesh_lines(mesh) -> list[str]:
             missing = int((~np.isfinite(values)).sum())
             lines.append(f"{kind} field {name!r} ({per}): {value}"
                          + (f", {missing} values without a result" if missing else ""))
+    more = [name for name in offered if name not in mesh.node_fields
+            and name not in mesh.element_fields]
+    if more:
+        lines.append(f"fields on request (render --field NAME, --layer for the layered; "
+                     f"render --help says what each is): {', '.join(more)}")
     if mesh.erodes:
         lines.append("deleted elements (erosion), per state: " + ", ".join(
             str(mesh.n_deleted(k)) for k in range(mesh.n_steps)))
@@ -88,8 +96,11 @@ def cmd_info(args) -> int:
     mesh, what it holds: :func:`mesh_lines`); 0."""
     if args.mesh is not None:
         from ..scene.builtin import load_mesh
+        from ..scene.readers.d3plot_fields import offered_by_file
+        from .field_options import is_d3plot
 
-        for line in mesh_lines(load_mesh(args.mesh, all_faces=args.all_faces)):
+        offered = offered_by_file(args.mesh) if is_d3plot(args.mesh) else ()
+        for line in mesh_lines(load_mesh(args.mesh, all_faces=args.all_faces), offered):
             print(line)
         return 0
     from ..data import shared_data_dir

@@ -19,6 +19,7 @@ from .arguments import (
     key_value,
     view_angles,
 )
+from .field_options import add_field_arguments, fields_epilog, load_with_fields
 from .render_image import check_drawn, check_extent, write_image
 
 # workbench.distributed.sortlast.METHODS, not imported here: it imports Dask
@@ -44,10 +45,11 @@ def add_parser(subparsers) -> None:
                "\nany option of a path's style: --option KEY=VALUE (e.g. "
                "--option edge_overdraw=skirts"
                "\n  --option height_scale=800 for a spacetime path, "
-               "--option clip_planes=((1,0,0,0),))")
+               "--option clip_planes=((1,0,0,0),))\n" + fields_epilog())
     p.add_argument("mesh", help="mesh file, built-in scene name or chunked scene folder")
     p.add_argument("-o", "--output", required=True, help="PNG file to write")
-    p.add_argument("--field", help="node or element field to colour by")
+    p.add_argument("--field", help="node or element field to colour by (a d3plot's: below)")
+    add_field_arguments(p)
     p.add_argument("--path", metavar="PATH",
                    help="render path (default: gouraud; pixel_color or element_color with --field; "
                         "spacetime_pixel on a spacetime scene); listed below")
@@ -217,7 +219,6 @@ def cmd_render(args) -> int:
     """Draw the scene, write ``--output``, print what was drawn; 0."""
     from ..paths import as_backend, make_path, path_class, render
     from ..paths.registry import scene_path
-    from ..scene.builtin import load_scene
     from .render_sortlast import (
         check_write_chunked,
         is_chunked_scene,
@@ -230,7 +231,7 @@ def cmd_render(args) -> int:
     if chunked:
         return render_chunked_scene(args)
     check_write_chunked(args)
-    scene = load_scene(args.mesh, all_faces=args.all_faces)
+    scene, args.field = load_with_fields(args, all_faces=args.all_faces)
     is_mesh = scene.kind == "mesh"
     if is_mesh:
         _check_field_and_step(scene, args)

@@ -46,6 +46,7 @@ from ..algo.fepatch.mesh_model import fepatch_model
 from ..algo.fepatch.surface import CORNER_ROW, corner_rows
 from ..gl import Camera, load_program
 from .base import GLPath
+from .kinds import warn_not_drawn
 from .mesh import ErosionWarning
 
 if TYPE_CHECKING:
@@ -140,6 +141,8 @@ class FETexturePath(GLPath):
             warnings.warn(f"{scene.name} deletes {deleted} elements at step {self.style.step} "
                           f"(erosion); path {self.name!r} draws one simplified surface of every "
                           f"element: the deleted ones are drawn", ErosionWarning, stacklevel=2)
+        if getattr(scene, "kind", None) == "mesh":
+            warn_not_drawn(scene, f"path {self.name!r}")  # beams and SPH particles
         surface = self._surface_for(scene)
         self._check_surface(surface)
         self._surface = surface

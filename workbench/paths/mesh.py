@@ -31,6 +31,7 @@ from ..gl import Camera, load_program
 from .base import GLPath
 from .colormap import NO_RESULT_COLOR, ColorScale, scale_for
 from .drawdata import Layout, MeshDrawData, Topology, compact, vertex_of_node
+from .kinds import build_overlay, warn_not_drawn
 from .style import GHOST_ALPHA, Style
 
 if TYPE_CHECKING:
@@ -66,6 +67,7 @@ class MeshPath(GLPath):
     field_per: ClassVar[str | None] = None
     style: Style
     _ghost_vao = None  # the ghost pass of deleted elements (Style.deleted = "ghost"), if any
+    _kinds = None  # the beams and SPH particles drawn over the surface (paths.kinds), if any
 
     @classmethod
     def default_camera(cls, scene: Scene, size: tuple[int, int], *,
@@ -236,6 +238,7 @@ class MeshPath(GLPath):
                                         defines={"NUM_CLIP": len(style.clip_planes)})),
                 [(self._positions, "3f", "position")], self._index, index_element_size=4))
             self._ghost_vao.program["ghost_color"].value = (*style.base_color, GHOST_ALPHA)
+        self._kinds = build_overlay(self, ctx, mesh, draws=type(self).draw is MeshPath.draw)
         self._set_clip_planes()
         self.set_camera(camera)
         self._live_shown = None  # the triangles in use that the index buffers hold (erosion)
@@ -275,6 +278,8 @@ class MeshPath(GLPath):
         if self.field_per is not None and not self.data.static_values:
             sent += self._upload_values(step)
         sent += self._upload_live(step)
+        if self._kinds is not None:
+            sent += self._kinds.set_step(step, shown, self.origin)
         self.step = step
         return sent
 
@@ -323,6 +328,8 @@ class MeshPath(GLPath):
     def draw(self) -> None:
         self.ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
         self._render(self.mode)
+        if self._kinds is not None:
+            self._kinds.draw(self._clip_distances(len(self.style.clip_planes)))
         if self._ghost_vao is not None:
             self._draw_ghosts()
 
@@ -330,7 +337,8 @@ class MeshPath(GLPath):
         """The fill and line programs, and the ghost pass's where there is one (its camera and
         clip planes set with theirs)."""
         ghost = [] if self._ghost_vao is None else [self._ghost_vao.program]
-        return [*super()._programs(), *ghost]
+        kinds = [] if self._kinds is None else self._kinds.programs
+        return [*super()._programs(), *ghost, *kinds]
 
     def _draw_ghosts(self) -> None:
         """The deleted elements' triangles (behind the live ones in the index buffer) in
@@ -363,6 +371,8 @@ class MeshPath(GLPath):
                 self.style.hide_range is not None:
             raise ValueError(f"path {self.name!r} draws domains of a triangle list without a "
                              f"wire frame or hidden range (strips {self.style.strips!r})")
+        if self._kinds is not None:
+            warn_not_drawn(self.mesh, "a sort-last domain (draw_triangles)")
         ids = np.asarray(ids, np.int64)
         index = np.ascontiguousarray(data.triangle_list()[ids], np.int32)
         if not len(index):

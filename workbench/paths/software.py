@@ -14,7 +14,8 @@ protocol (prepare, set_camera, set_step, draw, release) so that
 
 Refused with ValueError: a path that is not a mesh path, a wire frame (a GL line pass),
 strips (a GL index layout; the triangles are the same without), a perspective camera (the
-rasterizer is orthographic, as es2008's), MSAA samples.
+rasterizer is orthographic, as es2008's), MSAA samples. Beams and SPH particles are not
+drawn: a :class:`~workbench.paths.kinds.KindWarning` names them with their counts.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import numpy as np
 from ..algo.softraster import Frame, RasterOptions, Shading, render
 from . import colormap
 from .base import RenderPath
+from .kinds import warn_not_drawn
 from .registry import path_class
 
 if TYPE_CHECKING:
@@ -149,6 +151,7 @@ class SoftwarePath(RenderPath):
         if camera.projection != "orthographic":
             raise ValueError("the software rasterizer draws orthographic views only")
         data = self._drawn.draw_data(mesh)
+        warn_not_drawn(mesh, "the software rasterizer")  # beams and SPH particles: GL only
         if style.deleted == "ghost" and mesh.erodes:
             raise ValueError("the software rasterizer hides deleted elements; "
                              "deleted='ghost' (translucent) is drawn on GL only")

@@ -8,8 +8,9 @@ It decodes what the reader reads of the suite's decks — ``*KEYWORD`` formats, 
 and plain ``*PARAMETER`` — and applies the reader's documented rules (see
 :mod:`workbench.scene.readers.keyword`): what the reader must refuse, a triangle's blank n4,
 the mean nodal thickness with the section's T1..T4 where a card gives none. A deck with a
-keyword it does not decode (solids, thick shells, includes, expressions, part and section
-variants) is :class:`BeyondReference`, so that no check passes by decoding less.
+keyword it does not decode (solids, thick shells, beams, SPH particles, includes, expressions,
+part and section variants) is :class:`BeyondReference`, so that no check passes by decoding
+less.
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ _SHELL = (8,) * 10
 _THICK = (16,) * 4
 _TEN = (10,) * 8
 _SHELL_OPTIONS = {"THICKNESS", "BETA", "MCID", "OFFSET"}
-_BEYOND = ("ELEMENT_SOLID", "ELEMENT_TSHELL", "INCLUDE", "PARAMETER_EXPRESSION")
+_BEYOND = ("ELEMENT_SOLID", "ELEMENT_TSHELL", "ELEMENT_BEAM", "ELEMENT_SPH", "INCLUDE",
+           "PARAMETER_EXPRESSION")
 
 
 class Refused(ValueError):

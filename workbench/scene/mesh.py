@@ -18,18 +18,14 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
+from .conventions import ALIVE, MeshError
+
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
     from .crease import GouraudSplit
     from .derived import Triangulation
-
-
-ALIVE = "alive"  # the element field of erosion: 1 in use, 0 deleted
-
-
-class MeshError(ValueError):
-    """An FE mesh that cannot be drawn or measured: empty, or with dangling node references."""
+    from .kinds import Beams, Particles
 
 
 @dataclass(eq=False)
@@ -39,6 +35,11 @@ class FEMesh:
     Construction validates and normalises the arrays; an empty mesh, an element that names a
     node outside ``nodes``, or a step array whose shape does not match is refused with
     :class:`MeshError` (the first few offending elements are listed).
+
+    ``beams`` and ``particles`` (:mod:`workbench.scene.kinds`) hold the line elements and SPH
+    particles beside the surface, sharing its nodes; they are validated here too. A mesh needs
+    at least one surface element (shell or face): one of only beams or particles is refused.
+    The box of :meth:`bounds` includes their nodes.
     """
 
     nodes: np.ndarray
@@ -56,6 +57,9 @@ class FEMesh:
     # fields whose values cannot be known from this file, with why (a thickness parameter
     # defined in a master deck not read): drawn nowhere, refused where used
     unavailable: dict[str, str] = field(default_factory=dict)
+    # beams and SPH particles beside the surface (workbench.scene.kinds), None without
+    beams: Beams | None = None
+    particles: Particles | None = None
     # what render paths made the mesh derive, by cache key (see workbench.scene.needs)
     derived: dict[tuple[Any, ...], Any] = field(default_factory=dict, init=False, repr=False)
 
@@ -108,6 +112,9 @@ class FEMesh:
                         f"({self.n_steps}, {n}), got {values.shape}"
                     )
                 fields[key] = values
+        from .kinds import check_kinds
+
+        check_kinds(self)
 
     # ----------------------------------------------------------------- sizes
     @property
@@ -240,6 +247,10 @@ class FEMesh:
                all_steps: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) float64 corners of the axis-aligned box of the referenced nodes."""
         used = self.used_nodes()
+        if self.beams is not None or self.particles is not None:
+            from .kinds import kind_nodes
+
+            used = np.union1d(used, kind_nodes(self))
         if all_steps and self.steps is not None:
             pts = self.steps[:, used].reshape(-1, 3)
         else:
@@ -269,6 +280,8 @@ class FEMesh:
             name=self.name,
             units=self.units,
             unavailable=dict(self.unavailable),
+            beams=self.beams,
+            particles=self.particles,
         )
 
     def part(self, part_id: int) -> FEMesh:
@@ -279,9 +292,12 @@ class FEMesh:
         return self.subset(keep, name=f"{self.name}:{self.part_names.get(part_id, part_id)}")
 
     def subset(self, element_mask: np.ndarray, name: str | None = None) -> FEMesh:
-        """The sub-mesh of the selected elements, with unreferenced nodes removed."""
+        """The sub-mesh of the selected elements, with unreferenced nodes removed; beams and
+        particles are kept where their nodes are."""
         elements = self.elements[element_mask]
         used, inverse = np.unique(elements, return_inverse=True)
+        node_map = np.full(self.n_nodes, -1, np.int64)
+        node_map[used] = np.arange(len(used))
         return FEMesh(
             nodes=self.nodes[used],
             elements=inverse.reshape(elements.shape).astype(np.int32),
@@ -296,6 +312,8 @@ class FEMesh:
             name=name or self.name,
             units=self.units,
             unavailable=dict(self.unavailable),
+            beams=None if self.beams is None else self.beams.remapped(node_map),
+            particles=None if self.particles is None else self.particles.remapped(node_map),
         )
 
     # ----------------------------------------------------------------- derived (cached)

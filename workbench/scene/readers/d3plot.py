@@ -23,11 +23,20 @@ axes. The one exception is a deck that sets ``CMPFLG = 1`` in ``*DATABASE_EXTENT
 then orthotropic and anisotropic materials are written in their material axes, and nothing
 in the file says so — such results would need transforming before their tensors are used.
 
+**Fields on request.** More fields are derived only when asked for (``extra_fields``): nodal
+displacement, velocity and acceleration (magnitude and components), principal stresses,
+maximum shear, pressure, signed von Mises and triaxiality; ``layer`` chooses the shell layer
+(mid, bottom, top, max, min over the layers) of the layered ones, von Mises and plastic strain
+included. The default stays the mid surface and today's fields, so that a large result costs
+no memory for fields nobody draws: the command line asks for the one it draws. Names, layer
+order and why ``mid`` is the default: :mod:`~workbench.scene.readers.d3plot_fields`.
+
 The mid-surface point of ``von_mises`` and ``plastic_strain`` follows the d3plot layer order:
 with 3 layers (LS-DYNA's default MAXINT) they are written mid, inner, outer, so the first;
 otherwise bottom to top, so the middle one (the mean of the two middle ones for an even
 count). Shells of rigid parts carry no stress, strain or thickness in a d3plot; their values
-are NaN. Beams, solids and thick shells are not read. Part ids are the user part ids, names
+are NaN. Solids, thick shells, beams and SPH particles: see the module notes of
+:mod:`~workbench.scene.readers.d3plot_kinds`. Part ids are the user part ids, names
 come from the part titles.
 
 **Damaged families.** Each member of a family ends with the end-of-file marker (-999999.0)
@@ -55,6 +64,9 @@ from warnings import warn as _warn
 import numpy as np
 
 from ..mesh import FEMesh
+from ..stress_tensor import von_mises
+from . import d3plot_fields
+from . import d3plot_kinds as kinds
 from .d3plot_family import (
     STRESS_COMPONENTS,
     Member,
@@ -65,41 +77,8 @@ from .d3plot_family import (
     _select_states,
     family_members,
 )
+from .d3plot_fields import RIGID_MATERIAL_TYPE, mid_surface
 from .errors import ParseError, ParseWarning, build_mesh
-
-RIGID_MATERIAL_TYPE = 20
-
-
-def von_mises(stress: np.ndarray) -> np.ndarray:
-    """Von Mises equivalent stress of (..., 6) stress tensors ordered xx, yy, zz, xy, yz, zx.
-
-    sqrt(((sxx - syy)^2 + (syy - szz)^2 + (szz - sxx)^2) / 2 + 3 (sxy^2 + syz^2 + szx^2)), in the
-    units of the input; float64.
-    """
-    s = np.asarray(stress, dtype=np.float64)
-    if s.shape[-1] != 6:
-        raise ValueError(f"stress must be (..., 6), got {s.shape}")
-    xx, yy, zz, xy, yz, zx = np.moveaxis(s, -1, 0)
-    return np.sqrt(0.5 * ((xx - yy) ** 2 + (yy - zz) ** 2 + (zz - xx) ** 2)
-                   + 3.0 * (xy ** 2 + yz ** 2 + zx ** 2))
-
-
-def mid_surface(values: np.ndarray, layer_axis: int = 2) -> np.ndarray:
-    """The mid-surface values of shell data with the through-thickness layers on ``layer_axis``.
-
-    Three layers are in d3plot order mid, inner, outer (the first is taken); any other count is
-    ordered bottom to top (the middle one, or the mean of the two middle ones when even).
-    """
-    values = np.asarray(values)
-    n = values.shape[layer_axis]
-    if n == 0:
-        raise ValueError("no integration-point layers")
-    if n == 3 or n == 1:
-        return np.take(values, 0, axis=layer_axis)
-    if n % 2:
-        return np.take(values, n // 2, axis=layer_axis)
-    pair = np.take(values, [n // 2 - 1, n // 2], axis=layer_axis).astype(np.float64)
-    return pair.mean(axis=layer_axis)
 
 
 def through_thickness_mean(values: np.ndarray, layer_axis: int = 2) -> np.ndarray:
@@ -119,17 +98,24 @@ def through_thickness_mean(values: np.ndarray, layer_axis: int = 2) -> np.ndarra
 
 
 def read_d3plot(path: str | os.PathLike[str], units: str = "mm", all_faces: bool = False,
-                stress_components: bool = True) -> FEMesh:
+                stress_components: bool = True, extra_fields=(),
+                layer: str = d3plot_fields.DEFAULT_LAYER) -> FEMesh:
     """Read a d3plot family (``d3plot``, ``d3plot01``, ...) into an :class:`FEMesh` with steps.
 
     ``path`` is the first file of the family; a later member (``d3plot01``) is read from the
     first one beside it. See the module notes for the fields. ``units`` labels the coordinates.
     Solid elements are drawn by their boundary faces (every face with ``all_faces``), each
     keeping its solid's id and part; the shell fields are NaN on them. ``stress_components``
-    reads the six mid-surface stress components as element fields. What could not be read is
-    named in a ParseWarning (module notes); ParseError for a file that cannot be read.
+    reads the six mid-surface stress components as element fields. ``extra_fields`` names
+    further fields to derive (``"all"``: every one) and ``layer`` the shell layer of the
+    layered fields (:mod:`~workbench.scene.readers.d3plot_fields`; ValueError for an unknown
+    name). What could not be read is named in a ParseWarning (module notes); ParseError for a
+    file that cannot be read.
     """
     from lasso.dyna import ArrayType
+
+    requested = d3plot_fields.requested_fields(extra_fields)
+    d3plot_fields.check_layer(layer)
 
     path = _first_member(Path(path))
     plot, warnings = _lasso_read(path)
@@ -137,16 +123,21 @@ def read_d3plot(path: str | os.PathLike[str], units: str = "mm", all_faces: bool
     members, notes = getattr(plot, "family", None) or _family(path, plot)
     _select_states(arrays, members, ArrayType)
     dropped = _drop_damaged_layouts(plot, arrays, ArrayType, stress_components, notes)
+    kinds.merge_thick_shells(arrays, ArrayType)  # drawn as solids
+    if kinds.only_kinds_message(arrays, ArrayType):
+        raise ParseError(path, kinds.only_kinds_message(arrays, ArrayType) + warnings.summary())
     elements = _elements(path, arrays, ArrayType, warnings, all_faces)
     parts, part_names = _parts(path, arrays, ArrayType, warnings, elements.part_index)
     n_states = sum(min(m.states, m.read) for m in members)
     steps, times = _steps_and_times(arrays, ArrayType, elements.nodes, n_states, notes)
-    fields = {}
+    fields, node_fields = {}, {}
     if n_states:
         fields = _shell_fields(arrays, ArrayType, elements, n_states, stress_components)
         if elements.n_solids:
             _solid_fields(fields, arrays, ArrayType, elements.face_of, elements.n_shells,
                           n_states)
+        node_fields = d3plot_fields.add_requested(fields, arrays, ArrayType, elements,
+                                                  n_states, steps, requested, layer, notes)
         lost = [name for name in _expected_fields(plot, stress_components)
                 if name not in fields and name not in dropped]
         if lost:
@@ -163,15 +154,30 @@ def read_d3plot(path: str | os.PathLike[str], units: str = "mm", all_faces: bool
             notes.append(f"not read, as a section failed: {'; '.join(lost)}")
     mesh = build_mesh(
         path, nodes=elements.nodes, elements=elements.connectivity, parts=parts,
-        steps=steps, times=times, element_fields=fields, part_names=part_names,
+        steps=steps, times=times, element_fields=fields, node_fields=node_fields,
+        part_names=part_names,
         node_ids=None if node_ids is None else np.asarray(node_ids, dtype=np.int64),
-        element_ids=elements.element_ids, name=path.name, units=units)
+        element_ids=elements.element_ids, name=path.name, units=units,
+        **_kinds(path, arrays, ArrayType, warnings, elements.nodes, n_states, notes))
     for failure in warnings.failures:  # read, but with sections missing: say which
         _warn(ParseWarning(path, f"lasso-python could not read {failure}: what it holds is "
                                  f"missing"), stacklevel=2)
     for note in notes:
         _warn(ParseWarning(path, note), stacklevel=2)
     return mesh
+
+
+def _kinds(path: Path, arrays, ArrayType, warnings, nodes: np.ndarray, n_states: int,
+           notes: list[str]) -> dict:
+    """``beams`` and ``particles`` of the d3plot (:mod:`.d3plot_kinds`), notes for what is not
+    drawn added to ``notes``."""
+    def part_ids(part_index: np.ndarray) -> np.ndarray:
+        return _parts(path, arrays, ArrayType, warnings, part_index)[0]
+
+    notes.extend(kinds.not_drawn_notes(arrays, ArrayType))
+    return {"beams": kinds.read_beams(arrays, ArrayType, n_states, part_ids),
+            "particles": kinds.read_particles(arrays, ArrayType, n_states, nodes, part_ids,
+                                              notes)}
 
 
 def _first_member(path: Path) -> Path:
@@ -310,8 +316,8 @@ def _elements(path: Path, arrays, ArrayType, warnings: _LassoWarnings,
     solids = np.asarray(arrays.get(ArrayType.element_solid_node_indexes, np.zeros((0, 8))),
                         dtype=np.int64)
     if len(connectivity) == 0 and len(solids) == 0:
-        raise ParseError(path, "no shell or solid elements in the d3plot (beams and thick "
-                               "shells are not read)" + warnings.summary())
+        raise ParseError(path, "no shell, solid or thick shell elements in the d3plot"
+                         + warnings.summary())
     n_shells = len(connectivity)
     part_index = np.asarray(_need(path, arrays, ArrayType.element_shell_part_indexes, warnings)
                             if n_shells else np.zeros(0), dtype=np.int64)

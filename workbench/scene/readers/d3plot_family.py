@@ -19,7 +19,8 @@ from .errors import ParseError
 
 STRESS_COMPONENTS = ("xx", "yy", "zz", "xy", "yz", "zx")  # d3plot (and lasso-python) order
 END_MARKER = -999999.0  # LS-DYNA's end-of-file marker, one word after a member's last state
-STATE_ARRAYS = ("global_timesteps", "node_displacement", "element_shell_stress",
+STATE_ARRAYS = ("global_timesteps", "node_displacement", "node_velocity", "node_acceleration",
+                "element_shell_stress",
                 "element_shell_effective_plastic_strain", "element_shell_thickness",
                 "element_shell_is_alive", "element_solid_stress",
                 "element_solid_effective_plastic_strain", "element_solid_is_alive")

@@ -27,7 +27,9 @@ standard, I10 (``*KEYWORD I10=Y`` or a ``%`` after a keyword) and long (``*KEYWO
 ``+`` after a keyword; all fields 20 wide) formats are read; an ``*INCLUDE`` is read in the
 master deck's format unless its keyword names another one (``%``, ``+``, ``-``). Lines starting
 with ``$`` are comments; keywords are case-insensitive; any other keyword is skipped with its
-data, and every other ``*ELEMENT_...`` keyword (beams, SPH particles, discrete elements ...)
+data; ``*ELEMENT_BEAM`` and ``*ELEMENT_SPH`` are read as the mesh's beams and SPH particles
+(:mod:`~workbench.scene.readers.keyword_kinds`, which says what radius a particle is drawn
+with), and every other ``*ELEMENT_...`` keyword (discrete elements, masses, seat belts ...)
 is named in one :class:`~workbench.scene.readers.errors.ParseWarning` with its count. Node and
 element ids may be any integers (written as integers, or integral decimals such as ``101.0``;
 never with an exponent); they are kept in ``node_ids`` / ``element_ids`` and mapped to
@@ -81,6 +83,7 @@ from .cards import (
     _table,
 )
 from .errors import ParseWarning
+from .keyword_kinds import KindBlocks
 from .parameters import _Parameters
 
 # Card layouts in standard-format column widths; I10 widens fields under 10 to 10, long to 20.
@@ -117,7 +120,9 @@ def read_keyword(path: str | os.PathLike[str], units: str = "mm",
     """
     deck = _Deck(Path(path))
     deck.read_file(Path(path), None)
+    deck.kinds.refuse_alone(deck.master, sum(map(len, deck.shell_ids + deck.solid_ids)))
     mesh = deck_mesh(deck, units, all_faces)
+    deck.kinds.attach(mesh, deck.parts)  # beams and SPH particles
     for name, cards in sorted(deck.skipped.items()):
         what = f"{cards} element(s)" if name in _ONE_CARD_ELEMENTS else f"{cards} card(s)"
         warnings.warn(ParseWarning(deck.master, f"{what} not drawn: *{name} is not read"),
@@ -166,6 +171,7 @@ class _Deck:
     sections: dict[object, _Section] = field(default_factory=dict)
     parameters: _Parameters = field(default_factory=_Parameters)
     skipped: dict[str, int] = field(default_factory=dict)  # keyword -> data cards not read
+    kinds: KindBlocks = field(default_factory=KindBlocks)  # beams and SPH particles
 
     # ------------------------------------------------------------- files and blocks
     def read_file(self, path: Path, fmt: str | None) -> None:
@@ -206,6 +212,8 @@ class _Deck:
         elif name.startswith("ELEMENT_SOLID"):
             raise block.error(f"*{name} is not supported (read are *ELEMENT_SOLID and its "
                               f"options {', '.join(sorted(o[14:] for o in _SOLID_AS_LINEAR))})")
+        elif self.kinds.read(block):
+            pass
         elif name.startswith("ELEMENT_"):
             cards = sum(not block.blank(r) for r in block.rows.tolist())
             self.skipped[name] = self.skipped.get(name, 0) + cards
