@@ -305,6 +305,30 @@ def test_a_node_shared_by_two_parts_gets_each_parts_own_mean():
         fringes.part_averaged(smooth, "v_smooth")
 
 
+def test_part_averaging_keeps_the_beams_and_particles_in_place():
+    # a beam from the seam node 4 to a free node, and a particle on another free node: both
+    # stay, at the coordinates of every state, with their ids, parts and alive
+    from workbench.scene.kinds import Beams, Particles
+
+    mesh = two_part_mesh()
+    nodes = np.vstack([mesh.nodes, [[1, 2, 0], [3, 2, 0]]])
+    steps = np.concatenate([mesh.steps, np.stack([nodes[7:], nodes[7:] + [0, 0, 1]])], axis=1)
+    beams = Beams(parts=[30], ids=[900], fields={"alive": [[1.0], [0.0]]}, nodes=[[4, 7]])
+    particles = Particles(parts=[40], ids=[950], fields={}, node=[8], radius=[0.25])
+    mesh = FEMesh(nodes, mesh.elements, mesh.parts, steps, element_fields=mesh.element_fields,
+                  node_ids=np.arange(10, 19), beams=beams, particles=particles)
+    smooth = fringes.part_averaged(mesh, "v")
+    for state in range(2):
+        ends = smooth.coordinates(state)[smooth.beams.nodes[0]]
+        np.testing.assert_array_equal(ends, mesh.coordinates(state)[[4, 7]])
+        np.testing.assert_array_equal(smooth.coordinates(state)[smooth.particles.node],
+                                      mesh.coordinates(state)[[8]])
+    assert smooth.beams.ids.tolist() == [900] and smooth.particles.parts.tolist() == [40]
+    assert smooth.beams.fields["alive"].tolist() == [[1.0], [0.0]]
+    assert smooth.n_nodes == 11  # nodes 1 and 4 copied once more, the free nodes kept
+    assert np.isnan(smooth.node_fields["v_smooth"][:, smooth.particles.node]).all()
+
+
 def test_part_averages_of_the_d3plot_equal_a_loop_over_its_elements(meshes):
     mesh = meshes["max"]
     smooth = fringes.part_averaged(mesh, "principal_max")

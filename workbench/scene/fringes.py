@@ -44,11 +44,18 @@ def split_parts(mesh: FEMesh) -> tuple[FEMesh, np.ndarray]:
     """(mesh, origin): ``mesh`` with every node shared by elements of several parts copied
     once per part, each part using its own copies (elements, parts and element fields in
     their order; steps, node fields and node ids copied with the nodes, so a split node keeps
-    its id), and ``origin`` (N',) the node of ``mesh`` each new node is a copy of."""
+    its id), and ``origin`` (N',) the node of ``mesh`` each new node is a copy of. Nodes no
+    element uses (the free ends of beams, SPH particles) follow as they are; beams and
+    particles keep their places, a split node's at its first copy (its coordinates are every
+    copy's)."""
     corners = mesh.elements.astype(np.int64)
     key = mesh.parts.astype(np.int64)[:, None] * mesh.n_nodes + corners  # (part, node)
     unique, inverse = np.unique(key, return_inverse=True)
-    origin = unique % mesh.n_nodes
+    used = np.zeros(mesh.n_nodes, bool)
+    used[corners.ravel()] = True
+    origin = np.concatenate([unique % mesh.n_nodes, np.flatnonzero(~used)])
+    node_map = np.full(mesh.n_nodes, -1, np.int64)
+    node_map[origin[::-1]] = np.arange(len(origin))[::-1]  # each node's first copy
     split = FEMesh(
         nodes=mesh.nodes[origin], elements=inverse.reshape(corners.shape), parts=mesh.parts,
         steps=None if mesh.steps is None else mesh.steps[:, origin],
@@ -56,7 +63,9 @@ def split_parts(mesh: FEMesh) -> tuple[FEMesh, np.ndarray]:
         element_fields=dict(mesh.element_fields), part_names=dict(mesh.part_names),
         times=mesh.times, node_ids=None if mesh.node_ids is None else mesh.node_ids[origin],
         element_ids=mesh.element_ids, name=mesh.name, units=mesh.units,
-        unavailable=dict(mesh.unavailable))
+        unavailable=dict(mesh.unavailable),
+        beams=None if mesh.beams is None else mesh.beams.remapped(node_map),
+        particles=None if mesh.particles is None else mesh.particles.remapped(node_map))
     return split, origin
 
 
