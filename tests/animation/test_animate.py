@@ -67,18 +67,16 @@ def test_frames_equal_render_of_each_state(ctx, crash, mesh, tmp_path, path, fie
     ("position", None, 12), ("gouraud", None, 24), ("element_color", FIELD, 16)])
 def test_bytes_per_state_are_the_paths_bytes_per_step(ctx, mesh, path, field, per_vertex):
     """Coordinates (12 bytes a vertex), normals (12) where the path lights per vertex, field
-    values (4) where it colours, and the index of the triangles (12 a triangle: the d3plot
-    deletes a shell at its last state, live triangles are written first) at a state whose
-    elements in use change: the prepared path's bytes_per_step and the measured row's alike;
-    the states that keep the elements of the state before send no index."""
+    values (4) where it colours: set_step's bytes, the prepared path's bytes_per_step and the
+    measured row's alike; and at the state that deletes the triangle shell, the 12 bytes of
+    its one triangle made degenerate in place (the rest of the index is not sent again)."""
     style = make_path(path, field=field).style
     loop, frames = frames_of(ctx, mesh, path, style)
     row = measure(ctx, mesh, path, style, size=SIZE, timed=False).row
-    index = 12 * row["triangles"]
-    assert row["bytes_per_step"] == row["vertices"] * per_vertex + index
+    assert row["bytes_per_step"] == row["vertices"] * per_vertex
     assert [f.deleted for f in frames] == [0, 0, 1]
-    assert [f.bytes_uploaded for f in frames] == [row["bytes_per_step"] - index] * 2 + [
-        row["bytes_per_step"]]
+    assert [f.bytes_uploaded for f in frames] == [row["bytes_per_step"]] * 2 + [
+        row["bytes_per_step"] + 12]
     assert all(f.bytes_per_step == row["bytes_per_step"] for f in frames)
     assert loop.prepare_bytes == row["bytes_uploaded"] > row["bytes_per_step"]
     assert all(f.upload_ms >= 0 and f.draw_ms > 0 for f in frames)
@@ -186,7 +184,8 @@ def test_gif_holds_every_state(ctx, crash, mesh, tmp_path, capsys):
         assert np.abs(got[..., :3].astype(int) - want).mean() < 0.5
     printed = capsys.readouterr().out
     assert "3 frames of d3plot (3 states), path element_color" in printed
-    assert "116 bytes uploaded (the path's bytes_per_step: 116)" in printed  # 80 + the index
+    # coordinates and values (80 bytes), and at the last state the deleted triangle (12)
+    assert "80 or 92 bytes uploaded (the path's bytes_per_step: 80)" in printed
     assert "deleted elements per state (not drawn): 0, 0, 1" in printed
     assert [p.name for p in tmp_path.iterdir()] == ["crash.gif"]  # no temporary file left
 

@@ -38,9 +38,9 @@ def test_each_frame_is_the_image_render_draws_of_its_state(ctx, mesh):
         drawn = list(draw_frames(ready, range(mesh.n_steps), update=ready.path.set_step))
         per_step = ready.path.bytes_per_step
     assert [d.state for d in drawn] == [0, 1, 2]
-    # the whole state where the elements in use change (a shell deleted at the last), the
-    # coordinates and values alone where they do not: no index
-    assert drawn[2].sent == per_step > drawn[0].sent == drawn[1].sent > 0
+    # coordinates and values each state, and at the last, which deletes the triangle
+    # shell, its one triangle's index (12 bytes) made degenerate in place
+    assert drawn[0].sent == drawn[1].sent == per_step > 0 and drawn[2].sent == per_step + 12
     assert all(d.update_ms >= 0 and d.draw_ms > 0 and d.read_ms > 0 for d in drawn)
     images = [d.image for d in drawn]
     assert not np.array_equal(images[0], images[2])  # the shells rose: the frames differ

@@ -254,9 +254,10 @@ def test_a_still_names_its_state_time_and_deleted_elements():
 
 
 def test_a_state_that_keeps_the_deleted_elements_sends_no_index(ctx):
-    """The index buffers are written only where the elements in use change: a state deleting
-    what the state drawn before deleted sends the coordinates alone, and every state, in any
-    order, draws the image of a fresh preparation at that state."""
+    """The index is written only where the elements in use change, and then only the changed
+    triangles: a state deleting what the state drawn before deleted sends the coordinates
+    alone, and every state, in any order (elements deleted and given back), draws the image of
+    a fresh preparation at that state."""
     from workbench.animation.frames import draw_frames
     from workbench.paths import prepared
 
@@ -283,4 +284,8 @@ def test_a_state_that_keeps_the_deleted_elements_sends_no_index(ctx):
         np.testing.assert_array_equal(image, fresh(step))
     coordinates = mesh.n_nodes * 3 * 4
     assert sent[2] == coordinates  # 1 -> 2: the same elements deleted, no index
-    assert min(sent[1], sent[3], sent[4]) > coordinates  # the elements in use changed
+    # where the elements in use change, the 10 triangles of the 5 torn quads, 12 bytes each,
+    # made degenerate (0 -> 1, 0 -> 2) or given back (2 -> 0) in place, and the wire frame's
+    # edges (8 bytes each) written whole, the live ones first
+    triangles, edges = 12 * 2 * len(DELETED), 8 * len(mesh.edges)
+    assert sent[1] == sent[3] == sent[4] == coordinates + triangles + edges

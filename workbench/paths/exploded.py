@@ -225,13 +225,6 @@ class ExplodedPath(MeshPath):
         return Layout(layout.index[order], layout.primitive, layout.triangles, layout.strips,
                       layout.vertices_sent, triangle_element=element)
 
-    def _live_index(self, live: np.ndarray) -> tuple[np.ndarray, int]:
-        """Erosion without moving a triangle (the parts' ranges hold): a deleted element's
-        triangles become degenerate (three equal indices: no fragment); the whole list drawn."""
-        index = np.array(self.data.index, np.int32).reshape(-1, 3)
-        index[~live] = index[~live][:, :1]
-        return np.ascontiguousarray(index), -1
-
     def _build(self, ctx, mesh, camera) -> None:
         algo = _explode()
         style = self.style

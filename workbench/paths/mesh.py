@@ -241,7 +241,11 @@ class MeshPath(GLPath):
         self._kinds = build_overlay(self, ctx, mesh, draws=type(self).draw is MeshPath.draw)
         self._set_clip_planes()
         self.set_camera(camera)
-        self._live_shown = None  # the triangles in use that the index buffers hold (erosion)
+        # the triangles in use that the index buffers hold (erosion): every one as prepared;
+        # the ghost pass's layout (live first) is written by the first step
+        live = data.live_triangles(style.step)
+        self._live_shown = None if live is None or self._ghost_vao is not None else \
+            np.ones(len(live), bool)
         self.bytes_per_step = self.set_step(style.step)
         self.bytes_uploaded = uploaded + self.bytes_per_step
 
@@ -284,20 +288,26 @@ class MeshPath(GLPath):
         return sent
 
     def _upload_live(self, step: int) -> int:
-        """With erosion, write the triangles (and wire-frame edges) of the elements in use at
-        ``step`` to the front of their index buffers and draw only those; the bytes sent (the
-        whole index buffer, or nothing where the step keeps the elements of the step drawn
-        before: the buffers hold them already)."""
+        """With erosion, show the triangles (and wire-frame edges) of the elements in use at
+        ``step`` and no other; the bytes sent. Nothing is sent where the step keeps the
+        elements of the step drawn before (the buffers hold them already). The fill index is
+        changed in place (:meth:`_write_changed_triangles`: the triangles whose state changed,
+        a deleted one made degenerate), or, with the ghost pass, written whole with the live
+        triangles first (:meth:`_live_index`); the wire frame's edges are written whole, the
+        live ones first."""
         live = self.data.live_triangles(step)
         if live is None:
             return 0
         self.deleted = self.mesh.n_deleted(step)
-        if self._live_shown is not None and np.array_equal(live, self._live_shown):
+        before, self._live_shown = self._live_shown, live
+        if np.array_equal(live, before):
             return 0
-        self._live_shown = live
-        index, self._fill_vertices = self._live_index(live)
-        self._index.write(index.tobytes())
-        sent = index.nbytes
+        if self._ghost_vao is None:
+            sent = self._write_changed_triangles(live, before)
+        else:
+            index, self._fill_vertices = self._live_index(live)
+            self._index.write(index.tobytes())
+            sent = index.nbytes
         edges = self.data.live_edges(step)
         if edges is not None:
             pairs = np.ascontiguousarray(np.concatenate([self.data.edges[edges],
@@ -306,6 +316,25 @@ class MeshPath(GLPath):
             self._line_vertices = int(edges.sum()) * 2
             sent += pairs.nbytes
         return sent
+
+    def _write_changed_triangles(self, live: np.ndarray, before: np.ndarray) -> int:
+        """Write, in place, the triangles of the fill index whose state differs between
+        ``before`` (what the buffer holds) and ``live`` (bool over the triangle list): a
+        triangle now in use gets its three vertices back, one deleted becomes degenerate
+        (its first vertex three times: no fragment), each run of consecutive changed triangles
+        one write; every triangle keeps its place, so the whole buffer is drawn in the order of
+        an uneroded draw. The bytes sent (12 a changed triangle)."""
+        changed = np.flatnonzero(live != before)
+        rows = np.asarray(self.data.index, np.int32).reshape(-1, 3)[changed]
+        dead = ~live[changed]
+        rows[dead] = rows[dead][:, :1]
+        rows = np.ascontiguousarray(rows)
+        starts = np.flatnonzero(np.diff(changed, prepend=-2) != 1)
+        ends = np.append(starts[1:], len(changed))
+        for start, end in zip(starts.tolist(), ends.tolist()):
+            self._index.write(rows[start:end].tobytes(), offset=int(changed[start]) * 12)
+        self._fill_vertices = -1
+        return rows.nbytes
 
     def _upload_values(self, step: int) -> int:
         """Upload the normalised field values of ``step`` (non-finite ones as 0) and, for a
@@ -319,9 +348,8 @@ class MeshPath(GLPath):
 
     def _live_index(self, live: np.ndarray) -> tuple[np.ndarray, int]:
         """(the int32 triangle index to upload, the vertices the fill pass draws) with the
-        triangles ``live`` (bool over the triangle list) shown: the live triangles first and
-        the deleted ones behind them, for the ghost pass; the whole index every step, so each
-        step sends the same bytes."""
+        triangles ``live`` (bool over the triangle list) shown, for the ghost pass: the live
+        triangles first and the deleted ones behind them (which it draws translucent)."""
         index = np.concatenate([self.data.index[live], self.data.index[~live]])
         return np.ascontiguousarray(index, np.int32), int(live.sum()) * 3
 
