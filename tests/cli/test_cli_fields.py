@@ -39,6 +39,18 @@ def test_info_lists_the_fields_the_file_offers(rich, capsys):
     assert any(line.startswith("element field 'von_mises'") for line in lines)
 
 
+def test_the_built_in_d3plot_offers_its_fields_and_layers(d3plot_file, tmp_path, capsys):
+    # the built-in scene name reads the shared result as its file would be read
+    assert main(["info", "d3plot"]) == 0
+    offered = next(line for line in capsys.readouterr().out.splitlines()
+                   if line.startswith("fields on request"))
+    assert "principal_max" in offered and "displacement" in offered
+    out = tmp_path / "p.png"
+    assert main(["render", "d3plot", "--field", "principal_max", "--layer", "max", "--raw",
+                 "--size", "40x30", "-o", str(out)]) == 0
+    assert out.is_file()
+
+
 def refused_in_one_line(capsys, argv, *words) -> str:
     """Run ``argv``, which must end with exit status 2 and one line on stderr naming
     ``words``."""

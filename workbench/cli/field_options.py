@@ -53,26 +53,34 @@ def fields_epilog() -> str:
     return "\n".join(lines)
 
 
-def is_d3plot(spec: str) -> bool:
-    """Whether ``spec`` is a d3plot file (not a built-in scene)."""
+def d3plot_file(spec: str) -> str | None:
+    """The d3plot file ``spec`` names: a d3plot file itself, or the shared result the built-in
+    scene ``d3plot`` reads (where the shared data is found); None for anything else."""
+    if spec == "d3plot" and not Path(spec).is_file():
+        from ..data import D3PLOT, shared_file
+
+        path = shared_file(D3PLOT)
+        return None if path is None else str(path)
     from ..scene.readers import ParseError, detect_format
 
     if not Path(spec).is_file():
-        return False
+        return None
     try:
-        return detect_format(spec) == "d3plot"
+        return spec if detect_format(spec) == "d3plot" else None
     except ParseError:
-        return False
+        return None
 
 
 def _read(spec: str, args, all_faces: bool, mesh_only: bool):
-    """The scene ``spec``: a d3plot file read with ``--field`` derived at ``--layer``, anything
-    else as :func:`~workbench.scene.builtin.load_scene` reads it."""
-    if is_d3plot(spec):
+    """The scene ``spec``: a d3plot (a file, or the built-in ``d3plot``) read with ``--field``
+    derived at ``--layer``, anything else as :func:`~workbench.scene.builtin.load_scene` reads
+    it."""
+    file = d3plot_file(spec)
+    if file is not None:
         from ..scene.readers import read_d3plot
 
         wanted = [args.field] if args.field in FIELDS else []
-        return read_d3plot(spec, all_faces=all_faces, extra_fields=wanted,
+        return read_d3plot(file, all_faces=all_faces, extra_fields=wanted,
                            layer=args.layer or DEFAULT_LAYER)
     if args.layer is not None:
         raise ValueError(f"--layer applies to d3plot results, not to {spec!r}")

@@ -97,9 +97,10 @@ def cmd_info(args) -> int:
     if args.mesh is not None:
         from ..scene.builtin import load_mesh
         from ..scene.readers.d3plot_fields import offered_by_file
-        from .field_options import is_d3plot
+        from .field_options import d3plot_file
 
-        offered = offered_by_file(args.mesh) if is_d3plot(args.mesh) else ()
+        file = d3plot_file(args.mesh)
+        offered = offered_by_file(file) if file is not None else ()
         for line in mesh_lines(load_mesh(args.mesh, all_faces=args.all_faces), offered):
             print(line)
         return 0
