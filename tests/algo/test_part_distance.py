@@ -131,6 +131,33 @@ def test_time_steps():
     assert not np.array_equal(r0.distance, r1.distance)
 
 
+def test_deleted_elements_are_no_target_and_their_nodes_not_measured():
+    """Erosion: at a state that deletes elements, every search gives what it gives on the
+    same model with those elements removed (FEMesh.subset, mapped back by node id), and a node
+    that only deleted elements use is not measured; at the state before, nothing changes."""
+    rng = np.random.default_rng(3)
+    mesh = random_mesh(17, 3)
+    steps = np.stack([mesh.nodes, mesh.nodes + rng.normal(size=mesh.nodes.shape) * 0.05])
+    alive = np.ones((2, mesh.n_elements))
+    alive[1, rng.permutation(mesh.n_elements)[:mesh.n_elements // 3]] = 0
+    eroded = FEMesh(mesh.nodes, mesh.elements, mesh.parts, steps,
+                    element_fields={"alive": alive}, node_ids=np.arange(mesh.n_nodes))
+    kept = FEMesh(mesh.nodes, mesh.elements, mesh.parts, steps,
+                  node_ids=np.arange(mesh.n_nodes)).subset(alive[1] != 0)
+    only_deleted = ~eroded.live_nodes(1) & eroded.live_nodes(0)
+    assert only_deleted.any()
+    for search in (lambda m, s: part_distances(m, 2.0, step=s).distance,
+                   lambda m, s: part_distances(m, 2.0, step=s, kind="obb", leaf_size=4).distance,
+                   lambda m, s: batched_part_distances(m, 2.0, step=s).distance,
+                   lambda m, s: brute_force_part_distances(m, 2.0, step=s)[0]):
+        got = search(eroded, 1)
+        np.testing.assert_array_equal(got[kept.node_ids], search(kept, 1))
+        assert np.isinf(got[only_deleted]).all()
+        whole = FEMesh(mesh.nodes, mesh.elements, mesh.parts, steps)
+        np.testing.assert_array_equal(search(eroded, 0), search(whole, 0))
+        assert not np.array_equal(got, search(whole, 1))  # the fault: deleted ones measured
+
+
 # --------------------------------------------------------------------------- batched
 def assert_batched_exact(mesh, r, expected, step=0):
     """The batched search's distances equal the brute force's to the last bit; the part named

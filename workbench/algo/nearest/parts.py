@@ -21,9 +21,12 @@ Conventions, shared by all four:
 * An element is the triangles :attr:`FEMesh.triangles` gives it (quads split along the shorter
   diagonal); a topologically degenerate element (fewer than three distinct nodes, or a node at
   opposite corners) has no triangle and is never a target, although its nodes are measured.
-* A node's **own parts** are every part of an element that uses the node. A node on the seam of
-  two parts (shared by both) is therefore measured against the third parts only: its distance
-  to either of its own parts is zero by construction and says nothing. A node that no element
+* **Erosion**: an element deleted at the step measured (its ``"alive"`` field 0) is no
+  target, and a node that only deleted elements use is not measured (inf, part -1).
+* A node's **own parts** are every part of an element that uses the node (a deleted one
+  too). A node on the seam of two parts (shared by both) is therefore measured against the
+  third parts only: its distance to either of its own parts is zero by construction and says
+  nothing. A node that no element
   uses gets distance inf and part -1.
 * Distances are exact float64 (the closest point on each triangle,
   :func:`~workbench.algo.nearest.triangle.closest_point_on_triangle`), in the mesh's units
@@ -148,6 +151,8 @@ def _check(mesh, cutoff, kind, leaf_size, step, what="cutoff"):
     coords = mesh.coordinates(step)
     used = used_nodes(mesh.elements, mesh.n_nodes)
     check_finite(coords, used)
+    if mesh.erodes:  # the nodes of elements in use at the step (module notes)
+        used = used[mesh.live_nodes(step)[used]]
     return c, step, coords, used
 
 
@@ -240,9 +245,11 @@ def _csr_rows(ptr: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return pos, ptr[rows][pos] + within
 
 
-def _with_triangles(mesh) -> np.ndarray:
-    """Indices of the elements that have at least one triangle."""
-    return np.flatnonzero(np.bincount(mesh.triangulation.element_of, minlength=len(mesh.elements)))
+def _with_triangles(mesh, step: int) -> np.ndarray:
+    """Indices of the elements measured against at ``step``: those with at least one triangle,
+    in use at the step (erosion)."""
+    has = np.bincount(mesh.triangulation.element_of, minlength=len(mesh.elements)) > 0
+    return np.flatnonzero(has & mesh.alive(step))
 
 
 # --------------------------------------------------------------------------- the queries
@@ -261,7 +268,7 @@ def part_distances(mesh, cutoff: float, *, kind: str = "aabb", leaf_size: int = 
     n = mesh.n_nodes
     active = np.zeros(n, bool)
     active[used] = True
-    targets = _with_triangles(mesh)
+    targets = _with_triangles(mesh, step)
     if len(targets) == 0:  # only degenerate elements: nothing to measure against
         return PartDistances(np.full(n, np.inf), np.full(n, -1, np.int64),
                              np.full(n, -1, np.int64), 0, 0, 0, 0, 0, 0, int(active.sum()),
@@ -304,13 +311,19 @@ def batched_part_distances(mesh, cutoff: float, *, step: int = 0,
     ids = distinct(mesh.parts)
     element_part = np.searchsorted(ids, mesh.parts).astype(np.int64)
     local = coords - local_origin(coords, used)
-    corners = local[np.asarray(tr.triangles, dtype=np.int64)]
-    tree = BatchedTriangleTree(corners, element_part[tr.element_of], leaf_size=int(leaf_size))
+    live = mesh.alive(step)[tr.element_of]  # erosion: deleted elements are no target
+    element_of = np.ascontiguousarray(tr.element_of[live])
+    corners = local[np.asarray(tr.triangles, dtype=np.int64)[live]]
+    tree = BatchedTriangleTree(corners, element_part[element_of], leaf_size=int(leaf_size))
     t1 = time.perf_counter()
     node_set, set_ptr, set_parts = own_part_sets(mesh, element_part)
     d2, tri, counts = tree.nearest(local, node_set, set_ptr, set_parts, cutoff)
-    distance, element, other = _results(d2, tri, tr.element_of, element_part,
+    distance, element, other = _results(d2, tri, element_of, element_part,
                                         ids.astype(np.int64))
+    if mesh.erodes:  # a node only deleted elements use is not measured
+        unused = np.ones(n, bool)
+        unused[used] = False
+        distance[unused], element[unused], other[unused] = np.inf, -1, -1
     query_s = time.perf_counter() - t1
     return PartDistances(distance, other, element, tree.n_boxes, 0, counts["box_tests"],
                          counts["triangle_tests"], 0, counts["triangle_tests"], n_used,
@@ -363,7 +376,7 @@ def connectivity(mesh, distance: float, *, kind: str = "aabb", leaf_size: int = 
     p = len(parts)
     best = np.full((p, p), np.inf)
     count = np.zeros((p, p), np.int64)
-    targets = _with_triangles(mesh)
+    targets = _with_triangles(mesh, step)
     if len(targets):
         active = np.zeros(mesh.n_nodes, bool)
         active[used] = True
@@ -397,10 +410,13 @@ def brute_force_part_distances(mesh, cutoff: float, *, step: int = 0,
     origin = local_origin(coords, used)
     local = np.zeros((n, 3))
     local[used] = coords[used] - origin
-    corners = np.ascontiguousarray(local[np.asarray(tr.triangles, dtype=np.int64)])
+    live = mesh.alive(step)[tr.element_of]  # erosion: deleted elements are no target
+    if not live.any():
+        return distance, other
+    corners = np.ascontiguousarray(local[np.asarray(tr.triangles, dtype=np.int64)[live]])
     ids = distinct(mesh.parts)
     cp = np.searchsorted(ids, np.asarray(mesh.parts))
-    tri_part = cp.ravel()[tr.element_of]
+    tri_part = cp.ravel()[tr.element_of[live]]
     ptr, own = node_parts(mesh)
     own_cp = np.searchsorted(ids, own)
     step_nodes = max(1, int(chunk_pairs) // len(corners))
