@@ -53,8 +53,16 @@ def frames_of(ctx, mesh, path="gouraud", style=None, steps=None, size=SIZE, **kw
                                          ("quad_wire", None), ("element_color", FIELD),
                                          ("element_color", "alive")])
 def test_frames_equal_render_of_each_state(ctx, crash, mesh, tmp_path, path, field):
+    from contextlib import nullcontext
+
+    from workbench.paths.mesh import ErosionWarning
+
     style = make_path(path, field=field).style
-    _, frames = frames_of(ctx, mesh, path, style)
+    # quad_wire draws strips, which keep the shell the d3plot deletes: it says so
+    said = pytest.warns(ErosionWarning, match="quad_wire") if path == "quad_wire" else \
+        nullcontext()
+    with said:
+        _, frames = frames_of(ctx, mesh, path, style)
     assert [f.step for f in frames] == [0, 1, 2]
     options = ["--path", path] + (["--field", field] if field else [])
     for frame in frames:
