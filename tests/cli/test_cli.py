@@ -346,6 +346,7 @@ def test_bad_command_lines_end_in_one_line_and_status_2(argv, message, tmp_path,
     assert not list(tmp_path.iterdir())
 
 
+@pytest.mark.slow  # waits out the connection timeout (5 s)
 def test_an_unreachable_scheduler_is_refused_soon(tmp_path, capsys):
     """Nothing listens on port 1 of the loopback: one line, status 2, well before the old
     30 s connection timeout (the bound is generous: it is the connect timeout that matters)."""

@@ -163,6 +163,7 @@ def test_refusals(tmp_path, mesh):
 
 
 # ---------------------------------------------------------------------------- command line
+@pytest.mark.slow  # a command-line render through a cluster and back (8 s)
 def test_render_writes_a_chunked_scene_and_draws_it_again_from_its_folder(tmp_path, capsys):
     """``render --domains D --write-chunked F`` draws the plain render's image from the new
     chunked scene; ``render F`` draws it again from the folder alone, and with a colour bar
