@@ -22,12 +22,13 @@ from .field_options import add_field_arguments, load_with_fields
 
 class StateSelection(NamedTuple):
     """``--steps`` as given (``text``) and read: ``start``, ``stop``, ``stride`` of a Python
-    slice (None where left out)."""
+    slice (None where left out); ``option`` the option's name, for the messages."""
 
     text: str
     start: int | None
     stop: int | None
     stride: int | None
+    option: str = "--steps"
 
     def states(self, mesh) -> list[int]:
         """The states of ``mesh`` selected, as ``list(range(n_states))[start:stop:stride]``
@@ -36,12 +37,14 @@ class StateSelection(NamedTuple):
         n = mesh.n_steps
         states = f"{mesh.name} has {n} state{'s' * (n != 1)} (0..{n - 1})"
         if self.start is not None and not -n <= self.start < n:
-            raise ValueError(f"--steps {self.text}: state {self.start} is out of range; {states}")
+            raise ValueError(f"{self.option} {self.text}: state {self.start} is out of range; "
+                             f"{states}")
         if self.stop is not None and not -n <= self.stop <= n:
-            raise ValueError(f"--steps {self.text}: stop {self.stop} is out of range; {states}")
+            raise ValueError(f"{self.option} {self.text}: stop {self.stop} is out of range; "
+                             f"{states}")
         chosen = list(range(n))[self.start:self.stop:self.stride]
         if not chosen:
-            raise ValueError(f"--steps {self.text} selects no state; {states}")
+            raise ValueError(f"{self.option} {self.text} selects no state; {states}")
         return chosen
 
 

@@ -14,11 +14,26 @@ def add_parser(subparsers) -> None:
     p.add_argument("--tol", type=float, default=0.5,
                    help="tolerance, %% of each part's bounding-sphere diameter (default 0.5)")
     p.add_argument("-o", "--output", help="write the simplified surface (.ply, .obj, .stl, ...)")
+    p.add_argument("--states", type=states_option, metavar="all|A:B:S",
+                   help="a result with states (a d3plot, crash[:S]): decimate at its first "
+                        "state and measure the certified one-sided distance of the same "
+                        "topology at these states, per part against its tolerance; prints the "
+                        "worst part of each state and the worst of all")
     p.set_defaults(func=cmd_simplify)
 
 
+def states_option(text: str):
+    """``--states``: ``all`` (every state), ``K`` or ``A:B[:S]`` (as ``animate --steps``)."""
+    from .animate import state_selection
+
+    selection = state_selection(":" if text == "all" else text)
+    return selection._replace(text=text, option="--states")
+
+
 def cmd_simplify(args) -> int:
-    """Print the triangle counts, time, tolerance and collapses, and write ``--output``; 0."""
+    """Print the triangle counts, time, tolerance and collapses, with ``--states`` the
+    certified distance of the same topology at those states, and write ``--output``; 0.
+    ValueError (one line) for ``--states`` on a mesh without states or outside them."""
     from ..algo.simplify import hausdorff_decimate
     from ..output.export import write_surface
     from ..output.targets import output_target
@@ -27,6 +42,11 @@ def cmd_simplify(args) -> int:
     if args.output:
         output_target(args.output)  # refused before the decimation, not after it
     mesh = load_mesh(args.mesh)
+    states = None
+    if args.states is not None:  # refused before the decimation, not after it
+        if mesh.steps is None:
+            raise ValueError(f"--states: {mesh.name} has no states (one geometry)")
+        states = args.states.states(mesh)
     tri = mesh.triangulation
     d = hausdorff_decimate(mesh.nodes, tri.triangles, args.tol / 100.0, relative=True,
                            parts=mesh.parts[tri.element_of])
@@ -34,7 +54,27 @@ def cmd_simplify(args) -> int:
           f"{d.seconds:.2f} s; one-sided Hausdorff certified <= {args.tol:g} % of each part's "
           f"bounding-sphere diameter ({d.tol_abs.min():.4g} to {d.tol_abs.max():.4g} "
           f"{mesh.units}); {d.collapses} collapses")
+    if states is not None:
+        _print_states(mesh, tri, d, states)
     if args.output:
         out = write_surface(args.output, mesh.nodes, d.triangles)
         print(f"  written to {out}")
     return 0
+
+
+def _print_states(mesh, tri, decimation, states: list[int]) -> None:
+    """The certified distance of ``decimation`` at ``states``: the worst part of each state
+    and the worst of all, as ratios to the part's tolerance (above 1: exceeded)."""
+    from ..algo.simplify.states import bounds_over_states
+
+    bounds = bounds_over_states(mesh.steps, tri.triangles, mesh.parts[tri.element_of],
+                                decimation, states=states)
+    print("  certified one-sided distance of the same topology at each state, worst part "
+          "(distance / the part's tolerance):")
+    for k, (state, part, ratio) in enumerate(bounds.worst_per_state()):
+        upper = bounds.upper[k, list(bounds.part_labels).index(part)]
+        flag = "  exceeds" if ratio > 1.0 else ""
+        print(f"    state {state}: part {part}, {upper:.4g} {mesh.units}, {ratio:.3f}{flag}")
+    state, part, ratio = bounds.worst()
+    print(f"  worst: state {state}, part {part}, {ratio:.3f} x its tolerance"
+          + (" (the decimation holds at every state measured)" if ratio <= 1.0 else ""))

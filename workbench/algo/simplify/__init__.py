@@ -17,6 +17,7 @@ parts slide along their common boundary together (:mod:`.constraints`).
 Modules, from the entry point down:
 
 * :mod:`.decimate` -- :func:`hausdorff_decimate` and its result :class:`Decimation`;
+* :mod:`.states` -- how far one decimation holds at every state of a result (certified);
 * :mod:`.inputs` -- input checks and normal form (parts' tolerances, duplicate faces, normals,
   quadrics);
 * :mod:`.constraints` -- fixed vertices and constrained (feature/boundary) edges;
