@@ -300,10 +300,11 @@ class MeshPath(GLPath):
             return 0
         self.deleted = self.mesh.n_deleted(step)
         before, self._live_shown = self._live_shown, live
-        if np.array_equal(live, before):
+        changed = None if before is None else np.flatnonzero(live != before)
+        if changed is not None and not len(changed):
             return 0
         if self._ghost_vao is None:
-            sent = self._write_changed_triangles(live, before)
+            sent = self._write_changed_triangles(live, changed)
         else:
             index, self._fill_vertices = self._live_index(live)
             self._index.write(index.tobytes())
@@ -317,14 +318,14 @@ class MeshPath(GLPath):
             sent += pairs.nbytes
         return sent
 
-    def _write_changed_triangles(self, live: np.ndarray, before: np.ndarray) -> int:
-        """Write, in place, the triangles of the fill index whose state differs between
-        ``before`` (what the buffer holds) and ``live`` (bool over the triangle list): a
-        triangle now in use gets its three vertices back, one deleted becomes degenerate
-        (its first vertex three times: no fragment), each run of consecutive changed triangles
-        one write; every triangle keeps its place, so the whole buffer is drawn in the order of
-        an uneroded draw. The bytes sent (12 a changed triangle)."""
-        changed = np.flatnonzero(live != before)
+    def _write_changed_triangles(self, live: np.ndarray, changed: np.ndarray) -> int:
+        """Write, in place, the triangles ``changed`` (ascending indices into the triangle
+        list) of the fill index, whose state in ``live`` (bool over the triangle list) differs
+        from what the buffer holds: a triangle now in use gets its three vertices back, one
+        deleted becomes degenerate (its first vertex three times: no fragment), each run of
+        consecutive changed triangles one write; every triangle keeps its place, so the whole
+        buffer is drawn in the order of an uneroded draw. The bytes sent (12 a changed
+        triangle)."""
         rows = np.asarray(self.data.index, np.int32).reshape(-1, 3)[changed]
         dead = ~live[changed]
         rows[dead] = rows[dead][:, :1]

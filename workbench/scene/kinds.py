@@ -40,9 +40,33 @@ class _Kind:
 
     label: ClassVar[str] = "element"  # the kind's name in messages
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "parts", np.ascontiguousarray(self.parts, np.int32))
+        object.__setattr__(self, "fields", _float_fields(self.fields))
+        if self.ids is not None:
+            object.__setattr__(self, "ids", np.asarray(self.ids, np.int64))
+
     @property
     def count(self) -> int:
         return len(self.parts)
+
+    def remapped(self, node_map: np.ndarray):
+        """The items whose nodes ``node_map`` ((N,) new index, −1 dropped) all keeps,
+        renumbered, as a new object of the same kind; None when none is left."""
+        nodes = node_map[self._node_columns()]
+        keep = (nodes >= 0).reshape(self.count, -1).all(axis=1)
+        if not keep.any():
+            return None
+        return self._kept(keep, nodes[keep])
+
+    def _kept(self, keep: np.ndarray, nodes: np.ndarray):
+        """The items ``keep`` selects, with their renumbered ``nodes``."""
+        raise NotImplementedError
+
+    def _kept_common(self, keep: np.ndarray) -> dict:
+        """The shared attributes of the items ``keep`` selects."""
+        return dict(parts=self.parts[keep], ids=None if self.ids is None else self.ids[keep],
+                    fields={k: v[..., keep] for k, v in self.fields.items()})
 
     def field(self, name: str, step: int | None = None) -> np.ndarray:
         """(K,) values of ``name`` at ``step`` (static fields ignore the step)."""
@@ -108,26 +132,15 @@ class Beams(_Kind):
     label: ClassVar[str] = "beam"
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         object.__setattr__(self, "nodes", np.ascontiguousarray(
             np.asarray(self.nodes).reshape(-1, 2), np.int32))
-        object.__setattr__(self, "parts", np.ascontiguousarray(self.parts, np.int32))
-        object.__setattr__(self, "fields", _float_fields(self.fields))
-        if self.ids is not None:
-            object.__setattr__(self, "ids", np.asarray(self.ids, np.int64))
 
     def _node_columns(self) -> np.ndarray:
         return self.nodes
 
-    def remapped(self, node_map: np.ndarray) -> Beams | None:
-        """The beams whose two nodes ``node_map`` ((N,) new index, −1 dropped) keeps,
-        renumbered; None when none is left."""
-        nodes = node_map[self.nodes]
-        keep = (nodes >= 0).all(axis=1)
-        if not keep.any():
-            return None
-        return Beams(parts=self.parts[keep], ids=None if self.ids is None else self.ids[keep],
-                     fields={k: v[..., keep] for k, v in self.fields.items()},
-                     nodes=nodes[keep])
+    def _kept(self, keep: np.ndarray, nodes: np.ndarray) -> Beams:
+        return Beams(**self._kept_common(keep), nodes=nodes)
 
 
 @dataclass(frozen=True, eq=False)
@@ -142,12 +155,9 @@ class Particles(_Kind):
     label: ClassVar[str] = "SPH particle"
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         object.__setattr__(self, "node", np.ascontiguousarray(self.node, np.int32).ravel())
-        object.__setattr__(self, "parts", np.ascontiguousarray(self.parts, np.int32))
         object.__setattr__(self, "radius", np.asarray(self.radius, np.float64))
-        object.__setattr__(self, "fields", _float_fields(self.fields))
-        if self.ids is not None:
-            object.__setattr__(self, "ids", np.asarray(self.ids, np.int64))
 
     def _node_columns(self) -> np.ndarray:
         return self.node
@@ -164,15 +174,9 @@ class Particles(_Kind):
             raise MeshError(f"{mesh}: SPH radius must be finite and > 0, got "
                             f"{self.radius[bad][:5].tolist()}")
 
-    def remapped(self, node_map: np.ndarray) -> Particles | None:
-        """The particles whose node ``node_map`` keeps, renumbered; None when none is left."""
-        node = node_map[self.node]
-        keep = node >= 0
-        if not keep.any():
-            return None
-        return Particles(parts=self.parts[keep], ids=None if self.ids is None else self.ids[keep],
-                         fields={k: v[..., keep] for k, v in self.fields.items()},
-                         node=node[keep], radius=self.radius[..., keep])
+    def _kept(self, keep: np.ndarray, nodes: np.ndarray) -> Particles:
+        return Particles(**self._kept_common(keep), node=nodes,
+                         radius=self.radius[..., keep])
 
 
 def check_kinds(mesh) -> None:

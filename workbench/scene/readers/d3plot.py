@@ -77,7 +77,7 @@ from .d3plot_family import (
     _select_states,
     family_members,
 )
-from .d3plot_fields import RIGID_MATERIAL_TYPE, mid_surface
+from .d3plot_fields import mid_surface
 from .errors import ParseError, ParseWarning, build_mesh
 
 
@@ -365,12 +365,8 @@ def _shell_fields(arrays, ArrayType, elements: _Elements, n_states: int,
     and on the shells of rigid parts (which have no stress, strain or thickness records)."""
     n_shells = elements.n_shells
     n_faces = len(elements.connectivity) - n_shells  # solid faces carry no shell field: NaN
-    deformable = np.ones(n_shells, bool)
-    if ArrayType.part_material_type in arrays:
-        material = np.asarray(arrays[ArrayType.part_material_type])
-        shell_part_index = elements.part_index[:n_shells]
-        inside = shell_part_index < len(material)
-        deformable[inside] = material[shell_part_index[inside]] != RIGID_MATERIAL_TYPE
+    deformable = d3plot_fields.deformable_shells(arrays, ArrayType,
+                                                 elements.part_index[:n_shells])
 
     def per_shell(values: np.ndarray) -> np.ndarray | None:
         values = np.asarray(values, dtype=np.float64)

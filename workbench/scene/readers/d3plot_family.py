@@ -220,9 +220,15 @@ def _drop_damaged_layouts(plot, arrays: dict, ArrayType, stress_components: bool
 
 def _expected_fields(plot, stress_components: bool) -> list[str]:
     """The fields of the module notes that the header says the states hold."""
-    h = plot.header
     rigid = getattr(getattr(plot, "_material_section_info", None), "n_rigid_shells", 0)
-    shells = h.n_shells - rigid > 0 and h.n_shell_vars > 0
+    return header_fields(plot.header, rigid, stress_components)
+
+
+def header_fields(h, rigid_shells: int = 0, stress_components: bool = True) -> list[str]:
+    """The element fields of the module notes that a d3plot with lasso-python's header ``h``
+    (``D3plotHeader``) holds in its states, ``rigid_shells`` of its shells having no results
+    (unknown from the header alone: 0)."""
+    shells = h.n_shells - rigid_shells > 0 and h.n_shell_vars > 0
     solids = h.n_solids > 0 and h.n_solid_vars > 0
     names = []
     if (shells and h.has_shell_tshell_stress) or (solids and h.has_solid_stress):

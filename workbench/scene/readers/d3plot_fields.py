@@ -39,7 +39,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..stress_tensor import SCALARS, principal_stresses, stress_scalar
-from .d3plot_family import STRESS_COMPONENTS
+from .d3plot_family import STRESS_COMPONENTS, header_fields
 
 RIGID_MATERIAL_TYPE = 20  # LS-DYNA's *MAT_RIGID: a part without stress, strain or thickness
 LAYERS = ("mid", "bottom", "top", "max", "min")
@@ -96,24 +96,14 @@ def offered_fields(header) -> list[str]:
     """The names of :data:`FIELDS` that a d3plot with lasso-python's ``header``
     (``D3plotHeader``) can give, in the order of :data:`FIELDS`."""
     h = header
-    shells = h.n_shells > 0 and h.n_shell_vars > 0
-    solids = h.n_solids > 0 and h.n_solid_vars > 0
-    have = set()
+    have = set(header_fields(h))
     for name, flag in (("displacement", h.has_node_displacement),
                        ("velocity", h.has_node_velocity),
                        ("acceleration", h.has_node_acceleration)):
         if flag:
             have.update([name, *(f"{name}_{a}" for a in AXES)])
-    if (shells and h.has_shell_tshell_stress) or (solids and h.has_solid_stress):
+    if "von_mises" in have:  # a stress tensor: every scalar of it
         have.update(SCALARS)
-    if shells and h.has_shell_tshell_stress:
-        have.update(f"stress_{c}" for c in STRESS_COMPONENTS)
-    if (shells and h.has_shell_tshell_pstrain) or (solids and h.has_solid_pstrain):
-        have.add("plastic_strain")
-    if shells and h.has_shell_extra_variables:
-        have.add("thickness")
-    if h.has_element_deletion_data and (h.n_shells > 0 or h.n_solids > 0):
-        have.add("alive")
     return [name for name in FIELDS if name in have]
 
 
@@ -264,16 +254,22 @@ def element_fields(fields: dict, arrays: dict, ArrayType, elements, n_states: in
         fields["plastic_strain"][:, :n_shells] = spread(layered_strain(strain, layer))
 
 
+def deformable_shells(arrays: dict, ArrayType, shell_part_index: np.ndarray) -> np.ndarray:
+    """(S,) bool, the shells (by their part indexes) of parts that are not rigid: the ones a
+    d3plot writes results for (every shell where the file gives no material types)."""
+    deformable = np.ones(len(shell_part_index), bool)
+    if ArrayType.part_material_type in arrays:
+        material = np.asarray(arrays[ArrayType.part_material_type])
+        inside = shell_part_index < len(material)
+        deformable[inside] = material[shell_part_index[inside]] != RIGID_MATERIAL_TYPE
+    return deformable
+
+
 def _shell_spreader(arrays: dict, ArrayType, elements, n_states: int):
     """A function taking (T, S) values of the shells written with results (every shell, or
     the deformable ones: a rigid part's shells have none) to (T, shells), NaN where none."""
     n_shells = elements.n_shells
-    deformable = np.ones(n_shells, bool)
-    if ArrayType.part_material_type in arrays:
-        material = np.asarray(arrays[ArrayType.part_material_type])
-        index = elements.part_index[:n_shells]
-        inside = index < len(material)
-        deformable[inside] = material[index[inside]] != RIGID_MATERIAL_TYPE
+    deformable = deformable_shells(arrays, ArrayType, elements.part_index[:n_shells])
 
     def spread(values: np.ndarray) -> np.ndarray:
         if values.shape[1] == n_shells:
