@@ -63,36 +63,58 @@ def bounds_over_states(steps, triangles, parts, decimation: Decimation, *,
     ``parts`` (K,)) at each of ``states`` (default every state of ``steps``), each part's
     bracket narrowed to ``tol`` × its tolerance (default 1 %: the ratio's upper end is within
     0.01 of the exact ratio where the bracket reaches its width)."""
+    return distances_over_states(steps, triangles, parts, decimation.triangles,
+                                 decimation.parts, decimation.part_labels, decimation.tol_abs,
+                                 states=states, tol=tol)
+
+
+def distances_over_states(steps, triangles, parts, simplified, simplified_parts, part_labels,
+                          tol_abs, *, simplified_steps=None, states=None,
+                          tol: float = 0.01) -> StateBounds:
+    """:class:`StateBounds` of any simplified surface: ``simplified`` (K', 3) triangles with
+    part labels ``simplified_parts`` (K',), indexing ``simplified_steps`` (T, N', 3) -- by
+    default ``steps`` itself, the vertices kept in place --, measured against the original
+    ``triangles`` (K, 3) with ``parts`` (K,) at each of ``states``, per part of
+    ``part_labels`` (P,) against its tolerance ``tol_abs`` (P,, model units). A simplifier that
+    moves vertices has coordinates of its own only at the state it saw: the caller says how its
+    vertices follow the others (``simplified_steps``)."""
     steps = np.asarray(steps, dtype=np.float64)
     if steps.ndim != 3 or steps.shape[2] != 3:
         raise ValueError(f"steps must be (T, N, 3), got {steps.shape}")
+    moved = steps if simplified_steps is None else np.asarray(simplified_steps, np.float64)
+    if moved.ndim != 3 or moved.shape[0] != steps.shape[0] or moved.shape[2] != 3:
+        raise ValueError(f"simplified_steps must be ({steps.shape[0]}, N', 3), got "
+                         f"{moved.shape}")
     triangles = np.asarray(triangles, dtype=np.int64)
+    simplified = np.asarray(simplified, dtype=np.int64)
     parts = np.asarray(parts)
-    n = steps.shape[1]
-    for name, tri in (("triangles", triangles), ("the decimation's triangles",
-                                                 np.asarray(decimation.triangles, np.int64))):
+    simplified_parts = np.asarray(simplified_parts)
+    for name, tri, n in (("triangles", triangles, steps.shape[1]),
+                         ("the simplified triangles", simplified, moved.shape[1])):
         if tri.ndim != 2 or tri.shape[1] != 3 or (tri.size and (tri.min() < 0 or
                                                                  tri.max() >= n)):
-            raise ValueError(f"{name} must be (K, 3) indices of the {n} vertices of steps")
+            raise ValueError(f"{name} must be (K, 3) indices of the {n} vertices of their steps")
     if parts.shape != (len(triangles),):
         raise ValueError(f"parts must be ({len(triangles)},), got {parts.shape}")
+    if simplified_parts.shape != (len(simplified),):
+        raise ValueError(f"simplified_parts must be ({len(simplified)},), got "
+                         f"{simplified_parts.shape}")
     if not (np.isfinite(tol) and 0 < tol < 1):
         raise ValueError(f"tol must be a fraction in (0, 1), got {tol!r}")
     states = np.arange(len(steps)) if states is None else np.asarray(states, np.int64)
-    labels = np.asarray(decimation.part_labels)
-    tol_abs = np.asarray(decimation.tol_abs, np.float64)
+    labels = np.asarray(part_labels)
+    tol_abs = np.asarray(tol_abs, np.float64)
     upper = np.zeros((len(states), len(labels)))
     lower = np.zeros_like(upper)
     for p, label in enumerate(labels):
         original = triangles[parts == label]
-        simplified = np.asarray(decimation.triangles, np.int64)[decimation.parts == label]
-        if len(original) and not len(simplified):
-            raise ValueError(f"part {label}: the decimation left no triangle to measure")
+        kept = simplified[simplified_parts == label]
+        if len(original) and not len(kept):
+            raise ValueError(f"part {label}: the simplification left no triangle to measure")
         if not len(original):
             continue
         for k, state in enumerate(states):
-            coords = steps[state]
-            r = hausdorff(coords, original, coords, simplified, tol=tol * tol_abs[p],
+            r = hausdorff(steps[state], original, moved[state], kept, tol=tol * tol_abs[p],
                           estimates=False)
             upper[k, p], lower[k, p] = r.upper, r.lower
     return StateBounds(states, labels, tol_abs, upper, lower)
