@@ -61,13 +61,15 @@ def certificate_rounding(vertices, triangles, tol, depths) -> np.ndarray:
     """(len(tol),) the bound (model units) of the rounding error of a certificate
     ``max_{p ∈ T} d(p, S(T)) <= tol`` for each tolerance ``tol`` (one per part), following the
     error model of :mod:`workbench.algo.nearest.triangle`: a corner distance up to tol to a face no
-    longer than the bounding-box diagonal of the used ``vertices`` (N, 3, near the origin), plus
+    longer than the bounding-box diagonal of the used ``vertices`` ((N, 3) near the origin, or
+    (S, N, 3): the largest over the S states), plus
     how far a piece's corners may lie from T after ``depths.max()`` levels of midpoints and the
     translation of the model (which moves T and the faces alike: twice). The certification
     compares against ``tol`` less this, and the reported bounds are rounded up by it."""
-    used = vertices[np.unique(triangles)]
-    diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
-    magnitude = float(np.sqrt((used ** 2).sum(axis=1)).max())
+    states = vertices if vertices.ndim == 3 else vertices[None]
+    used = states[:, np.unique(triangles)]
+    diagonal = float(np.linalg.norm(used.max(axis=1) - used.min(axis=1), axis=1).max())
+    magnitude = float(np.sqrt((used ** 2).sum(axis=2)).max())
     levels = int(np.max(depths, initial=0)) + 2
     return np.array([distance_rounding(t, diagonal) + construction_rounding(magnitude, levels)
                      for t in np.asarray(tol, np.float64)])
@@ -179,21 +181,62 @@ def _certify(t, cand, n_cand, tol, max_depth, used, stack, depth, piece, corners
 
 
 @numba.njit(cache=True)
-def _final_bounds(V, F, orig, orig_tol, sup, sup_n, orig_depth):
-    """Per original triangle, the upper bound of :func:`triangle_bounds` against its support
-    (split while above tol). The certificate: each is <= tol by construction."""
+def _final_bounds(Vs, F, originals, sup, sup_n):
+    """Per original triangle, the largest over the certified states at which it is live of the
+    upper bound of :func:`triangle_bounds` against its support placed at that state (split
+    while above tol); NaN for a triangle live at none. The certificate: each is <= tol by
+    construction. A state at which the triangle and its support have bit for bit the
+    coordinates of a state already bounded gives the same bound and is skipped."""
+    orig, index, live = originals.corners, originals.index, originals.live
     k_orig = orig.shape[0]
     out = np.empty(k_orig)
+    tri = np.empty((3, 3))
+    checked = np.empty(Vs.shape[0], np.int64)
     for t in range(k_orig):
         n = sup_n[t]
         if n == 0:
             out[t] = np.inf
             continue
+        worst = np.nan
         faces = np.empty((n, 3, 3))
-        for j in range(n):
-            g = sup[t, j]
-            for k in range(3):
-                for c in range(3):
-                    faces[j, k, c] = V[F[g, k], c]
-        out[t] = triangle_bounds(orig[t], faces, orig_tol[t], orig_depth[t])[1]
+        n_checked = 0
+        for st in range(Vs.shape[0]):
+            if not live[st, t] or _unmoved(t, st, checked, n_checked, Vs, F, index, sup, n):
+                continue
+            checked[n_checked] = st
+            n_checked += 1
+            for j in range(n):
+                g = sup[t, j]
+                for k in range(3):
+                    for c in range(3):
+                        faces[j, k, c] = Vs[st, F[g, k], c]
+            if st == 0:
+                tri[:] = orig[t]
+            else:
+                for k in range(3):
+                    for c in range(3):
+                        tri[k, c] = Vs[st, index[t, k], c]
+            b = triangle_bounds(tri, faces, originals.tol[t], originals.depth[t])[1]
+            if not b <= worst:
+                worst = b
+        out[t] = worst
     return out
+
+
+@numba.njit(cache=True)
+def _unmoved(t, st, checked, n_checked, Vs, F, index, sup, n):
+    """Whether original triangle t (corners ``index[t]``) and its support faces ``sup[t, :n]``
+    have at state st bit for bit the coordinates they have at one of ``checked[:n_checked]``."""
+    for r in range(n_checked):
+        other = checked[r]
+        same = True
+        for k in range(3 * n + 3):
+            x = index[t, k] if k < 3 else F[sup[t, (k - 3) // 3], (k - 3) % 3]
+            for c in range(3):
+                if Vs[st, x, c] != Vs[other, x, c]:
+                    same = False
+            if not same:
+                break
+        if same:
+            return True
+    return False

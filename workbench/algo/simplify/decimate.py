@@ -19,7 +19,7 @@ from .certify import _final_bounds, certificate_rounding, certification_depths
 from .collapse import _decimate
 from .constraints import _constraints
 from .inputs import (
-    _centred,
+    _box_centre,
     _check_inputs,
     _distinct_faces,
     _part_tolerances,
@@ -48,7 +48,11 @@ class Decimation:
     an exact metric such as :mod:`workbench.algo.hausdorff`.
     ``collapses`` counts half-edge collapses done, ``rejected`` the collapses refused, by
     reason (see :mod:`~workbench.algo.simplify.rules`), ``seconds`` the wall time of the call,
-    ``passes`` how often the queue was filled.
+    ``passes`` how often the queue was filled. ``source`` (K',) int64 is the input triangle each
+    output triangle descends from (a collapse renames a corner of a triangle, never merges
+    two): its element, its fields and whether it is drawn at a state. ``states_certified`` is
+    the number of coordinate sets the bounds hold at (1: only the vertices the decimation saw)
+    and ``bounds`` the largest over them.
     ``bytes_saved`` is the size of the vertex array a separate simplified mesh would store
     (referenced vertices × 3 × 8 bytes for float64; multiply by the number of time steps for a
     time-dependent result), which sharing the original buffer saves.
@@ -68,6 +72,8 @@ class Decimation:
     passes: int
     dropped: int = 0
     notes: list[str] = field(default_factory=list)
+    states_certified: int = 1
+    source: np.ndarray | None = None
 
     def tol_for(self, label: int) -> float:
         """The tolerance (model units) of the part labelled ``label``; KeyError if none."""
@@ -86,7 +92,8 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
                        parts=None, feature_deg: float = 30.0, keep_boundary: bool = True,
                        max_normal_deg: float = 60.0, max_depth: int | None = None,
                        passes: int = 2, slide_shared: bool = True,
-                       feature_min_length: float | None = 10.0) -> Decimation:
+                       feature_min_length: float | None = 10.0, states=None,
+                       alive=None) -> Decimation:
     """Decimate a triangle mesh by half-edge collapses within a certified one-sided Hausdorff
     distance from the original surface (crash2000, section 3.2).
 
@@ -117,8 +124,20 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     (:func:`certification_depths`, 5 to 10), an integer fixes it;
     ``passes`` is how often the queue is refilled with every remaining half-edge.
 
+    ``states`` (S, N, 3) float64, optional, are further coordinates of the same vertices (the
+    other time steps of a result): a collapse is then accepted only when the bound holds with
+    the vertices at ``vertices`` AND at each of ``states``, the tolerance of a part being the
+    one at ``vertices``. The rules (normals, degenerate faces) and the order of the collapses
+    see ``vertices`` only. ``alive`` (S + 1, K) bool, optional, says which input triangles are
+    drawn at ``vertices`` and at each of ``states`` (eroded elements are not): the triangles
+    with the same pattern of states form a group of their own within their part, decimated
+    apart from the others with the common boundaries of groups kept like those of parts, so
+    that a simplified triangle is drawn at exactly the states its input triangles are, and
+    an input triangle is certified only at the states it is drawn at.
+
     Guarantee: every point of every input triangle is within its part's tolerance of the
-    simplified surface, certified by the convexity bound of
+    simplified surface (at every certified state at which it is drawn), certified by the
+    convexity bound of
     :func:`~workbench.algo.nearest.triangle.triangle_bounds` (recomputed with that function for the
     returned ``bounds``), not by sampling. Computation runs in float64 relative to the centre
     of the mesh's bounding box, so far-away models keep their digits.
@@ -135,6 +154,7 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     start = time.perf_counter()
     v_in, t_in, tol, p_in = _check_inputs(vertices, triangles, tol, parts, feature_deg,
                                           max_normal_deg, max_depth, passes, feature_min_length)
+    further, live_in = _check_states(states, alive, v_in, len(t_in))
     k_in = len(t_in)
     repeated = _repeated_index(t_in)
     keep = np.flatnonzero(~repeated)
@@ -143,12 +163,19 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
         notes.append(f"{int(repeated.sum())} triangles with a repeated vertex index dropped")
     t_orig = t_in[keep]
     p_orig = p_in[keep]
+    live = live_in[:, keep]
     labels, part_index, tol_of_label = _part_tolerances(v_in, t_orig, p_orig, tol, relative)
-    V = _centred(v_in, t_orig)
-    F, fpart, orig_face = _distinct_faces(t_orig, p_orig)
+    # each part and pattern of drawn states is decimated as a part of its own
+    group_part, group = _groups(part_index, live)
+    group_tol = tol_of_label[group_part]
+    # every state relative to the same origin: a vertex that does not move keeps its coordinates
+    centre = _box_centre(v_in, t_orig)
+    Vs = np.stack([v_in - centre, *(x - centre for x in further)])
+    V = Vs[0]
+    F, fgroup, orig_face = _distinct_faces(t_orig, group)
     orig = np.ascontiguousarray(V[t_orig])
     n_origin, face_area, degenerate = _unit_normals(V[F])
-    constraints = _constraints(V, F, fpart, n_origin, degenerate, tol_of_label, feature_deg,
+    constraints = _constraints(V, F, fgroup, n_origin, degenerate, group_tol, feature_deg,
                                keep_boundary, slide_shared, feature_min_length)
     quadrics = _quadrics(V, F, n_origin, face_area)
 
@@ -156,22 +183,28 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     orig_depth = certification_depths(orig, tol_of_label[part_index], max_depth)
     # certify against each tolerance less the bound of the certificate's own rounding, and
     # report the bounds rounded up by it: a reported bound <= tol holds for the exact distance
-    margin = certificate_rounding(V, t_orig, tol_of_label, orig_depth)
-    orig_tol = (tol_of_label - margin)[part_index]
+    margin = certificate_rounding(Vs, t_orig, tol_of_label, orig_depth)
+    originals = Originals(orig, (tol_of_label - margin)[part_index], orig_face, orig_depth,
+                          t_orig, np.ascontiguousarray(live))
     cos_max = float(np.cos(np.radians(float(max_normal_deg))))
     sup, sup_n, collapses, rejected, n_passes = _decimate(
-        Surface(V, F, fpart, alive, n_origin), Originals(orig, orig_tol, orig_face, orig_depth),
-        quadrics, constraints, cos_max, int(passes))
-    kept_bounds = _final_bounds(V, F, orig, orig_tol, sup, sup_n, orig_depth)
+        Surface(V, Vs, F, fgroup, alive, n_origin), originals, quadrics, constraints, cos_max,
+        int(passes))
+    kept_bounds = _final_bounds(Vs, F, originals, sup, sup_n)
+    if np.isnan(kept_bounds).any():
+        notes.append(f"{int(np.isnan(kept_bounds).sum())} triangles drawn at no certified "
+                     f"state: no bound")
 
     bounds = np.full(k_in, np.nan)
     bounds[keep] = np.nextafter(kept_bounds + margin[part_index], np.inf)
     out_faces = np.flatnonzero(alive)
+    first_of_face = np.full(len(F), len(orig_face), np.int64)
+    np.minimum.at(first_of_face, orig_face, np.arange(len(orig_face)))
     out = np.ascontiguousarray(F[out_faces], np.int32)
     n_used = len(np.unique(out))
     return Decimation(
         triangles=out,
-        parts=np.ascontiguousarray(fpart[out_faces]),
+        parts=np.ascontiguousarray(labels[group_part[fgroup[out_faces]]], np.int32),
         part_labels=labels.astype(np.int32),
         tol_abs=tol_of_label,
         collapses=int(collapses),
@@ -184,4 +217,40 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
         passes=int(n_passes),
         dropped=int(repeated.sum()),
         notes=notes,
+        states_certified=len(Vs),
+        source=keep[first_of_face[out_faces]],
     )
+
+
+def _check_states(states, alive, vertices: np.ndarray, k: int):
+    """``states`` as a list of (N, 3) float64 arrays (empty for None) and ``alive`` as an
+    (S + 1, K) bool array (all True for None); ValueError for the shapes and values
+    :func:`hausdorff_decimate` refuses."""
+    further = []
+    if states is not None:
+        arr = np.asarray(states)
+        if arr.ndim != 3 or arr.shape[1:] != vertices.shape or arr.dtype.kind not in "fiu":
+            raise ValueError(f"states must be a numeric (S, {len(vertices)}, 3) array, got "
+                             f"{arr.dtype} {arr.shape}")
+        arr = np.asarray(arr, np.float64)
+        if not np.isfinite(arr).all():
+            raise ValueError("states must be finite")
+        further = list(arr)
+    if alive is None:
+        return further, np.ones((len(further) + 1, k), np.bool_)
+    live = np.asarray(alive)
+    if live.shape != (len(further) + 1, k) or live.dtype != np.bool_:
+        raise ValueError(f"alive must be a ({len(further) + 1}, {k}) bool array (the input "
+                         f"triangles drawn at the vertices and at each state), got {live.dtype} "
+                         f"{live.shape}")
+    return further, live
+
+
+def _groups(part_index: np.ndarray, live: np.ndarray):
+    """The groups of the input triangles, one per part and pattern of drawn states (columns
+    of ``live`` (S + 1, K)): each group's part index (G,) and each triangle's group (K,)
+    int32, groups in the order of (part, pattern)."""
+    rows = np.concatenate([part_index[:, None].astype(np.int64),
+                           live.T.astype(np.int64)], axis=1)
+    unique, group = np.unique(rows, axis=0, return_inverse=True)
+    return unique[:, 0], np.ascontiguousarray(group.ravel(), np.int32)

@@ -82,11 +82,10 @@ def _part_tolerances(v: np.ndarray, t: np.ndarray, p: np.ndarray, tol: float, re
     return labels, part_index, tol_of_label
 
 
-def _centred(v: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """(N, 3) ``v`` relative to the centre of the bounding box of the vertices ``t`` uses."""
+def _box_centre(v: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """(3,) the centre of the bounding box of the vertices of ``v`` that ``t`` uses."""
     used_all = np.unique(t)
-    centre = 0.5 * (v[used_all].min(axis=0) + v[used_all].max(axis=0))
-    return np.ascontiguousarray(v - centre)
+    return 0.5 * (v[used_all].min(axis=0) + v[used_all].max(axis=0))
 
 
 def _distinct_faces(t: np.ndarray, p: np.ndarray):

@@ -6,6 +6,15 @@ the new fan around v, each against the faces of its own part and its own toleran
 sliding along the common boundary of two parts thereby re-certifies the triangles of both.
 The collapse is refused (``hausdorff``) unless all pass, or (``support``) when one needs more
 than ``_MAX_SUPPORT`` faces.
+
+With several certified states (``Surface.Vs``), each original triangle is certified at every
+state at which it is live, against the same candidate faces placed at that state; its new
+support is the union of the faces that certified a piece at any state, so one support certifies
+it at all of them. The state that failed last is tried first: most refused collapses are
+refused there, before the other states cost anything. A state at which every vertex the
+certificate reads has bit for bit the coordinates of a state already checked is not checked
+again: the same computation on the same numbers gives the same answer (all states are centred
+on one origin, so a vertex that does not move keeps its coordinates exactly).
 """
 
 from __future__ import annotations
@@ -20,21 +29,23 @@ from .state import _MAX_SUPPORT
 
 @numba.njit(cache=True)
 def _recertified(u, v, nfu, nfv, cur, surface, originals, supports, s):
-    """Whether the collapse u → v keeps every original triangle within tolerance:
-    (``_ACCEPTED``, ``_HAUSDORFF`` or ``_SUPPORT``, n_aff, new_sup (n_aff, S), new_n (n_aff,)),
-    the new supports of the original triangles ``s.aff[:n_aff]`` where accepted. The faces
-    around u and v are ``s.fu[:nfu]`` and ``s.fv[:nfv]``; ``cur`` numbers this attempt."""
+    """Whether the collapse u → v keeps every original triangle within tolerance at every
+    certified state: (``_ACCEPTED``, ``_HAUSDORFF`` or ``_SUPPORT``, n_aff, new_sup (n_aff, S),
+    new_n (n_aff,)), the new supports of the original triangles ``s.aff[:n_aff]`` where
+    accepted. The faces around u and v are ``s.fu[:nfu]`` and ``s.fv[:nfv]``; ``cur`` numbers
+    this attempt."""
     fan, n_fan = _new_fan(u, v, nfu, nfv, surface, s)
     n_aff = _affected(nfu, cur, supports, s)
-    reason, new_sup, new_n = _recertify(u, fan, n_fan, n_aff, surface, originals, supports, s)
+    reason, new_sup, new_n = _recertify(u, v, fan, n_fan, n_aff, surface, originals, supports,
+                                       s)
     return reason, n_aff, new_sup, new_n
 
 
 @numba.njit(cache=True)
 def _new_fan(u, v, nfu, nfv, surface, s):
     """The faces around v after the collapse u → v into ``s.fw`` and their records
-    (``_REC``): (records (n_fan, _REC), n_fan)."""
-    V, F = surface.V, surface.F
+    (``_REC``) at every certified state: (records (S, n_fan, _REC), n_fan)."""
+    Vs, F = surface.Vs, surface.F
     fu, fv, fw, tri = s.fu, s.fv, s.fw, s.tri
     # unchanged faces of v, changed faces of u (of every part; an original triangle is
     # certified against the faces of its own part only)
@@ -51,16 +62,18 @@ def _new_fan(u, v, nfu, nfv, surface, s):
             continue
         fw[n_fan] = f
         n_fan += 1
-    fan = np.empty((n_fan, _REC))
-    for j in range(n_fan):
-        g = fw[j]
-        for k in range(3):
-            x = F[g, k]
-            if x == u:
-                x = v
-            for c in range(3):
-                tri[k, c] = V[x, c]
-        _set_record(fan, j, tri[0], tri[1], tri[2])
+    n_states = Vs.shape[0]
+    fan = np.empty((n_states, n_fan, _REC))
+    for st in range(n_states):
+        for j in range(n_fan):
+            g = fw[j]
+            for k in range(3):
+                x = F[g, k]
+                if x == u:
+                    x = v
+                for c in range(3):
+                    tri[k, c] = Vs[st, x, c]
+            _set_record(fan[st], j, tri[0], tri[1], tri[2])
     return fan, n_fan
 
 
@@ -100,27 +113,51 @@ def _affected(nfu, cur, supports, s):
 
 
 @numba.njit(cache=True)
-def _recertify(u, fan, n_fan, n_aff, surface, originals, supports, s):
-    """Certify each of ``s.aff[:n_aff]`` against its remaining support plus the new fan (faces
-    ``s.fw[:n_fan]``, records ``fan``): (``_ACCEPTED``, ``_HAUSDORFF`` or ``_SUPPORT``,
-    new_sup (n_aff, S), new_n (n_aff,)), filled up to the first failure."""
+def _recertify(u, v, fan, n_fan, n_aff, surface, originals, supports, s):
+    """Certify each of ``s.aff[:n_aff]`` at every state at which it is live against its
+    remaining support plus the new fan (faces ``s.fw[:n_fan]``, records ``fan`` per state):
+    (``_ACCEPTED``, ``_HAUSDORFF`` or ``_SUPPORT``, new_sup (n_aff, S), new_n (n_aff,)),
+    filled up to the first failure."""
     S = _MAX_SUPPORT
     aff = s.aff
+    n_states = surface.Vs.shape[0]
     new_sup = np.empty((n_aff, S), np.int32)
     new_n = np.zeros(n_aff, np.int32)
     cand = np.empty((S + n_fan, _REC))
     cand_id = np.empty(S + n_fan, np.int64)
+    cand_fan = np.empty(S + n_fan, np.int64)
     used = np.empty(S + n_fan, np.bool_)
+    involved = np.empty(3 + 3 * (S + n_fan), np.int64)
+    checked = np.empty(n_states, np.int64)
     reason = _ACCEPTED
     for i in range(n_aff):
         t = aff[i]
-        nc = _candidates(t, u, fan, n_fan, surface, originals, supports, s, cand, cand_id)
+        nc = _candidates(t, u, n_fan, surface, originals, supports, s, cand_id, cand_fan)
         for j in range(nc):
             used[j] = False
-        if nc == 0 or not _certify(originals.corners[t], cand, nc, originals.tol[t],
-                                   originals.depth[t], used, s.stack, s.depth, s.piece,
-                                   s.corners):
-            reason = _HAUSDORFF
+        n_inv = _involved(t, u, v, nc, cand_id, surface, originals, involved)
+        n_checked = 0
+        first = s.hint[0]
+        for step in range(n_states):
+            # the state that failed last first, then the others in order
+            st = first if step == 0 else (step - 1 if step <= first else step)
+            if not originals.live[st, t]:
+                continue
+            if _same_as_checked(st, checked, n_checked, involved, n_inv, surface.Vs):
+                continue
+            checked[n_checked] = st
+            n_checked += 1
+            corners = _corners_at(t, st, surface, originals, s.at_state)
+            if nc == 0 or not _reaching(corners, st, fan, nc, cand_id, cand_fan, surface,
+                                        originals.tol[t], cand):
+                reason = _HAUSDORFF
+            elif not _certify(corners, cand, nc, originals.tol[t], originals.depth[t], used,
+                              s.stack, s.depth, s.piece, s.corners):
+                reason = _HAUSDORFF
+            if reason >= 0:
+                s.hint[0] = st
+                break
+        if reason >= 0:
             break
         cnt = 0
         for j in range(nc):
@@ -137,23 +174,64 @@ def _recertify(u, fan, n_fan, n_aff, surface, originals, supports, s):
 
 
 @numba.njit(cache=True)
-def _candidates(t, u, fan, n_fan, surface, originals, supports, s, cand, cand_id):
-    """The faces original triangle t is certified against after the collapse of u, as records
-    into ``cand`` and face indices into ``cand_id``; returns their count. Its support faces
-    away from u as they are, then the faces of the new fan (``s.fw[:n_fan]``, records
-    ``fan``) of t's part whose bounding sphere comes within tol of t's."""
-    V, F, fpart = surface.V, surface.F, surface.fpart
-    orig, tol = originals.corners, originals.tol[t]
-    sup, sup_n = supports.sup, supports.sup_n
-    fw, tc = s.fw, s.tc
-    # T's bounding sphere, to skip fan faces that cannot reach it
-    for c in range(3):
-        tc[c] = (orig[t, 0, c] + orig[t, 1, c] + orig[t, 2, c]) / 3.0
-    t_rad = 0.0
+def _involved(t, u, v, nc, cand_id, surface, originals, out):
+    """The vertices a certificate of original triangle t against the candidates
+    ``cand_id[:nc]`` after the collapse u → v reads (u read as v), into ``out``; returns
+    their count (with repeats)."""
+    F = surface.F
+    n = 0
     for k in range(3):
-        t_rad = max(t_rad, (orig[t, k, 0] - tc[0]) ** 2 + (orig[t, k, 1] - tc[1]) ** 2
-                    + (orig[t, k, 2] - tc[2]) ** 2)
-    t_rad = np.sqrt(t_rad)
+        out[n] = originals.index[t, k]
+        n += 1
+    for j in range(nc):
+        g = cand_id[j]
+        for k in range(3):
+            x = F[g, k]
+            out[n] = v if x == u else x
+            n += 1
+    return n
+
+
+@numba.njit(cache=True)
+def _same_as_checked(st, checked, n_checked, involved, n_inv, Vs):
+    """Whether every vertex of ``involved[:n_inv]`` has, at state st, bit for bit the
+    coordinates it has at one of the states ``checked[:n_checked]``: the certificate there
+    is then the same computation on the same numbers, and holds at st."""
+    for r in range(n_checked):
+        other = checked[r]
+        same = True
+        for j in range(n_inv):
+            x = involved[j]
+            if Vs[st, x, 0] != Vs[other, x, 0] or Vs[st, x, 1] != Vs[other, x, 1] or \
+                    Vs[st, x, 2] != Vs[other, x, 2]:
+                same = False
+                break
+        if same:
+            return True
+    return False
+
+
+@numba.njit(cache=True, inline="always")
+def _corners_at(t, st, surface, originals, out):
+    """The corners of original triangle t at certified state st (state 0: as stored)."""
+    if st == 0:
+        return originals.corners[t]
+    for k in range(3):
+        x = originals.index[t, k]
+        for c in range(3):
+            out[k, c] = surface.Vs[st, x, c]
+    return out
+
+
+@numba.njit(cache=True)
+def _candidates(t, u, n_fan, surface, originals, supports, s, cand_id, cand_fan):
+    """The faces original triangle t is certified against after the collapse of u, at every
+    state: face indices into ``cand_id`` and, for faces of the new fan, their place in it
+    (``s.fw``) into ``cand_fan`` (-1 for a support face kept as it is); returns their count.
+    Its support faces away from u as they are, then the faces of the new fan of t's part."""
+    F, fpart = surface.F, surface.fpart
+    sup, sup_n = supports.sup, supports.sup_n
+    fw = s.fw
     nc = 0
     for j in range(sup_n[t]):
         g = sup[t, j]
@@ -165,18 +243,47 @@ def _candidates(t, u, fan, n_fan, surface, originals, supports, s, cand, cand_id
                 in_fan = True
         if in_fan:
             continue
-        _set_record(cand, nc, V[F[g, 0]], V[F[g, 1]], V[F[g, 2]])
         cand_id[nc] = g
+        cand_fan[nc] = -1
         nc += 1
     t_part = fpart[originals.face[t]]
     for q in range(n_fan):
         if fpart[fw[q]] != t_part:
             continue
-        reach = t_rad + fan[q, 12] + tol
-        if (fan[q, 9] - tc[0]) ** 2 + (fan[q, 10] - tc[1]) ** 2 + \
-                (fan[q, 11] - tc[2]) ** 2 > reach * reach:
-            continue
-        cand[nc] = fan[q]
         cand_id[nc] = fw[q]
+        cand_fan[nc] = q
         nc += 1
     return nc
+
+
+@numba.njit(cache=True)
+def _reaching(corners, st, fan, nc, cand_id, cand_fan, surface, tol, cand):
+    """Fill the records ``cand[:nc]`` of the candidates at state st; a fan face whose bounding
+    sphere does not come within tol of the bounding sphere of the triangle ``corners`` gets a
+    record no piece can reach (its centre at infinity). Returns whether any candidate reaches."""
+    Vs, F = surface.Vs, surface.F
+    tc0 = (corners[0, 0] + corners[1, 0] + corners[2, 0]) / 3.0
+    tc1 = (corners[0, 1] + corners[1, 1] + corners[2, 1]) / 3.0
+    tc2 = (corners[0, 2] + corners[1, 2] + corners[2, 2]) / 3.0
+    t_rad = 0.0
+    for k in range(3):
+        t_rad = max(t_rad, (corners[k, 0] - tc0) ** 2 + (corners[k, 1] - tc1) ** 2
+                    + (corners[k, 2] - tc2) ** 2)
+    t_rad = np.sqrt(t_rad)
+    any_reach = False
+    for j in range(nc):
+        q = cand_fan[j]
+        if q < 0:
+            g = cand_id[j]
+            _set_record(cand, j, Vs[st, F[g, 0]], Vs[st, F[g, 1]], Vs[st, F[g, 2]])
+            any_reach = True
+            continue
+        reach = t_rad + fan[st, q, 12] + tol
+        if (fan[st, q, 9] - tc0) ** 2 + (fan[st, q, 10] - tc1) ** 2 + \
+                (fan[st, q, 11] - tc2) ** 2 > reach * reach:
+            cand[j] = fan[st, q]
+            cand[j, 9] = np.inf  # no piece of t comes within tol of it
+            continue
+        cand[j] = fan[st, q]
+        any_reach = True
+    return any_reach

@@ -21,11 +21,13 @@ _MAX_SUPPORT = 12
 
 
 class Surface(NamedTuple):
-    """The current mesh: coordinates (centred), faces and what each face descends from."""
+    """The current mesh: coordinates (centred), faces and what each face descends from. The
+    rules and the collapse order see ``V``; the certificates hold at every row of ``Vs``."""
 
     V: np.ndarray         # (N, 3) float64 vertex coordinates, never changed
+    Vs: np.ndarray        # (S, N, 3) float64 the coordinates of every certified state (Vs[0] = V)
     F: np.ndarray         # (M, 3) int32 face corners, rewritten by collapses
-    fpart: np.ndarray     # (M,) int32 part label of each face
+    fpart: np.ndarray     # (M,) int32 group of each face: its part (and pattern of drawn states)
     alive: np.ndarray     # (M,) bool, False once a collapse removed the face
     n_origin: np.ndarray  # (M, 3) float64 unit normal of the input face (zero if degenerate)
 
@@ -33,10 +35,12 @@ class Surface(NamedTuple):
 class Originals(NamedTuple):
     """The input triangles that must stay within tolerance of the surface."""
 
-    corners: np.ndarray   # (K, 3, 3) float64 corner coordinates (centred)
+    corners: np.ndarray   # (K, 3, 3) float64 corner coordinates (centred), at ``Surface.V``
     tol: np.ndarray       # (K,) float64 tolerance of each (its part's), model units
     face: np.ndarray      # (K,) int64 the face of the Surface it was on input
     depth: np.ndarray     # (K,) int64 subdivision depth of its certification
+    index: np.ndarray     # (K, 3) int32 their vertices (their corners at ``Surface.Vs[s]``)
+    live: np.ndarray      # (S, K) bool: whether each must be certified at each state
 
 
 class Quadrics(NamedTuple):
@@ -120,6 +124,8 @@ class Scratch(NamedTuple):
     depth: np.ndarray     # (4 D + 4,) int64 their levels
     piece: np.ndarray     # (3, 3) one piece
     corners: np.ndarray   # (5, 3) points of one distance query
+    at_state: np.ndarray  # (3, 3) corners of an original triangle at one state
+    hint: np.ndarray      # (1,) int64 the state whose certificate failed last (tried first)
 
 
 @numba.njit(cache=True)
@@ -197,4 +203,4 @@ def _new_scratch(n_vert, m, k_orig, max_depth):
         np.empty(k_orig, np.int64), np.zeros(k_orig, np.int64),
         np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3),
         np.empty((4 * max_depth + 4, 3, 3)), np.empty(4 * max_depth + 4, np.int64),
-        np.empty((3, 3)), np.empty((5, 3)))
+        np.empty((3, 3)), np.empty((5, 3)), np.empty((3, 3)), np.zeros(1, np.int64))

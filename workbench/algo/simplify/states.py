@@ -58,26 +58,34 @@ class StateBounds:
 
 
 def bounds_over_states(steps, triangles, parts, decimation: Decimation, *,
-                       states=None, tol: float = 0.01) -> StateBounds:
+                       states=None, tol: float = 0.01, alive=None) -> StateBounds:
     """:class:`StateBounds` of ``decimation`` (made from ``triangles`` (K, 3) with part labels
     ``parts`` (K,)) at each of ``states`` (default every state of ``steps``), each part's
     bracket narrowed to ``tol`` × its tolerance (default 1 %: the ratio's upper end is within
-    0.01 of the exact ratio where the bracket reaches its width)."""
+    0.01 of the exact ratio where the bracket reaches its width). ``alive`` (T, K) bool,
+    optional, says which of ``triangles`` are drawn at each state (eroded elements are not): a
+    simplified triangle is drawn where the triangle it descends from is (its ``source``)."""
     return distances_over_states(steps, triangles, parts, decimation.triangles,
                                  decimation.parts, decimation.part_labels, decimation.tol_abs,
-                                 states=states, tol=tol)
+                                 states=states, tol=tol, alive=alive,
+                                 simplified_alive=None if alive is None else
+                                 np.asarray(alive)[:, decimation.source])
 
 
 def distances_over_states(steps, triangles, parts, simplified, simplified_parts, part_labels,
                           tol_abs, *, simplified_steps=None, states=None,
-                          tol: float = 0.01) -> StateBounds:
+                          tol: float = 0.01, alive=None, simplified_alive=None) -> StateBounds:
     """:class:`StateBounds` of any simplified surface: ``simplified`` (K', 3) triangles with
     part labels ``simplified_parts`` (K',), indexing ``simplified_steps`` (T, N', 3) -- by
     default ``steps`` itself, the vertices kept in place --, measured against the original
     ``triangles`` (K, 3) with ``parts`` (K,) at each of ``states``, per part of
     ``part_labels`` (P,) against its tolerance ``tol_abs`` (P,, model units). A simplifier that
     moves vertices has coordinates of its own only at the state it saw: the caller says how its
-    vertices follow the others (``simplified_steps``)."""
+    vertices follow the others (``simplified_steps``). ``alive`` (T, K) and
+    ``simplified_alive`` (T, K') bool, optional (both or neither), say which triangles are drawn
+    at each state: only the drawn original triangles are measured, against the drawn simplified
+    ones; a part with drawn original triangles and no drawn simplified one is infinitely far
+    (upper and lower ``inf``), a part with none drawn is 0."""
     steps = np.asarray(steps, dtype=np.float64)
     if steps.ndim != 3 or steps.shape[2] != 3:
         raise ValueError(f"steps must be (T, N, 3), got {steps.shape}")
@@ -101,20 +109,35 @@ def distances_over_states(steps, triangles, parts, simplified, simplified_parts,
                          f"{simplified_parts.shape}")
     if not (np.isfinite(tol) and 0 < tol < 1):
         raise ValueError(f"tol must be a fraction in (0, 1), got {tol!r}")
+    if (alive is None) != (simplified_alive is None):
+        raise ValueError("alive and simplified_alive go together")
+    if alive is not None:
+        alive = np.asarray(alive, bool)
+        simplified_alive = np.asarray(simplified_alive, bool)
+        if alive.shape != (len(steps), len(triangles)) or \
+                simplified_alive.shape != (len(steps), len(simplified)):
+            raise ValueError(f"alive must be ({len(steps)}, {len(triangles)}) and "
+                             f"simplified_alive ({len(steps)}, {len(simplified)}), got "
+                             f"{alive.shape} and {simplified_alive.shape}")
     states = np.arange(len(steps)) if states is None else np.asarray(states, np.int64)
     labels = np.asarray(part_labels)
     tol_abs = np.asarray(tol_abs, np.float64)
     upper = np.zeros((len(states), len(labels)))
     lower = np.zeros_like(upper)
     for p, label in enumerate(labels):
-        original = triangles[parts == label]
-        kept = simplified[simplified_parts == label]
-        if len(original) and not len(kept):
+        in_part, kept_in_part = parts == label, simplified_parts == label
+        if in_part.any() and not kept_in_part.any():
             raise ValueError(f"part {label}: the simplification left no triangle to measure")
-        if not len(original):
-            continue
         for k, state in enumerate(states):
-            r = hausdorff(steps[state], original, moved[state], kept, tol=tol * tol_abs[p],
-                          estimates=False)
+            mine, kept = in_part, kept_in_part
+            if alive is not None:
+                mine, kept = mine & alive[state], kept & simplified_alive[state]
+            if not mine.any():
+                continue
+            if not kept.any():
+                upper[k, p] = lower[k, p] = np.inf
+                continue
+            r = hausdorff(steps[state], triangles[mine], moved[state], simplified[kept],
+                          tol=tol * tol_abs[p], estimates=False)
             upper[k, p], lower[k, p] = r.upper, r.lower
     return StateBounds(states, labels, tol_abs, upper, lower)
