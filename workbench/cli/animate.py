@@ -7,6 +7,11 @@ values (:class:`~workbench.animation.frames.FrameLoop`); every frame is the imag
 state's time and, with a field, the colour bar (:mod:`workbench.animation.decoration`).
 Printed: what was written, what preparing cost, and per state the median and range of the
 upload and of the draw with its read-back (ms), with the bytes each state uploaded.
+
+``--simplify PCT`` draws instead the mesh's triangles decimated once within a certified
+one-sided Hausdorff distance of PCT % of each part's bounding-sphere diameter, at every state's
+coordinates, a row under each frame giving the bound certified at its state
+(:mod:`workbench.animation.simplified`).
 """
 
 from __future__ import annotations
@@ -78,6 +83,11 @@ def positive_fps(text: str) -> float:
     return value
 
 
+def positive_percent(text: str) -> float:
+    """``--simplify``: a positive, finite percentage."""
+    return positive_fps(text)
+
+
 def add_parser(subparsers) -> None:
     """Add ``animate`` to the ``workbench`` command's subparsers."""
     p = subparsers.add_parser(
@@ -128,6 +138,15 @@ def add_parser(subparsers) -> None:
                         "drawn translucent")
     p.add_argument("-O", "--option", type=key_value, action="append", metavar="KEY=VALUE",
                    help="any style option of the path (repeatable)")
+    p.add_argument("--simplify", type=positive_percent, metavar="PCT",
+                   help="draw the triangles decimated once, part by part, within a certified "
+                        "one-sided Hausdorff distance of PCT %% of each part's bounding-sphere "
+                        "diameter (as simplify --tol), at every state's coordinates; a row "
+                        "under each frame gives the bound certified at its state, as a "
+                        "multiple of the tolerance. Refused for a mesh without states")
+    p.add_argument("--states", choices=("first", "all"),
+                   help="with --simplify: decimate at the first state drawn (first, default) "
+                        "or certify the decimation at every state drawn (all)")
     add_device_argument(p)
     p.set_defaults(func=cmd_animate)
 
@@ -167,16 +186,27 @@ def cmd_animate(args) -> int:
     out = video_target(args.output)
     if out.suffix.lower() == ".mp4":
         check_even(args.size, "--size")
+    if args.states is not None and args.simplify is None:
+        raise ValueError(f"--states {args.states} applies to --simplify: give --simplify PCT")
     mesh, args.field = load_with_fields(args, mesh_only=True)
     steps = args.steps.states(mesh) if args.steps is not None else list(range(mesh.n_steps))
     path_name = scene_path(mesh, args.path, args.field, source=args.mesh)
     check_animated_path(path_name)
     style = _style(args, path_name)
+    simplified = None
+    if args.simplify is not None:
+        from ..animation.simplified import simplify_animation
+
+        simplified = simplify_animation(
+            mesh, steps, args.simplify, args.states or "first", args.field,
+            progress=lambda text: print(f"animate: {text} ...", file=sys.stderr))
     ctx = create_context(device=args.device)
-    loop = FrameLoop(ctx, mesh, path_name, style, steps=steps, size=args.size, view=args.view,
-                     up=args.up, scale=args.scale)
+    loop = FrameLoop(ctx, mesh if simplified is None else simplified.mesh, path_name, style,
+                     steps=steps, size=args.size, view=args.view, up=args.up, scale=args.scale)
     decorate = Decoration(f"{mesh.name} ({path_name})", loop.field, args.units,
                           loop.style.colormap, loop.style.bands, args.time_units)
+    if simplified is not None:
+        decorate = simplified.decorate(decorate)
     costs: list[tuple] = []
     bar = _progress(len(steps))
 
@@ -194,6 +224,8 @@ def cmd_animate(args) -> int:
         bar.close()
     for line in _report(out, count, mesh, path_name, loop, costs, args):
         print(line)
+    if simplified is not None:
+        print(simplified.summary())
     return 0
 
 
