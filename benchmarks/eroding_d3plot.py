@@ -26,9 +26,8 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
 from workbench.measurement.bench import Case, benchmark, needs_gl, needs_module
+from workbench.output.d3plot import write_d3plot
 
 SIZE = (800, 600)
 FAILURE_STRAIN = 2.5
@@ -43,30 +42,6 @@ def eroding_crash(k: int, states: int):
     rigid = [part for part, title in car.part_names.items() if "rigid" in title.lower()]
     big = refine(car, k) if k > 1 else car
     return crash_sequence(big, steps=states, still_parts=rigid, failure_strain=FAILURE_STRAIN)
-
-
-def write_d3plot(mesh, folder: Path) -> Path:
-    """``mesh`` (shells, every state, ``plastic_strain`` and ``alive``) as a d3plot in
-    ``folder`` written by lasso-python; the path of its first file."""
-    from lasso.dyna import ArrayType, D3plot
-
-    plot = D3plot()
-    arrays = plot.arrays
-    parts, part_index = np.unique(mesh.parts, return_inverse=True)
-    arrays[ArrayType.node_coordinates] = mesh.nodes.astype(np.float32)
-    arrays[ArrayType.node_ids] = np.arange(1, mesh.n_nodes + 1, dtype=np.int32)
-    arrays[ArrayType.element_shell_node_indexes] = mesh.elements.astype(np.int32)
-    arrays[ArrayType.element_shell_part_indexes] = part_index.astype(np.int32)
-    arrays[ArrayType.element_shell_ids] = np.arange(1, mesh.n_elements + 1, dtype=np.int32)
-    arrays[ArrayType.part_ids] = parts.astype(np.int32)
-    arrays[ArrayType.global_timesteps] = np.asarray(mesh.times, np.float32)
-    arrays[ArrayType.node_displacement] = mesh.steps.astype(np.float32)
-    strain = mesh.element_fields["plastic_strain"].astype(np.float32)
-    arrays[ArrayType.element_shell_effective_plastic_strain] = strain[:, :, None]
-    arrays[ArrayType.element_shell_is_alive] = mesh.element_fields["alive"].astype(np.float32)
-    path = folder / "d3plot"
-    plot.write_d3plot(str(path))
-    return path
 
 
 def _frames(ctx, mesh, path: str, field: str | None):
