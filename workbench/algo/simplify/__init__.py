@@ -14,10 +14,16 @@ rules that refuse some and count them by reason (:mod:`.rules`); feature lines, 
 the common boundaries of parts are kept as polylines along which vertices only slide, and
 parts slide along their common boundary together (:mod:`.constraints`).
 
+For a result with several states (the time steps of a crash), ``states=`` certifies every
+collapse at each state's coordinates too, so that the one simplified topology holds its bound
+over the whole animation, and ``alive=`` decimates the triangles deleted at different states
+apart (:mod:`.recertify`).
+
 Modules, from the entry point down:
 
 * :mod:`.decimate` -- :func:`hausdorff_decimate` and its result :class:`Decimation`;
-* :mod:`.states` -- how far one decimation holds at every state of a result (certified);
+* :mod:`.states` -- how far one decimation holds at every state of a result, measured with the
+  certified metric;
 * :mod:`.inputs` -- input checks and normal form (parts' tolerances, duplicate faces, normals,
   quadrics);
 * :mod:`.constraints` -- fixed vertices and constrained (feature/boundary) edges;

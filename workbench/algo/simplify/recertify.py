@@ -127,6 +127,8 @@ def _recertify(u, v, fan, n_fan, n_aff, surface, originals, supports, s):
     cand_id = np.empty(S + n_fan, np.int64)
     cand_fan = np.empty(S + n_fan, np.int64)
     used = np.empty(S + n_fan, np.bool_)
+    slot = np.empty(S + n_fan, np.int64)
+    used_here = np.empty(S + n_fan, np.bool_)
     involved = np.empty(3 + 3 * (S + n_fan), np.int64)
     checked = np.empty(n_states, np.int64)
     reason = _ACCEPTED
@@ -135,7 +137,9 @@ def _recertify(u, v, fan, n_fan, n_aff, surface, originals, supports, s):
         nc = _candidates(t, u, n_fan, surface, originals, supports, s, cand_id, cand_fan)
         for j in range(nc):
             used[j] = False
-        n_inv = _involved(t, u, v, nc, cand_id, surface, originals, involved)
+        n_inv = 0
+        if n_states > 1:
+            n_inv = _involved(t, u, v, nc, cand_id, surface, originals, involved)
         n_checked = 0
         first = s.hint[0]
         for step in range(n_states):
@@ -148,15 +152,18 @@ def _recertify(u, v, fan, n_fan, n_aff, surface, originals, supports, s):
             checked[n_checked] = st
             n_checked += 1
             corners = _corners_at(t, st, surface, originals, s.at_state)
-            if nc == 0 or not _reaching(corners, st, fan, nc, cand_id, cand_fan, surface,
-                                        originals.tol[t], cand):
+            n_reach = _reaching(corners, st, fan, nc, cand_id, cand_fan, surface,
+                                originals.tol[t], cand, slot)
+            for j in range(n_reach):
+                used_here[j] = used[slot[j]]
+            if n_reach == 0 or not _certify(corners, cand, n_reach, originals.tol[t],
+                                            originals.depth[t], used_here, s.stack, s.depth,
+                                            s.piece, s.corners):
                 reason = _HAUSDORFF
-            elif not _certify(corners, cand, nc, originals.tol[t], originals.depth[t], used,
-                              s.stack, s.depth, s.piece, s.corners):
-                reason = _HAUSDORFF
-            if reason >= 0:
                 s.hint[0] = st
                 break
+            for j in range(n_reach):
+                used[slot[j]] = used_here[j]
         if reason >= 0:
             break
         cnt = 0
@@ -257,10 +264,11 @@ def _candidates(t, u, n_fan, surface, originals, supports, s, cand_id, cand_fan)
 
 
 @numba.njit(cache=True)
-def _reaching(corners, st, fan, nc, cand_id, cand_fan, surface, tol, cand):
-    """Fill the records ``cand[:nc]`` of the candidates at state st; a fan face whose bounding
-    sphere does not come within tol of the bounding sphere of the triangle ``corners`` gets a
-    record no piece can reach (its centre at infinity). Returns whether any candidate reaches."""
+def _reaching(corners, st, fan, nc, cand_id, cand_fan, surface, tol, cand, slot):
+    """The records at state st of the candidates that may reach the triangle ``corners`` into
+    ``cand``, and the candidate each one is into ``slot``; returns their count. A support face
+    always counts; a fan face only where its bounding sphere comes within tol of the
+    triangle's."""
     Vs, F = surface.Vs, surface.F
     tc0 = (corners[0, 0] + corners[1, 0] + corners[2, 0]) / 3.0
     tc1 = (corners[0, 1] + corners[1, 1] + corners[2, 1]) / 3.0
@@ -270,20 +278,18 @@ def _reaching(corners, st, fan, nc, cand_id, cand_fan, surface, tol, cand):
         t_rad = max(t_rad, (corners[k, 0] - tc0) ** 2 + (corners[k, 1] - tc1) ** 2
                     + (corners[k, 2] - tc2) ** 2)
     t_rad = np.sqrt(t_rad)
-    any_reach = False
+    n = 0
     for j in range(nc):
         q = cand_fan[j]
         if q < 0:
             g = cand_id[j]
-            _set_record(cand, j, Vs[st, F[g, 0]], Vs[st, F[g, 1]], Vs[st, F[g, 2]])
-            any_reach = True
-            continue
-        reach = t_rad + fan[st, q, 12] + tol
-        if (fan[st, q, 9] - tc0) ** 2 + (fan[st, q, 10] - tc1) ** 2 + \
-                (fan[st, q, 11] - tc2) ** 2 > reach * reach:
-            cand[j] = fan[st, q]
-            cand[j, 9] = np.inf  # no piece of t comes within tol of it
-            continue
-        cand[j] = fan[st, q]
-        any_reach = True
-    return any_reach
+            _set_record(cand, n, Vs[st, F[g, 0]], Vs[st, F[g, 1]], Vs[st, F[g, 2]])
+        else:
+            reach = t_rad + fan[st, q, 12] + tol
+            if (fan[st, q, 9] - tc0) ** 2 + (fan[st, q, 10] - tc1) ** 2 + \
+                    (fan[st, q, 11] - tc2) ** 2 > reach * reach:
+                continue
+            cand[n] = fan[st, q]
+        slot[n] = j
+        n += 1
+    return n
