@@ -142,6 +142,9 @@ def hausdorff_decimate(vertices, triangles, tol: float = 0.005, *, relative: boo
     returned ``bounds``), not by sampling. Computation runs in float64 relative to the centre
     of the mesh's bounding box, so far-away models keep their digits.
 
+    Takes more than 12 arguments because it is the public call of the decimation: the mesh and
+    the tolerance, then keyword options that each change one rule, default as the paper does.
+
     Non-manifold input (edges with three or more faces, bow-tie vertices) and duplicate faces
     are accepted: what cannot be collapsed safely is left as it is, duplicate faces are kept
     once (the others are certified against it), zero-area triangles keep their vertices in
