@@ -17,8 +17,8 @@ def add_parser(subparsers) -> None:
                    help="tolerance, %% of each part's bounding-sphere diameter (default 0.5)")
     p.add_argument("-o", "--output", help="write the simplified surface (.ply, .obj, .stl, ...)")
     p.add_argument("--states", type=states_option, metavar="all|A:B:S",
-                   help="a result with states (a d3plot, crash[:S]): decimate at its first "
-                        "state and measure the certified one-sided distance of the same "
+                   help="a result with states (a d3plot, crash[:S]): decimate at the first "
+                        "of these states and measure the certified one-sided distance of the same "
                         "topology at these states, per part against its tolerance; prints the "
                         "worst part of each state and the worst of all")
     p.add_argument("--certify-states", action="store_true",
@@ -78,7 +78,7 @@ def cmd_simplify(args) -> int:
     if states is not None:
         _print_states(mesh, tri, d, states, alive)
     if args.output:
-        out = write_surface(args.output, mesh.nodes, d.triangles)
+        out = write_surface(args.output, reference, d.triangles)
         print(f"  written to {out}")
     return 0
 

@@ -253,6 +253,8 @@ def _groups(part_index: np.ndarray, live: np.ndarray):
     """The groups of the input triangles, one per part and pattern of drawn states (columns
     of ``live`` (S + 1, K)): each group's part index (G,) and each triangle's group (K,)
     int32, groups in the order of (part, pattern)."""
+    if live.all():  # no erosion: the groups are the parts
+        return np.arange(int(part_index.max()) + 1), np.ascontiguousarray(part_index, np.int32)
     rows = np.concatenate([part_index[:, None].astype(np.int64),
                            live.T.astype(np.int64)], axis=1)
     unique, group = np.unique(rows, axis=0, return_inverse=True)
