@@ -278,6 +278,8 @@ def test_eroded_elements_vanish_with_the_simplified_triangles_they_descend_from(
     tri = eroded.triangulation
     drawn = alive[2, tri.element_of[every.decimation.source]] != 0
     assert 0 < drawn.sum() < len(drawn)
+    # the stamp counts the elements the result deletes, not the simplified triangles hidden
+    assert every.deleted == {0: 0, 1: 0, 2: int((alive[2] == 0).sum())}
     loop = FrameLoop(ctx, every.mesh, "flat", make_path("flat").style, steps=[2], size=SIZE,
                      view=VIEW)
     frame = next(iter(loop))

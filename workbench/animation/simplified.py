@@ -22,10 +22,11 @@ apart), and each frame's bound is measured between the triangles drawn at its st
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -52,7 +53,8 @@ class SimplifiedAnimation:
     states, times and node fields; element fields where the decimation gives each triangle's
     source), ``decimation``, ``bounds`` (certified at each state drawn), ``percent`` (the
     tolerance, % of each part's bounding-sphere diameter), ``certified`` (``"first"`` or
-    ``"all"``), ``input_triangles`` and the wall seconds of the decimation and the bounds."""
+    ``"all"``), ``input_triangles``, the wall seconds of the decimation and the bounds, and
+    ``deleted``: per state drawn, the elements the input mesh deletes (erosion)."""
 
     mesh: FEMesh
     decimation: Decimation
@@ -62,6 +64,7 @@ class SimplifiedAnimation:
     input_triangles: int
     decimate_s: float
     bounds_s: float
+    deleted: dict[int, int] = dataclasses.field(default_factory=dict)
 
     def worst(self, step: int) -> tuple[int, float]:
         """(part label, ratio) of the largest ratio of bound to tolerance at state ``step``;
@@ -88,7 +91,8 @@ class SimplifiedAnimation:
         holding the frame's :meth:`stamp` (dark red where the bound exceeds the tolerance)."""
 
         def decorated(frame: Frame) -> np.ndarray:
-            image = decoration(frame)
+            # the elements the result deletes, not the simplified triangles they hide
+            image = decoration(replace(frame, deleted=self.deleted.get(frame.step, 0)))
             row = stamp_row(image.shape[1], self.stamp(frame.step),
                             self.worst(frame.step)[1] > 1.0)
             return np.concatenate([image, row])
@@ -170,7 +174,7 @@ def simplify_animation(mesh: FEMesh, steps: Sequence[int], percent: float,
     bounds_s = time.perf_counter() - start
     return SimplifiedAnimation(simplified_mesh(mesh, decimation, tri.element_of), decimation,
                                bounds, float(percent), certified, len(tri.triangles),
-                               decimate_s, bounds_s)
+                               decimate_s, bounds_s, {k: mesh.n_deleted(k) for k in steps})
 
 
 def simplified_mesh(mesh: FEMesh, decimation: Decimation,
