@@ -155,10 +155,10 @@ def simplify_animation(mesh: FEMesh, steps: Sequence[int], percent: float,
     say = progress or (lambda text: None)
     tri = mesh.triangulation
     parts = mesh.parts[tri.element_of]
-    alive = np.stack([mesh.alive(k)[tri.element_of] for k in range(len(mesh.steps))])
+    alive = mesh.triangles_alive()
     certify = steps[:1] if certified == "first" else steps
     further = {"states": mesh.steps[certify[1:]]} if len(certify) > 1 else {}
-    if not alive.all():
+    if alive is not None:
         further["alive"] = alive[certify]
     say(f"decimating {grouped(len(tri.triangles))} triangles at {percent:g} % (state "
         f"{steps[0]}{' and the other states drawn' if len(certify) > 1 else ''})")
@@ -170,7 +170,7 @@ def simplify_animation(mesh: FEMesh, steps: Sequence[int], percent: float,
         f"state{'s' * (len(steps) != 1)}")
     start = time.perf_counter()
     bounds = bounds_over_states(mesh.steps, tri.triangles, parts, decimation, states=steps,
-                                alive=None if alive.all() else alive)
+                                alive=alive)
     bounds_s = time.perf_counter() - start
     return SimplifiedAnimation(simplified_mesh(mesh, decimation, tri.element_of), decimation,
                                bounds, float(percent), certified, len(tri.triangles),

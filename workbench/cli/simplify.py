@@ -3,8 +3,6 @@ optionally written to a mesh file."""
 
 from __future__ import annotations
 
-import numpy as np
-
 
 def add_parser(subparsers) -> None:
     """Add ``simplify`` to the ``workbench`` command's subparsers."""
@@ -59,9 +57,7 @@ def cmd_simplify(args) -> int:
             raise ValueError(f"--states: {mesh.name} has no states (one geometry)")
         states = args.states.states(mesh)
     tri = mesh.triangulation
-    alive = None
-    if mesh.steps is not None and mesh.erodes:
-        alive = np.stack([mesh.alive(k)[tri.element_of] for k in range(mesh.n_steps)])
+    alive = mesh.triangles_alive()
     further = {}
     reference = mesh.nodes if states is None else mesh.steps[states[0]]
     if args.certify_states:

@@ -82,11 +82,8 @@ class Animated:
 def _animated(label: str, mesh: FEMesh) -> Animated:
     tri = mesh.triangulation
     steps = mesh.nodes[None] if mesh.steps is None else mesh.steps
-    alive = None
-    if mesh.erodes:
-        alive = np.stack([mesh.alive(k)[tri.element_of] for k in range(len(steps))])
     return Animated(label, np.asarray(steps, np.float64), tri.triangles.astype(np.int64),
-                    mesh.parts[tri.element_of], alive)
+                    mesh.parts[tri.element_of], mesh.triangles_alive())
 
 
 def _read_back(mesh: FEMesh) -> FEMesh:

@@ -212,6 +212,14 @@ class FEMesh:
             return np.ones(self.n_elements, bool)
         return self.element_field(ALIVE, step) != 0
 
+    def triangles_alive(self) -> np.ndarray | None:
+        """(T, K) bool: whether each triangle of :attr:`triangulation` is in use at each of
+        the T states (that of its element); None without erosion."""
+        if not self.erodes:
+            return None
+        element_of = self.triangulation.element_of
+        return np.stack([self.alive(k)[element_of] for k in range(self.n_steps)])
+
     def n_deleted(self, step: int | None = None) -> int:
         """The number of elements deleted at ``step`` (0 without erosion)."""
         return self.n_elements - int(self.alive(step).sum())
