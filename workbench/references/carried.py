@@ -123,24 +123,26 @@ def _edge_barycentric(corners: np.ndarray, points: np.ndarray) -> np.ndarray:
     return out
 
 
+def _finite_floats(a, ndim: int, name: str, shape: str) -> np.ndarray:
+    """``a`` as float64 with ``ndim`` dimensions, the last of 3; ValueError naming ``name``
+    and its expected ``shape`` otherwise, or where a coordinate is not finite."""
+    x = np.asarray(a)
+    if x.ndim != ndim or x.shape[-1] != 3 or not np.issubdtype(x.dtype, np.floating):
+        raise ValueError(f"{name} must be {shape} floats, got {x.shape} {x.dtype}")
+    x = np.asarray(x, np.float64)
+    if not np.isfinite(x).all():
+        raise ValueError(f"{name}: non-finite coordinates")
+    return x
+
+
 def _check(steps, triangles, points, parts, point_parts):
-    s = np.asarray(steps)
-    if s.ndim != 3 or s.shape[2] != 3 or not np.issubdtype(s.dtype, np.floating):
-        raise ValueError(f"steps must be (T, N, 3) floats, got {s.shape} {s.dtype}")
-    s = np.asarray(s, np.float64)
-    if not np.isfinite(s).all():
-        raise ValueError("steps: non-finite coordinates")
+    s = _finite_floats(steps, 3, "steps", "(T, N, 3)")
     t = np.asarray(triangles)
     if (t.ndim != 2 or t.shape[1] != 3 or not len(t) or not np.issubdtype(t.dtype, np.integer)
             or t.min() < 0 or t.max() >= s.shape[1]):
         raise ValueError(f"triangles must be (K, 3) indices of the {s.shape[1]} vertices, got "
                          f"{t.shape} {t.dtype}")
-    p = np.asarray(points)
-    if p.ndim != 2 or p.shape[1] != 3 or not np.issubdtype(p.dtype, np.floating):
-        raise ValueError(f"points must be (M, 3) floats, got {p.shape} {p.dtype}")
-    p = np.asarray(p, np.float64)
-    if not np.isfinite(p).all():
-        raise ValueError("points: non-finite coordinates")
+    p = _finite_floats(points, 2, "points", "(M, 3)")
     if (parts is None) != (point_parts is None):
         raise ValueError("give both parts and point_parts, or neither")
     if parts is not None:
