@@ -2,6 +2,8 @@
 compared with another run (no change against itself, the slowed path flagged, only it), and
 the claims report written from it; and the ``workbench results`` command line."""
 
+import hashlib
+import json
 import math
 import subprocess
 import time
@@ -328,6 +330,15 @@ def test_workbench_run_records_into_the_chosen_store(probe_experiment, tmp_path)
     assert {(r["experiment"], r["experiment_size"], r["table"]) for r in rows} == {
         (NAME, "quick", "table"), (NAME, "quick", "extra")}
     assert not (tmp_path / "fig" / "results").exists()
+    # the output folder names the run that wrote it, and the hash of each of its files
+    folder = tmp_path / "fig" / NAME
+    record = json.loads((folder / "provenance.json").read_text())
+    assert record["run_id"] == store.run_ids()[0] and record["size"] == "quick"
+    written = sorted(f.name for f in folder.iterdir() if f.name != "provenance.json")
+    assert sorted(record["files"]) == written == ["extra.csv", "extra.md", "table.csv",
+                                                   "table.md"]
+    for name, digest in record["files"].items():
+        assert hashlib.sha256((folder / name).read_bytes()).hexdigest() == digest
 
 
 def test_a_slowed_draw_takes_its_share_longer_and_a_negative_share_is_refused():

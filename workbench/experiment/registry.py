@@ -136,8 +136,10 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     output folder, so a run's outputs change as a set: a run that fails or is killed leaves the
     previous outputs whole. With a ``recorder`` every table's rows are then appended to its
     results store (columns ``experiment``, ``table`` and ``experiment_size`` added), once the
-    folder is in place. With ``warm`` (the default) a quick or full run is preceded by the
-    experiment's tiny run, untimed and thrown away
+    folder is in place, and the folder holds ``provenance.json`` naming the run and the
+    SHA-256 of each of its files
+    (:meth:`~workbench.results.recording.Recorder.write_provenance`). With ``warm`` (the
+    default) a quick or full run is preceded by the experiment's tiny run, untimed and thrown away
     (:func:`~workbench.experiment.warm.warm_experiment`), so that no table times the
     compilation of a kernel; a Dask cluster the experiment starts is started once and kept
     for both runs (:func:`~workbench.distributed.kept.kept_clusters`), its workers warm. What
@@ -188,6 +190,8 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
         write_table(rows, staging, "table", title=f"{exp.name}: {exp.description}",
                     notes=empty_gpu_note(rows, context.gl_renderer),
                     legend=context.legend("table", rows))
+        if recorder is not None:  # the folder names its run: figures link to it
+            recorder.write_provenance(staging, exp.name, size)
         _swap_in(staging, out_dir)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)

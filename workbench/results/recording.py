@@ -7,6 +7,8 @@ to the store under the run's id, beside the CSV/Markdown tables written from the
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -18,6 +20,19 @@ from .store import ResultsStore
 
 if TYPE_CHECKING:
     import moderngl
+
+
+PROVENANCE = "provenance.json"
+"""The file in an experiment's output folder that names the run which wrote the folder."""
+
+
+def file_sha256(path: str | os.PathLike[str]) -> str:
+    """The SHA-256 of the file at ``path``, as 64 hex digits."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 @dataclass
@@ -33,6 +48,27 @@ class Recorder:
     @property
     def run_id(self) -> str:
         return self.run["run_id"]
+
+    def write_provenance(self, folder: str | os.PathLike[str], experiment: str,
+                         size: str) -> Path:
+        """Write :data:`PROVENANCE` into ``folder`` (an experiment's output folder, before it
+        is swapped into place): this run's id, ``experiment``, ``size`` and the SHA-256 of
+        every regular file under ``folder`` by its ``/``-separated relative path, so that a
+        figure can be traced to the run that made it (and one changed since be told apart).
+        Hidden files are left out. Returns the path written."""
+        from ..output.tables import atomic_write_text
+
+        folder = Path(folder)
+        files = {}
+        for path in sorted(folder.rglob("*")):
+            relative = path.relative_to(folder)
+            if (path.is_file() and not path.is_symlink() and relative.as_posix() != PROVENANCE
+                    and not any(part.startswith(".") for part in relative.parts)):
+                files[relative.as_posix()] = file_sha256(path)
+        record = {"run_id": self.run_id, "experiment": experiment, "size": size,
+                  "commit": self.run.get("commit"), "machine_id": self.machine["machine_id"],
+                  "files": files}
+        return atomic_write_text(folder / PROVENANCE, json.dumps(record, indent=1) + "\n")
 
     def append(self, rows: Sequence[dict[str, Any]], **common: Any) -> Path | None:
         """Append ``rows`` with the ``common`` columns (``experiment``, ``table`` …) under this
