@@ -72,6 +72,18 @@ def _scale_examples(item, scale: float, done: set) -> None:
         parent=current, max_examples=max(1, round(current.max_examples * scale)))
 
 
+def pytest_addoption(parser):
+    parser.addoption("--update-golden", action="store_true", default=False,
+                     help="rewrite the golden reference images of tests/golden (and the "
+                          "renderer they were made on) from this run's images")
+
+
+@pytest.fixture(scope="session")
+def update_golden(request):
+    """Whether ``--update-golden`` asks the golden-image tests to rewrite their references."""
+    return bool(request.config.getoption("--update-golden"))
+
+
 @pytest.fixture(autouse=True, scope="session")
 def session_results_store(tmp_path_factory):
     """The results store of the session: set as ``WORKBENCH_RESULTS`` for every test."""
