@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Install workbench on a fresh Debian/Ubuntu machine: the system libraries for headless OpenGL
-# (EGL + Mesa) and open3d (libusb-1.0), then a virtual environment in .venv with the package
-# and its test, notebook and docs tools. Safe to run again.
+# (EGL + Mesa), open3d (libusb-1.0) and the results site's browser test (chromium and
+# chromium-driver), then a virtual environment in .venv with the package and its test, notebook
+# and docs tools. Safe to run again.
 set -euo pipefail
 cd "$(dirname "$0")"
 
-packages="libegl1 libegl-mesa0 libgl1-mesa-dri libgomp1 libusb-1.0-0"
+packages="libegl1 libegl-mesa0 libgl1-mesa-dri libgomp1 libusb-1.0-0 chromium chromium-driver"
 missing=$(dpkg-query -W -f='${Package} ${Status}\n' $packages 2>/dev/null | grep -vc "install ok installed" || true)
 if ! dpkg-query -W $packages >/dev/null 2>&1 || [ "$missing" != "0" ]; then
     sudo=""

@@ -3,7 +3,8 @@ circle, and no private name is imported across packages.
 
 Layers, bottom to top: ``gl`` (with the shaders, ``glsl``), ``scene`` (with ``data``) →
 ``algo`` → ``paths`` → ``measurement`` and ``output`` → ``references``, ``results``,
-``distributed`` and ``animation`` → ``experiment`` → ``sweep`` → ``reliability`` → ``cli``
+``distributed`` and ``animation`` → ``experiment`` → ``sweep`` and ``site`` (the static
+results site) → ``reliability`` → ``cli``
 (beside it the live Jupyter view, ``viewer``), and the experiment scripts (``reproductions``)
 on top. A module
 may import its own layer and the layers below. Imports inside functions count: a lazy import
@@ -26,8 +27,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 LAYERS = {"gl": 0, "scene": 0, "data": 0, "glsl": 0, "__init__": 0, "algo": 1, "paths": 2,
           "measurement": 3, "output": 3, "references": 4, "results": 4, "distributed": 4,
-          "animation": 4, "experiment": 5, "sweep": 6, "reliability": 7, "cli": 8, "viewer": 8,
-          "reproductions": 9}
+          "animation": 4, "experiment": 5, "sweep": 6, "site": 6, "reliability": 7, "cli": 8,
+          "viewer": 8, "reproductions": 9}
 # upward imports allowed by name: the package root's lazy facade (``workbench.load``,
 # ``render``, ``measure``, ``view``)
 ROOT_FACADE = {("workbench", "workbench.paths.facade"), ("workbench", "workbench.measurement.rows"),

@@ -1,6 +1,7 @@
 """``workbench results``: the results store of every run — query it with SQL, compare two runs
-(or commits, or machines), draw a Pareto figure of any query, and regenerate the measured
-claims of the README and docs/results.md from it.
+(or commits, or machines), follow a quantity over the runs with its change points, draw a
+Pareto figure of any query, and regenerate the measured claims of the README and
+docs/results.md (or a static site) from it.
 
 The store is ``--results DIR``, else ``$WORKBENCH_RESULTS``, else ``figures/results``.
 """
@@ -72,6 +73,31 @@ def add_parser(subparsers) -> None:
     add_results_option(c)
     c.set_defaults(func=cmd_compare)
 
+    h = sub.add_parser("history", help="a quantity over the stored runs, with its change points",
+                       description="List every measurement of QUANTITY (a stored column: "
+                                   "COLUMN, EXPERIMENT/COLUMN or EXPERIMENT/TABLE/COLUMN) over "
+                                   "the stored runs of each machine, oldest first, and the "
+                                   "change points E-divisive means finds in it (each split "
+                                   "kept where a permutation test finds it significant at "
+                                   "--alpha). Measurements are paired as `results compare` "
+                                   "pairs them; quick and full runs, and machines, are never "
+                                   "mixed; tiny runs are left out. Exit status 0.")
+    h.add_argument("quantity", help="e.g. wall_ms, render_paths/wall_ms or "
+                                    "simplify_tradeoff/states/ratio")
+    h.add_argument("--machine", metavar="ID", help="only machines whose id starts with ID")
+    h.add_argument("--size", choices=("full", "quick", "tiny"),
+                   help="only runs of this experiment size (default full and quick, apart)")
+    h.add_argument("--where", action="append", default=[], metavar="COLUMN=VALUE",
+                   help="only rows whose COLUMN is VALUE (text); may be repeated")
+    h.add_argument("--alpha", type=float, default=None, metavar="P",
+                   help="significance of a change point (default 0.02)")
+    h.add_argument("--all", action="store_true",
+                   help="list every measurement, not only those with a change point")
+    h.add_argument("--runs", action="store_true", help="print each run's value and interval")
+    h.add_argument("--csv", metavar="FILE", help="write every run of every measurement as CSV")
+    add_results_option(h)
+    h.set_defaults(func=cmd_history)
+
     f = sub.add_parser("pareto", help="figure of time against error from a query",
                        description="Plot the rows of a query as time against error, with the "
                                    "front of the rows no other is both faster and more exact "
@@ -97,6 +123,14 @@ def add_parser(subparsers) -> None:
     r.add_argument("--history", metavar="FILE",
                    help="the page whose benchmarks section is rewritten (default "
                         "docs/history.md where it exists; 'none' to leave it)")
+    r.add_argument("--html", metavar="DIR",
+                   help="write only a static site of the store into DIR (replaced whole; "
+                        "opens from disk): experiments with their claims, tables, Pareto plots "
+                        "and figures, runs, machines and each claim's history")
+    r.add_argument("--figures", metavar="DIR",
+                   help="where the experiments' figure folders are, for --html (default: the "
+                        "store's parent folder where the store folder is named 'results', "
+                        "else figures)")
     add_results_option(r)
     r.set_defaults(func=cmd_report)
 
@@ -153,6 +187,53 @@ def cmd_compare(args) -> int:
     return 1 if any(line["flagged"] for line in lines) else 0
 
 
+def cmd_history(args) -> int:
+    """``workbench results history QUANTITY``: per measurement its runs and change points; 0
+    (2 with one line for an unknown column or a bad option)."""
+    from ..output.tables import format_number, markdown_table, write_table
+    from ..results.changepoints import ALPHA
+    from ..results.history import histories
+
+    where = {}
+    for item in args.where:
+        column, sep, value = item.partition("=")
+        if not sep or not column:
+            return refused(ValueError(f"--where takes COLUMN=VALUE, got {item!r}"))
+        where[column] = value
+    alpha = ALPHA if args.alpha is None else args.alpha
+    if not 0 < alpha < 1:
+        return refused(ValueError(f"--alpha must lie in (0, 1), got {alpha}"))
+    try:
+        found = histories(store_of(args), args.quantity, machine=args.machine, size=args.size,
+                          where=where, alpha=alpha)
+    except ValueError as exc:
+        return refused(exc)
+    if args.csv:
+        out = Path(args.csv)
+        rows = [{"experiment": h.experiment, "table": h.table, "measurement": h.measurement,
+                 "quantity": h.quantity, "machine_id": h.machine_id, "size": h.size,
+                 "run_id": p.run_id, "started": p.started, "commit": p.commit,
+                 "value": p.value, "lo": p.lo, "hi": p.hi, "change_point": i in h.changes}
+                for h in found for i, p in enumerate(h.points)]
+        write_table(rows, out.parent if str(out.parent) else Path("."), out.stem)
+    changed = [h for h in found if h.changes]
+    for h in (found if args.all else changed):
+        print(f"{h.name}: {len(h.points)} {h.size or ''} runs on machine {h.machine_id}"
+              + (f", {h.missing} without a value" if h.missing else ""))
+        for index, step in zip(h.changes, h.steps()):
+            p = h.points[index]
+            print(f"  change at run {p.run_id} (commit {(p.commit or '?')[:10]}, "
+                  f"{p.started[:19]}): × {format_number(step, 3)}")
+        if args.runs:
+            print(markdown_table([{"run": p.run_id, "commit": (p.commit or "")[:10],
+                                   "started": p.started[:19], "value": p.value, "lo": p.lo,
+                                   "hi": p.hi, "change": "◆" if i in h.changes else ""}
+                                  for i, p in enumerate(h.points)]), end="")
+    print(f"history of {args.quantity}: {len(found)} measurements, {len(changed)} with a "
+          f"change point (alpha {alpha:g})")
+    return 0
+
+
 def cmd_pareto(args) -> int:
     """``workbench results pareto``: the figure of the query's rows; 0."""
     import duckdb
@@ -179,9 +260,13 @@ def cmd_pareto(args) -> int:
 
 def cmd_report(args) -> int:
     """``workbench results report``: rewrite the README's claims, docs/results.md and the
-    benchmarks section of docs/history.md; 0."""
+    benchmarks section of docs/history.md (with ``--html DIR``: write only the site, printing
+    the path of its index); 0, or 2 for a refused folder or an empty store."""
     from ..experiment.report import write_report
     from ..output.targets import output_target
+
+    if args.html is not None:
+        return _report_html(args)
 
     # refused before the README is read: reading a FIFO would block
     readme, doc = map(output_target, (args.readme, args.doc))
@@ -191,4 +276,24 @@ def cmd_report(args) -> int:
                            history=None if history == "none" else output_target(history))
     for path in written:
         print(f"wrote {path}", file=sys.stderr)
+    return 0
+
+
+def _report_html(args) -> int:
+    """``workbench results report --html DIR``: the static site of the store; prints the path
+    of its index; 0, or 2 (one error line) for a refused DIR or a store without runs."""
+    import time
+
+    from ..site import write_site
+
+    store = store_of(args)
+    figures = args.figures or (store.root.parent if store.root.name == "results"
+                               else Path("figures"))
+    start = time.perf_counter()
+    try:
+        index = write_site(store, args.html, figures)
+    except ValueError as exc:
+        return refused(exc)
+    print(f"site written in {time.perf_counter() - start:.1f} s", file=sys.stderr)
+    print(index)
     return 0
