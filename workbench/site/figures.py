@@ -11,14 +11,14 @@ out, as is the store's own folder.
 
 from __future__ import annotations
 
-import hashlib
 import json
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..results.recording import PROVENANCE, file_sha256
+
 IMAGES = (".png", ".svg", ".gif", ".jpg", ".jpeg", ".webp")
 LINKED = (".mp4", ".webm", ".pdf")
-PROVENANCE = "provenance.json"
 
 
 @dataclass(frozen=True)
@@ -32,15 +32,6 @@ class FigureFile:
     image: bool
     run_id: str | None
     note: str | None
-
-
-def sha256_of(path: Path) -> str:
-    """The SHA-256 of the file at ``path``, in hex."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as handle:
-        for block in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 def _provenance(folder: Path) -> tuple[dict | None, str | None]:
@@ -78,7 +69,7 @@ def experiment_figures(folder: Path, runs: set[str] | frozenset[str]) -> list[Fi
             listed = provenance["files"].get(name)
             if listed is None:
                 note = f"not listed in {PROVENANCE}"
-            elif listed != sha256_of(path):
+            elif listed != file_sha256(path):
                 note = f"changed since run {provenance.get('run_id')} wrote it"
             elif provenance.get("run_id") not in runs:
                 note = f"run {provenance.get('run_id')} is not in the results store"

@@ -163,7 +163,7 @@ def machines_page(contents: Contents) -> str:
 
 def machine_body(contents: Contents, machine_id: str) -> str:
     """One machine's page: every fingerprint field (those of
-    :data:`~workbench.results.provenance.MACHINE_FIELDS` first) and the runs made on it."""
+    ``MACHINE_FIELDS`` of :mod:`workbench.results.provenance` first) and the runs made on it."""
     machine = contents.machines[machine_id]
     fields = [f for f in MACHINE_FIELDS if f in machine] + sorted(
         f for f in machine if f not in MACHINE_FIELDS and f != "machine_id")
