@@ -4,13 +4,12 @@ and not invented on seeded synthetic series, and histories that keep machines, s
 measurements apart."""
 
 import itertools
-import subprocess
-import sys
 from fractions import Fraction
 
 import numpy as np
 import pytest
 
+from workbench.cli import main
 from workbench.results.changepoints import change_points, energy_statistics
 from workbench.results.history import histories, parse_quantity
 from workbench.results.store import ResultsStore
@@ -156,14 +155,19 @@ def test_history_refuses_unknown_columns_and_bad_quantities(tmp_path):
     assert parse_quantity("e/c") == ("e", None, "c")
 
 
-def test_history_command(tmp_path):
+def test_history_command(tmp_path, capsys):
     store_with_step(tmp_path / "s")
-    run = [sys.executable, "-m", "workbench.cli", "results", "history", "--results",
-           str(tmp_path / "s")]
-    done = subprocess.run([*run, "exp/wall_ms"], capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr
-    assert "path=flat" in done.stdout and "change at run m1-08 (commit c08" in done.stdout
-    assert "path=gouraud" not in done.stdout  # no change: listed only with --all
-    assert "2 measurements, 1 with a change point" in done.stdout
-    bad = subprocess.run([*run, "wal_ms"], capture_output=True, text=True, timeout=120)
-    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "wall_ms" in bad.stderr
+    base = ["results", "history", "--results", str(tmp_path / "s")]
+    assert main([*base, "exp/wall_ms"]) == 0
+    out = capsys.readouterr().out
+    assert "path=flat" in out and "change at run m1-08 (commit c08" in out
+    assert "path=gouraud" not in out  # no change: listed only with --all
+    assert "2 measurements, 1 with a change point" in out
+    assert main([*base, "exp/wall_ms", "--all", "--runs"]) == 0
+    out = capsys.readouterr().out
+    assert "path=gouraud" in out and out.count("◆") == 1
+    assert main([*base, "wal_ms"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "closest: wall_ms" in err
+    assert main([*base, "wall_ms", "--where", "path"]) == 2
+    assert main([*base, "wall_ms", "--alpha", "1.5"]) == 2
