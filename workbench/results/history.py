@@ -129,8 +129,11 @@ def histories(store: ResultsStore, quantity: str, *, machine: str | None = None,
     id starts with it, ``size`` one experiment size, ``where`` the rows whose column equals the
     given text (``{"scene": "car"}``). ValueError for a column the store does not hold (naming
     the closest ones)."""
+    import pyarrow as pa
+
     experiment, table, column = parse_quantity(quantity)
-    stored = store.query("SELECT * FROM rows LIMIT 0").column_names
+    schema = store.query("SELECT * FROM rows LIMIT 0").schema
+    stored = schema.names
     if column not in stored:
         close = difflib.get_close_matches(column, stored, n=4)
         hint = f" (closest: {', '.join(close)})" if close else ""
@@ -148,8 +151,13 @@ def histories(store: ResultsStore, quantity: str, *, machine: str | None = None,
                           else "r.experiment_size IS DISTINCT FROM 'tiny'")
     if machine is not None:
         conditions.append(f"starts_with(CAST(u.machine_id AS VARCHAR), {_quoted(machine)})")
+    # the text columns (the measurement's parameters) and the quantity's own, not the rest
+    wanted = {"run_id", "row_index", "experiment", "table", "experiment_size", column,
+              f"{column}_lo", f"{column}_hi", f"{column[:-3]}_samples_ms", *(where or {})}
+    keep = [f.name for f in schema if f.name in wanted or pa.types.is_string(f.type)]
     rows = store.query(
-        f"SELECT r.*, CAST(u.started AS VARCHAR) AS {_RUN[0]}, "
+        f"SELECT {', '.join('r.' + _column(c) for c in keep)}, "
+        f"CAST(u.started AS VARCHAR) AS {_RUN[0]}, "
         f"CAST(u.\"commit\" AS VARCHAR) AS {_RUN[1]}, CAST(u.machine_id AS VARCHAR) AS "
         f"{_RUN[2]} FROM rows r JOIN runs u ON r.run_id = u.run_id "
         f"WHERE {' AND '.join(conditions)} "

@@ -3,9 +3,10 @@ experiment its latest stored run (:func:`~workbench.experiment.report.latest_sou
 declaration, its claims stated from that run and its stored tables with their legends; every
 run and every machine fingerprint.
 
-The store is asked few times: one query for the runs, one for the machines and one per stored
-table (a table a claim reads again is not asked twice: :class:`OnceStore` keeps each query's
-answer for the build).
+The store's Parquet files are read once per build: :class:`OnceStore` copies its three views
+into an in-memory DuckDB database when it is made, and answers every query of the build from
+that copy (each distinct query once), so the site shows the store as it was at one moment even
+while runs go on writing to it.
 """
 
 from __future__ import annotations
@@ -32,18 +33,28 @@ if TYPE_CHECKING:
 
 
 class OnceStore:
-    """A :class:`~workbench.results.store.ResultsStore` seen through a cache: each distinct
-    SQL text is asked of the store once (the store is read, never written, while a site is
-    built). ``root`` and every other attribute are the store's."""
+    """A snapshot of a :class:`~workbench.results.store.ResultsStore` for one build: its views
+    ``rows``, ``runs`` and ``machines`` copied into tables of an in-memory DuckDB database, each
+    distinct SQL text answered once. ``root`` and every other attribute are the store's."""
 
     def __init__(self, store: ResultsStore) -> None:
         self._store, self._answers = store, {}
+        self._con = store.connect()
+        for view in ("rows", "runs", "machines"):
+            self._con.execute(f"CREATE TABLE snapshot_{view} AS SELECT * FROM {view}")
+        for view in ("rows", "runs", "machines"):
+            self._con.execute(f"DROP VIEW {view}")
+            self._con.execute(f"ALTER TABLE snapshot_{view} RENAME TO {view}")
 
     def query(self, sql: str) -> pa.Table:
-        """The answer to ``sql`` (asked of the store the first time only)."""
+        """The answer to ``sql`` over the snapshot (computed the first time only)."""
         if sql not in self._answers:
-            self._answers[sql] = self._store.query(sql)
+            self._answers[sql] = self._con.sql(sql).to_arrow_table()
         return self._answers[sql]
+
+    def close(self) -> None:
+        """Release the snapshot's database."""
+        self._con.close()
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._store, name)

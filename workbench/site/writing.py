@@ -120,7 +120,15 @@ def write_site(store: ResultsStore, out: str | os.PathLike[str],
     an ``out`` that exists and is a symbolic link or not a folder, and a store without an
     experiment run at quick or full size, before anything is written."""
     out = output_folder(out)
-    store = OnceStore(store)
+    snapshot = OnceStore(store)
+    try:
+        return _write_site(snapshot, out, Path(figures))
+    finally:
+        snapshot.close()
+
+
+def _write_site(store: OnceStore, out: Path, figures: Path) -> Path:
+    """:func:`write_site` from the snapshot ``store``."""
     gather(store)  # refuse an empty store before making anything (its answers are kept)
     parent = out.parent
     parent.mkdir(parents=True, exist_ok=True)
@@ -128,7 +136,7 @@ def write_site(store: ResultsStore, out: str | os.PathLike[str],
     staging = parent / f".{out.name}.{os.getpid()}.{secrets.token_hex(4)}.partial"
     staging.mkdir()
     try:
-        build(staging, store, Path(figures))
+        build(staging, store, figures)
         if os.path.lexists(output_folder(out)):
             old = parent / f".{out.name}.{os.getpid()}.{secrets.token_hex(4)}.old"
             os.replace(out, old)
