@@ -60,10 +60,14 @@ def pareto_columns(rows: Sequence[dict[str, Any]]) -> tuple[str, str] | None:
 def pareto_plot(path: Path, rows: Sequence[dict[str, Any]], time: str, error: str,
                 title: str) -> Path:
     """Write the Pareto PNG of ``rows`` (``error`` against ``time``, each point named by its
-    path, case, function, scene or style, else its row number) to ``path`` atomically."""
+    path, case, function, scene or style, else its row number, and its scene where the table
+    holds several) to ``path`` atomically."""
     named = []
+    scenes = {row.get("scene") for row in rows} - {None}
     for i, row in enumerate(rows):
         label = next((str(row[c]) for c in _LABELS if row.get(c) is not None), f"row {i}")
+        if len(scenes) > 1 and row.get("scene") is not None and label != str(row["scene"]):
+            label += f" ({row['scene']})"  # a table of several scenes: name each point's
         named.append({**row, "path": label})
     return save_pareto(path, named, time_column=time, metric=error, title=title)
 
@@ -104,7 +108,8 @@ def history_plot(path: Path, histories: Sequence[History], title: str, unit: str
     ax.grid(True, alpha=0.3)
     if values:
         ax.legend(fontsize=7)
-    fig.tight_layout()
+    # fixed margins: tight_layout gives up on a legend of long measurement names
+    fig.subplots_adjust(left=0.1, right=0.98, top=0.92, bottom=0.12)
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png")
     return atomic_write_bytes(path, buffer.getvalue())

@@ -61,7 +61,7 @@ def _experiment(staging: Path, store: OnceStore, contents: Contents, name: str,
         if columns is not None:
             png = f"pareto-{safe(name)}-{safe(stored.name)}.png"
             pareto_plot(staging / "plots" / png, stored.rows, *columns,
-                        title=f"{name} / {stored.name}: {columns[1]} against {columns[0]}")
+                        title=f"{name} / {stored.name}\n{columns[1]} against {columns[0]}")
             paretos[stored.name] = (f"plots/{png}", *columns)
     history = False
     if view.claims:
