@@ -182,6 +182,9 @@ def test_measurement_keys_leave_out_who_ran_it_and_the_times():
            "path": "p", "renderer": "r1", "run_id": "x", "wall_ms": 1.0, "note_ms": "3"}
     other = {**row, "renderer": "r2", "run_id": "y", "wall_ms": 2.0}
     assert measurement_key(row) == measurement_key(other)
+    # the EGL device the harness stamps on each row is where it ran, not what it measured
+    assert measurement_key({**row, "egl_device": "egl0:software"}) == measurement_key(
+        {**other, "egl_device": "egl1:0f3c"})
     assert measurement_key(row) != measurement_key({**row, "path": "q"})
 
 

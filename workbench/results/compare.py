@@ -4,8 +4,8 @@ P slower?", "how does this machine compare with that one?".
 A side is chosen by a selector: a run id, a commit or a machine id (or a unique prefix of one);
 a commit or a machine selects every run recorded for it. Rows are paired when they are the same
 measurement: the same experiment, table and experiment size, the same text-valued parameters
-(scene, path, style, case …; the renderer and the run's own columns are left out so that two
-machines can be compared), and the same position among the rows equal in all of those.
+(scene, path, style, case …; the renderer, the EGL device and the run's own columns are left out
+so that two machines can be compared), and the same position among the rows equal in all of those.
 
 Each measured quantity of a pair gives one line of the comparison:
 
@@ -47,9 +47,10 @@ if TYPE_CHECKING:
 
 THRESHOLD = 0.10
 MIN_DRIFT_TIMES = 3  # times a group needs for its drift: with one, the drift is its own ratio
-# columns that are not the measurement's parameters: who ran it, and where
-RUN_COLUMNS = {"run_id", "row_index", "renderer", "experiment", "table", "experiment_size",
-               "error"}
+# columns that are not the measurement's parameters: who ran it, and where (the renderer and
+# the EGL device the harness stamps on each row drawn on it)
+RUN_COLUMNS = {"run_id", "row_index", "renderer", "egl_device", "experiment", "table",
+               "experiment_size", "error"}
 ERROR_COLUMNS = ("max_diff_255", "mean_diff_255", "share_differing", "psnr_db", "ssim")
 _TIMED = re.compile(r"(_ms|_s)(_min|_max|_lo|_hi)?$|_samples_ms$|^repeats$|_pairs$")
 _SELECTOR = re.compile(r"^[A-Za-z0-9_.-]+$")

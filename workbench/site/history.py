@@ -1,9 +1,9 @@
 """The history pages: per experiment with claims, per claim, every numeric column the claim
 reads (:attr:`Claim.reads <workbench.experiment.declare.Claim.reads>`) over the stored runs,
 from :func:`workbench.results.history.histories`: a plot (value per run with its interval,
-change points as dashed lines) and per measurement a table of its runs, the first run after
-each change point marked (class ``change-point``) and listed with its step (the ratio of the
-medians after and before).
+change points as dashed lines) and per measurement a table of its runs (folded away where the
+measurement has no change point), the first run after each change point marked (class
+``change-point``) and listed with its step (the ratio of the medians after and before).
 
 Interval bounds (``_lo``/``_hi``) and pair counts are not columns of their own here: a
 history carries its run's interval with each value.
@@ -144,10 +144,12 @@ def _points(history: History, machines: set[str]) -> str:
     classes = ["change-point" if i in changed else "" for i in range(len(rows))]
     machine = (link(machine_page(history.machine_id), history.machine_id[:12])
                if history.machine_id in machines else escape(history.machine_id[:12]))
+    runs = table(rows, raw=("run",), row_classes=classes)
+    if not history.changes:  # folded: a claim may read hundreds of steady measurements
+        runs = f"<details><summary>its {len(rows)} runs</summary>{runs}</details>"
     return (f"<h4>{escape(history.measurement or 'all rows')}</h4>"
             f'<p class="source">machine {machine}, size {escape(str(history.size))}, '
-            f"{len(history.points)} runs</p>" + _changes(history)
-            + table(rows, raw=("run",), row_classes=classes))
+            f"{len(history.points)} runs</p>" + _changes(history) + runs)
 
 
 def history_body(view: ExperimentView, claims: list[tuple[ClaimView, list[Quantity]]],
