@@ -17,6 +17,7 @@ h3 { font-size: 1.05em; margin-top: 1.3em; }
 table { border-collapse: collapse; margin: 0.5em 0; font-size: 0.85em; }
 th, td { border: 1px solid #ccc; padding: 0.2em 0.5em; vertical-align: top; }
 td { white-space: nowrap; } table#experiments td { white-space: normal; }
+table#experiments td:nth-child(3) { min-width: 30em; }
 th { background: #f2f2f2; }
 table.sortable th { cursor: pointer; user-select: none; }
 table.sortable th[aria-sort="ascending"]::after { content: " \\25B2"; }
