@@ -291,3 +291,19 @@ def write_rich_d3plot(folder, seed=0, permute=False, rename_node=None):
     path = folder / "d3plot"
     plot.write_d3plot(str(path))
     return path
+
+
+def flange_plates():
+    """Three parallel plates (mm) as an FEMesh named "plates": part 0 at z = 0 over x 0..100,
+    part 1 at z = 1 over x 0..40 (1 mm from part 0), part 2 at z = 30 over x 60..100 (30 mm
+    away); y 0..50 for all."""
+    from workbench.scene.mesh import FEMesh
+
+    blocks = [quad_grid(20, 10, span=((0, 100), (0, 50)), z=0.0),
+              quad_grid(8, 10, span=((0, 40), (0, 50)), z=1.0),
+              quad_grid(8, 10, span=((60, 100), (0, 50)), z=30.0)]
+    first = np.cumsum([0] + [len(b[0]) for b in blocks[:-1]])
+    nodes = np.concatenate([b[0] for b in blocks])
+    elements = np.concatenate([b[1] + k for b, k in zip(blocks, first)]).astype(np.int32)
+    parts = np.repeat(np.arange(3), [len(b[1]) for b in blocks]).astype(np.int32)
+    return FEMesh(nodes=nodes, elements=elements, parts=parts, name="plates")

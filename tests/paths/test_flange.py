@@ -3,14 +3,13 @@ farther than the threshold hidden by the alpha test."""
 
 import numpy as np
 import pytest
-from meshes import quad_grid
+from meshes import flange_plates
 
 from workbench.algo.nearest.parts import flange_distances
 from workbench.measurement.images import coverage
 from workbench.measurement.rows import default_camera, measure
 from workbench.paths import make_path
 from workbench.paths.flange import FlangeStyle
-from workbench.scene.mesh import FEMesh
 
 SIZE = (300, 200)
 
@@ -19,14 +18,7 @@ SIZE = (300, 200)
 def plates():
     """Part 0: a plate at z = 0 over x 0..100; part 1 at z = 1 over x 0..40 (1 mm away);
     part 2 at z = 30 over x 60..100 (30 mm away)."""
-    blocks = [quad_grid(20, 10, span=((0, 100), (0, 50)), z=0.0),
-              quad_grid(8, 10, span=((0, 40), (0, 50)), z=1.0),
-              quad_grid(8, 10, span=((60, 100), (0, 50)), z=30.0)]
-    first = np.cumsum([0] + [len(b[0]) for b in blocks[:-1]])
-    nodes = np.concatenate([b[0] for b in blocks])
-    elements = np.concatenate([b[1] + k for b, k in zip(blocks, first)]).astype(np.int32)
-    parts = np.repeat(np.arange(3), [len(b[1]) for b in blocks]).astype(np.int32)
-    return FEMesh(nodes=nodes, elements=elements, parts=parts, name="plates")
+    return flange_plates()
 
 
 def test_distances_of_the_plates(plates):

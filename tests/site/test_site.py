@@ -25,11 +25,11 @@ from site_store import (
 )
 
 from workbench.cli import main
+from workbench.output.swap import clean_dead_swaps
 from workbench.results.store import ResultsStore
 from workbench.site import write_site
 from workbench.site import writing as site_writing
 from workbench.site.plots import pareto_columns
-from workbench.site.writing import clean_dead_builds
 
 
 class Parsed(HTMLParser):
@@ -228,10 +228,10 @@ def test_the_site_is_written_whole_and_bad_targets_are_refused(tmp_path, monkeyp
     # what a killed build left is cleaned up by the next: its half-built folder removed, an
     # old site it had set aside (killed between the renames) put back first
     dead = 999_999_999  # no such process
-    (out.parent / f".site.{dead}.0a0a.partial").mkdir()
-    os.replace(out, out.parent / f".site.{dead}.0b0b.old")
-    assert sorted(p.name for p in clean_dead_builds(out)) == [f".site.{dead}.0a0a.partial",
-                                                              f".site.{dead}.0b0b.old"]
+    (out.parent / f".site.0a0a.{dead}.partial").mkdir()
+    os.replace(out, out.parent / f".site.{dead}.old")
+    assert sorted(p.name for p in clean_dead_swaps(out)) == [f".site.0a0a.{dead}.partial",
+                                                             f".site.{dead}.old"]
     assert (out / "kept.txt").read_text() == "old site"
     assert sorted(p.name for p in out.parent.iterdir()) == ["site"]
 

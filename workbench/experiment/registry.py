@@ -13,13 +13,11 @@ the declared legend.
 
 from __future__ import annotations
 
-import glob
 import importlib
 import os
 import pkgutil
 import re
 import shutil
-import tempfile
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -28,9 +26,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..measurement.timing import empty_gpu_note
-from ..output.tables import current_umask, write_table
+from ..output.swap import clean_dead_swaps, staging_folder, swap_in
+from ..output.tables import write_table
 from ..output.targets import output_folder
-from ..results.store import process_alive
 from .context import SIZES, ExperimentContext
 from .declare import Declaration
 from .warm import warm_experiment
@@ -167,9 +165,7 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
             took = warm_experiment(exp)
             if progress is not None:
                 progress(f"kernels warmed by the tiny run ({took:.1f} s, not timed)")
-        staging = Path(tempfile.mkdtemp(dir=root, prefix=f".{exp.name}.",
-                                        suffix=f".{os.getpid()}.partial"))
-        os.chmod(staging, 0o777 & ~current_umask())  # mkdtemp makes 0700; the folder is public
+        staging = staging_folder(out_dir)
         context = ExperimentContext(exp.name, staging, size, progress, declared=exp.declared)
         try:
             try:
@@ -192,7 +188,7 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
                     legend=context.legend("table", rows))
         if recorder is not None:  # the folder names its run: figures link to it
             recorder.write_provenance(staging, exp.name, size)
-        _swap_in(staging, out_dir)
+        swap_in(staging, out_dir)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
@@ -202,39 +198,14 @@ def run_experiment(name: str, figures_root: str | os.PathLike[str] = Path("figur
     return rows, out_dir
 
 
-def _swap_in(staging: Path, out_dir: Path) -> None:
-    """Put ``staging`` in the place of ``out_dir``: the previous folder is set aside as
-    ``.<name>.<pid>.old`` first and removed last (a kill in between leaves it for
-    :func:`clean_dead_runs` to put back). Refuses (ValueError) an ``out_dir`` that has become
-    a symbolic link or something other than a folder."""
-    if not os.path.lexists(output_folder(out_dir)):
-        os.replace(staging, out_dir)
-        return
-    old = out_dir.with_name(f".{out_dir.name}.{os.getpid()}.old")
-    shutil.rmtree(old, ignore_errors=True)
-    os.replace(out_dir, old)
-    os.replace(staging, out_dir)
-    shutil.rmtree(old, ignore_errors=True)
-
-
 def clean_dead_runs(root: Path, name: str) -> list[Path]:
     """Remove what runs of experiment ``name`` that died left in ``root``: their staging
-    folders, temporary files in the output folder, and a previous output folder set aside (put
-    back when the output folder is missing, i.e. the run died between the two renames).
-    Folders of runs still alive are left alone. Returns what was removed or restored."""
-    done = []
+    folders and a previous output folder set aside (put back when the output folder is
+    missing: :func:`~workbench.output.swap.clean_dead_swaps`), and temporary files in the
+    output folder. Folders of runs still alive are left alone. Returns what was removed or
+    restored."""
     out_dir = root / name
-    for entry in sorted(root.glob(f".{glob.escape(name)}.*")):
-        parts = entry.name.rsplit(".", 2)
-        if len(parts) != 3 or parts[2] not in ("partial", "old") or not parts[1].isdigit():
-            continue
-        if process_alive(int(parts[1])) and int(parts[1]) != os.getpid():
-            continue
-        if parts[2] == "old" and not os.path.lexists(out_dir):
-            os.replace(entry, out_dir)
-        else:
-            shutil.rmtree(entry, ignore_errors=True)
-        done.append(entry)
+    done = clean_dead_swaps(out_dir)
     if out_dir.is_dir() and not out_dir.is_symlink():  # never remove files through a link
         for tmp in out_dir.glob(".*.tmp"):
             tmp.unlink(missing_ok=True)

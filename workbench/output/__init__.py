@@ -2,6 +2,7 @@
 
 ============  ================================================================
 ``targets``   where output may go (a regular file replaced whole, or a folder)
+``swap``      a folder of outputs replaced whole (staging folder, then renames)
 ``tables``    CSV and aligned Markdown tables, atomic writes
 ``figures``   PNGs, field images with a colour bar, comparison grids, animations
 ``video``     frames as MP4 or GIF

@@ -46,6 +46,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..output.swap import process_alive
 from ..output.targets import output_folder, output_target
 
 if TYPE_CHECKING:
@@ -197,24 +198,6 @@ def _write(table: pa.Table, path: Path, root: Path, exclusive: bool = False) -> 
             pass
     _fsync_dir(path.parent)
     return True
-
-
-def process_alive(pid: int) -> bool:
-    """Whether process ``pid`` still runs on this machine (a zombie does not: its writes are
-    over)."""
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    try:  # a killed child nobody has reaped yet is a zombie: its writes are over
-        with open(f"/proc/{pid}/stat", "rb") as stat:
-            return stat.read().rsplit(b")", 1)[1].split()[0] != b"Z"
-    except (OSError, IndexError):
-        return True
 
 
 def _quote(name: str) -> str:

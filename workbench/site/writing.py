@@ -1,7 +1,7 @@
 """Writing the whole site at once: :func:`write_site` builds it in a hidden folder beside the
-target (``.<name>.<pid>.<hex>.partial``) and only then puts it in the target's place with
-renames, so a reader sees the old site or the new one, never half of one; a build that fails
-removes its folder and leaves the old site as it was.
+target and only then puts it in the target's place with renames
+(:mod:`workbench.output.swap`), so a reader sees the old site or the new one, never half of
+one; a build that fails removes its folder and leaves the old site as it was.
 
 Layout of the site (every page in its top folder, every link relative, so it opens from disk)::
 
@@ -17,20 +17,19 @@ Layout of the site (every page in its top folder, every link relative, so it ope
 Refused before anything is written (ValueError naming the path): a target that exists and is
 not a folder or is a symbolic link (:func:`workbench.output.targets.output_folder`), and a
 store holding no experiment run at quick or full size. What a build killed midway left beside
-the target is cleaned up by the next (:func:`clean_dead_builds`).
+the target is cleaned up by the next (:func:`~workbench.output.swap.clean_dead_swaps`).
 """
 
 from __future__ import annotations
 
-import glob
 import os
-import secrets
 import shutil
 from pathlib import Path
 from urllib.parse import quote
 
+from ..output.swap import clean_dead_swaps, staging_folder, swap_in
 from ..output.targets import output_folder
-from ..results.store import ResultsStore, process_alive
+from ..results.store import ResultsStore
 from .assets import CSS, CSS_NAME, JS, JS_NAME
 from .contents import Contents, OnceStore, gather
 from .figures import experiment_figures
@@ -92,26 +91,6 @@ def build(staging: Path, store: ResultsStore | OnceStore, figures: Path) -> None
     _write(staging / "index.html", index_page(contents, extras))
 
 
-def clean_dead_builds(out: Path) -> list[Path]:
-    """Remove what builds of the site ``out`` that died left beside it (their
-    ``.<name>.<pid>.<hex>.partial`` folders, and ``.old`` ones: an old site set aside is put
-    back where ``out`` is missing, the build having died between its two renames). Folders of
-    builds still running are left alone. Returns what was removed or put back."""
-    done = []
-    for entry in sorted(out.parent.glob(f".{glob.escape(out.name)}.*.*")):
-        parts = entry.name[len(out.name) + 2:].split(".")
-        if (len(parts) != 3 or parts[2] not in ("partial", "old") or not parts[0].isdigit()
-                or (process_alive(int(parts[0])) and int(parts[0]) != os.getpid())
-                or entry.is_symlink() or not entry.is_dir()):
-            continue
-        if parts[2] == "old" and not os.path.lexists(out):
-            os.replace(entry, out)
-        else:
-            shutil.rmtree(entry, ignore_errors=True)
-        done.append(entry)
-    return done
-
-
 def write_site(store: ResultsStore, out: str | os.PathLike[str],
                figures: str | os.PathLike[str] = "figures") -> Path:
     """Write the site of ``store`` into the folder ``out`` (made with its parents where
@@ -130,20 +109,11 @@ def write_site(store: ResultsStore, out: str | os.PathLike[str],
 def _write_site(store: OnceStore, out: Path, figures: Path) -> Path:
     """:func:`write_site` from the snapshot ``store``."""
     gather(store)  # refuse an empty store before making anything (its answers are kept)
-    parent = out.parent
-    parent.mkdir(parents=True, exist_ok=True)
-    clean_dead_builds(out)
-    staging = parent / f".{out.name}.{os.getpid()}.{secrets.token_hex(4)}.partial"
-    staging.mkdir()
+    clean_dead_swaps(out)
+    staging = staging_folder(out)
     try:
         build(staging, store, figures)
-        if os.path.lexists(output_folder(out)):
-            old = parent / f".{out.name}.{os.getpid()}.{secrets.token_hex(4)}.old"
-            os.replace(out, old)
-            os.replace(staging, out)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(staging, out)
+        swap_in(staging, out)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return out / "index.html"
